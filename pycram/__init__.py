@@ -1,0 +1,1 @@
+"""PyCRAM: concurrent, reactive plans for mobile manipulation robots."""
