@@ -1,0 +1,560 @@
+"""The thesis' ``Designator`` API (ch. 3.3) and the lazy, cached resolution shared by all kinds.
+
+A designator is an immutable list of ``(key, value)`` properties describing an entity (a motion,
+an object, a location, an action). Designators describing the same entity over time are *equated*
+into a chain (``first`` ... ``current``); resolving (``reference``) yields a concrete solution.
+
+Guarantees
+----------
+- Properties are validated on construction: anything that is not a sequence of pairs raises
+  :class:`PropertyError`. They never change afterwards (``copy`` makes a new designator).
+- ``reference()`` is thread-safe: concurrent callers on one designator run ``_reference`` once;
+  the others wait (evaporably, through the runtime's ``wait_until`` when available) and receive
+  the same solution. Repeated calls return the same solution.
+- Resolution is lazy: resolvers and generators are advanced only as far as the solutions
+  requested so far (:class:`GeneratorList`).
+- A broken resolver (raises, returns a non-iterable) surfaces as :class:`ResolverError` naming the
+  designator and the resolver, never as a silent empty result; a designator without solutions
+  raises :class:`NoSolutionError` naming its properties and the resolvers tried.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Mapping
+from inspect import isgenerator, isgeneratorfunction
+from typing import Any, Callable, Iterable, Iterator, Optional, Sequence
+
+__all__ = [
+    "Designator",
+    "DesignatorError",
+    "PropertyError",
+    "ResolverError",
+    "NoSolutionError",
+    "UnknownKindError",
+    "GeneratorList",
+    "LazyDesignator",
+    "Property",
+]
+
+logger = logging.getLogger("pycram.designator")
+
+Property = tuple[Any, Any]
+
+_MISSING = object()
+
+
+# --------------------------------------------------------------------------- errors
+
+
+class DesignatorError(Exception):
+    """Base class of all designator errors (thesis name); also "not resolvable"."""
+
+
+class PropertyError(DesignatorError, ValueError):
+    """The properties given to a designator are malformed (not a sequence of pairs...)."""
+
+
+class UnknownKindError(DesignatorError, TypeError):
+    """An object was used as a designator of a kind the operation does not know."""
+
+
+class ResolverError(DesignatorError):
+    """A resolver (or generator, validator) failed: it raised or returned something unusable.
+
+    Attributes: ``designator``, ``resolver`` and ``cause`` (also chained as ``__cause__``).
+    """
+
+    def __init__(self, message: str, designator: Any = None, resolver: Any = None,
+                 cause: Optional[BaseException] = None) -> None:
+        super().__init__(message)
+        self.designator = designator
+        self.resolver = resolver
+        self.cause = cause
+
+
+class NoSolutionError(DesignatorError):
+    """The designator has no (more) solutions. Attributes: ``designator``, ``resolvers``."""
+
+    def __init__(self, message: str, designator: Any = None,
+                 resolvers: Sequence[Any] = ()) -> None:
+        super().__init__(message)
+        self.designator = designator
+        self.resolvers = list(resolvers)
+
+
+def callable_name(f: Any) -> str:
+    """A readable name for a resolver, generator or validator in error messages."""
+    module = getattr(f, "__module__", None)
+    name = getattr(f, "__qualname__", None) or getattr(f, "__name__", None)
+    if name is None:
+        return repr(f)
+    return f"{module}.{name}" if module and module != "builtins" else name
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _now() -> float:
+    """Current time of the active pycram clock (wall clock when the runtime is unavailable)."""
+    try:
+        from pycram.runtime import current_clock
+    except ImportError:  # runtime not importable: fall back to the wall clock
+        return time.time()
+    return current_clock().now()
+
+
+def _wait(condition: threading.Condition, predicate: Callable[[], bool]) -> None:
+    """Block on ``condition`` (held by the caller) until ``predicate()``; evaporable if possible."""
+    try:
+        from pycram.runtime import wait_until
+    except ImportError:
+        condition.wait_for(predicate)
+        return
+    wait_until(condition, predicate)
+
+
+def normalize_properties(properties: Any, kwargs: Mapping[str, Any], owner: str) -> list[Property]:
+    """Validate and normalize ``properties`` (pairs, or a mapping) plus keyword properties.
+
+    Keyword properties are appended after positional ones; a keyword repeating a key of
+    ``properties`` overwrites it (same rule as :meth:`Designator.copy`).
+    """
+    result: list[Property] = []
+    if properties is None:
+        pass
+    elif isinstance(properties, Mapping):
+        result.extend(properties.items())
+    elif isinstance(properties, (str, bytes)) or not isinstance(properties, Iterable):
+        raise PropertyError(
+            f"{owner}: properties must be a list of (key, value) pairs, got {properties!r}")
+    else:
+        for index, prop in enumerate(properties):
+            if not isinstance(prop, (tuple, list)) or len(prop) != 2:
+                raise PropertyError(
+                    f"{owner}: property #{index} {prop!r} is not a (key, value) pair "
+                    f"in {properties!r}")
+            if isinstance(prop[0], (list, dict, set)):
+                raise PropertyError(f"{owner}: property key {prop[0]!r} is not hashable")
+            result.append((prop[0], prop[1]))
+    for key, value in kwargs.items():
+        _merge(result, key, value)
+    return result
+
+
+def _merge(properties: list[Property], key: Any, value: Any) -> None:
+    replaced = False
+    for i, (k, _) in enumerate(properties):
+        if k == key:
+            properties[i] = (key, value)
+            replaced = True
+    if not replaced:
+        properties.append((key, value))
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+# --------------------------------------------------------------------------- Designator
+
+
+class Designator:
+    """A symbolic description of an entity as ``(key, value)`` pairs (thesis ch. 3.3).
+
+    ``Designator(properties, parent=None)`` with ``properties`` a list of pairs; keyword
+    properties are a convenience: ``Designator(shape='round')`` equals
+    ``Designator([('shape', 'round')])``. ``parent`` equates the new designator to an existing one.
+
+    Only ``timestamp`` is a public attribute; everything else is reached through methods.
+    Subclasses implement resolution by overriding ``_reference`` (called serialized by
+    :meth:`reference`) and ``next_solution``.
+    """
+
+    def __init__(self, properties: Any = None, parent: Optional["Designator"] = None,
+                 **kwargs: Any) -> None:
+        self._mutex = threading.Condition(threading.RLock())
+        self._resolving: Optional[int] = None  # ident of the thread running _reference
+        self._parent: Optional[Designator] = None
+        self._successor: Optional[Designator] = None
+        self._effective = False
+        self._data: Any = None
+        self.timestamp: Optional[float] = None
+        self._properties: list[Property] = normalize_properties(
+            properties, kwargs, type(self).__name__)
+        if parent is not None:
+            if not isinstance(parent, Designator):
+                raise UnknownKindError(
+                    f"{type(self).__name__}: parent must be a Designator, got {parent!r}")
+            self.equate(parent)
+
+    # -- chain ----------------------------------------------------------------------------
+
+    def equate(self, parent: "Designator") -> None:
+        """Equate this designator with ``parent``: both describe the same entity afterwards.
+
+        This designator (with any ancestors it already has) is appended after the most recent
+        designator of ``parent``'s chain. Does nothing if they are already equal.
+        """
+        if not isinstance(parent, Designator):
+            raise UnknownKindError(f"cannot equate {self!r} with non-designator {parent!r}")
+        with _chain_lock:
+            if self.equal(parent):
+                return
+            youngest_parent = parent.current()
+            first_parent = parent.first()
+            if self._parent is not None:
+                # Splice parent's chain between our former parent and us (thesis semantics).
+                first_parent._parent = self._parent
+                first_parent._parent._successor = first_parent
+            self._parent = youngest_parent
+            youngest_parent._successor = self
+
+    def equal(self, other: "Designator") -> bool:
+        """``True`` iff both designators are in the same chain (same first ancestor)."""
+        return other.first() is self.first()
+
+    def first(self) -> "Designator":
+        """The first ancestor of the chain of equated designators."""
+        desig = self
+        while desig._parent is not None:
+            desig = desig._parent
+        return desig
+
+    def current(self) -> "Designator":
+        """The most recent designator of the chain of equated designators."""
+        desig = self
+        while desig._successor is not None:
+            desig = desig._successor
+        return desig
+
+    def newest_effective(self) -> Optional["Designator"]:
+        """The most recent effective designator of the chain, or ``None`` if there is none."""
+        desig: Optional[Designator] = self.current()
+        while desig is not None and not desig._effective:
+            desig = desig._parent
+        return desig
+
+    # -- properties -----------------------------------------------------------------------
+
+    @property
+    def properties(self) -> list[Property]:
+        """A copy of the properties as a list of ``(key, value)`` pairs."""
+        return list(self._properties)
+
+    def prop_value(self, key: Any) -> Any:
+        """The value of the first property with ``key``, or ``None``."""
+        for k, v in self._properties:
+            if k == key:
+                return v
+        return None
+
+    def check_constraints(self, properties: Iterable[Any]) -> bool:
+        """``True`` iff every constraint holds.
+
+        A tuple ``(key, value)`` requires the property to equal ``value``; any other element is a
+        key whose value must not be ``None``.
+        """
+        for prop in properties:
+            if type(prop) == tuple:  # noqa: E721 - thesis semantics: only tuples are pairs
+                key, value = prop
+                if self.prop_value(key) != value:
+                    return False
+            elif self.prop_value(prop) is None:
+                return False
+        return True
+
+    def make_dictionary(self, properties: Iterable[Any]) -> dict[Any, Any]:
+        """A dict of the listed properties: tuples are taken literally, keys are looked up."""
+        dictionary: dict[Any, Any] = {}
+        for prop in properties:
+            if type(prop) == tuple:  # noqa: E721
+                key, value = prop
+                dictionary[key] = value
+            else:
+                dictionary[prop] = self.prop_value(prop)
+        return dictionary
+
+    # -- new designators ------------------------------------------------------------------
+
+    def copy(self, new_properties: Any = None, **kwargs: Any) -> "Designator":
+        """A new, unequated designator of the same class with the same properties.
+
+        ``new_properties`` (pairs) and keyword properties are dominant: an existing key is
+        overwritten, a new key appended.
+        """
+        properties = list(self._properties)
+        for key, value in normalize_properties(new_properties, kwargs, type(self).__name__):
+            _merge(properties, key, value)
+        return self.__class__(properties)
+
+    def make_effective(self, properties: Any = None, data: Any = None,
+                       timestamp: Optional[float] = None) -> "Designator":
+        """A new effective designator of the same class holding the low-level ``data``.
+
+        Properties default to this designator's; the timestamp to the active clock's now.
+        Like the thesis, the new designator is not equated to this one.
+        """
+        if properties is None:
+            properties = self._properties
+        desig = self.__class__(properties)
+        desig._effective = True
+        desig._data = data
+        desig.timestamp = _now() if timestamp is None else timestamp
+        return desig
+
+    # -- resolution -----------------------------------------------------------------------
+
+    def _reference(self) -> Any:
+        """Resolve; override in subclasses. Default: the data of an effective designator."""
+        if self._effective:
+            return self._data
+        raise DesignatorError(f"{self!r} is not effective and {type(self).__name__} "
+                              f"has no resolution")
+
+    def reference(self) -> Any:
+        """Resolve this designator to its low-level solution (always the same one).
+
+        Thread-safe: ``_reference`` runs in one thread at a time; concurrent callers wait
+        (evaporable) and then get the cached solution. A resolver that calls ``reference`` on the
+        designator it is resolving gets a :class:`ResolverError` instead of a deadlock.
+        Raises :class:`DesignatorError` (or a subclass) when it cannot be resolved.
+        """
+        me = threading.get_ident()
+        with self._mutex:
+            if self._resolving == me:
+                raise ResolverError(
+                    f"{self!r}: a resolver called reference() on the designator it is resolving",
+                    designator=self)
+            _wait(self._mutex, lambda: self._resolving is None)
+            self._resolving = me
+        try:
+            ret = self._reference()
+        finally:
+            with self._mutex:
+                self._resolving = None
+                self._mutex.notify_all()
+        self._effective = True
+        if self.timestamp is None:
+            self.timestamp = _now()
+        return ret
+
+    def next_solution(self) -> Optional["Designator"]:
+        """A new designator equated to this one for the next solution, or ``None``."""
+        return None
+
+    def solutions(self, from_root: Any = None) -> Iterator[Any]:
+        """Generator of all solutions of this designator (from the chain's first if
+        ``from_root`` is not ``None``), following ``next_solution``.
+
+        Designators that cannot be referenced are skipped (thesis); a broken resolver
+        (:class:`ResolverError`) propagates.
+        """
+        desig: Optional[Designator] = self.first() if from_root is not None else self
+
+        def generator(desig: Optional[Designator]) -> Iterator[Any]:
+            while desig is not None:
+                try:
+                    yield desig.reference()
+                except ResolverError:
+                    raise
+                except DesignatorError:
+                    pass
+                desig = desig.next_solution()
+
+        return generator(desig)
+
+    # -- display --------------------------------------------------------------------------
+
+    def __repr__(self) -> str:
+        props = ", ".join(f"({_short(k)}, {_short(v)})" for k, v in self._properties)
+        return f"{type(self).__name__}([{props}])"
+
+
+_chain_lock = threading.RLock()  # serializes equate() so concurrent chain edits stay consistent
+
+
+# --------------------------------------------------------------------------- lazy solutions
+
+
+class GeneratorList:
+    """A list filled on demand from a generator (thesis helper), safe for concurrent use.
+
+    ``get(i)`` advances the generator until ``i`` elements exist and raises ``StopIteration``
+    when it is exhausted first. An exception raised by the generator is remembered and re-raised
+    by every later ``get`` beyond the cached elements (a generator cannot be resumed after
+    raising); an interruption by a ``BaseException`` (e.g. evaporation) is reported as a
+    :class:`DesignatorError` on later calls.
+    """
+
+    def __init__(self, generator: Any) -> None:
+        if isgeneratorfunction(generator):
+            generator = generator()
+        self._generator = generator
+        self._generated: list[Any] = []
+        self._lock = threading.RLock()
+        self._done = False
+        self._error: Optional[BaseException] = None
+        self._advancing = False
+
+    def get(self, index: int = 0) -> Any:
+        with self._lock:
+            while len(self._generated) <= index:
+                if self._error is not None:
+                    raise self._error
+                if self._done:
+                    raise StopIteration
+                if self._advancing:
+                    raise ResolverError("a resolver re-entered the resolution it is part of")
+                self._advancing = True
+                try:
+                    self._generated.append(next(self._generator))
+                except StopIteration:
+                    self._done = True
+                    raise
+                except Exception as e:
+                    self._error = e
+                    raise
+                except BaseException:
+                    self._error = DesignatorError("resolution was interrupted (evaporated)")
+                    raise
+                finally:
+                    self._advancing = False
+            return self._generated[index]
+
+    def has(self, index: int) -> bool:
+        """``True`` iff an element exists at ``index`` (generating up to it)."""
+        try:
+            self.get(index)
+            return True
+        except StopIteration:
+            return False
+
+    @property
+    def generated(self) -> list[Any]:
+        """The elements generated so far (a copy)."""
+        with self._lock:
+            return list(self._generated)
+
+
+def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[Any]:
+    """Yield the solutions in a resolver's ``result``: items may be plain solutions,
+    generators or generator functions (thesis). Failures become :class:`ResolverError`."""
+    name = callable_name(resolver)
+    if result is None:
+        return
+    if isgeneratorfunction(result):
+        result = result()
+    if isinstance(result, (str, bytes)) or not isinstance(result, Iterable):
+        raise ResolverError(
+            f"resolver {name} returned a non-iterable {_short(result)} for {designator!r}; "
+            f"resolvers must return a list of solutions", designator=designator,
+            resolver=resolver)
+    iterator = iter(result)
+    while True:
+        try:
+            solution = next(iterator)
+        except StopIteration:
+            return
+        except Exception as e:
+            raise ResolverError(f"resolver {name} failed while resolving {designator!r}: {e!r}",
+                                designator=designator, resolver=resolver, cause=e) from e
+        if isgeneratorfunction(solution):
+            solution = solution()
+        if isgenerator(solution):
+            while True:
+                try:
+                    item = next(solution)
+                except StopIteration:
+                    break
+                except Exception as e:
+                    raise ResolverError(
+                        f"a solution generator of resolver {name} failed while resolving "
+                        f"{designator!r}: {e!r}", designator=designator, resolver=resolver,
+                        cause=e) from e
+                yield item
+        else:
+            yield solution
+
+
+def call_resolver(designator: Any, resolver: Any, *args: Any) -> Any:
+    """Call ``resolver(designator, *args)``, turning an exception into :class:`ResolverError`."""
+    try:
+        return resolver(designator, *args)
+    except DesignatorError as e:
+        if isinstance(e, ResolverError) and e.designator is designator:
+            raise
+        raise ResolverError(
+            f"resolver {callable_name(resolver)} failed while resolving {designator!r}: {e!r}",
+            designator=designator, resolver=resolver, cause=e) from e
+    except Exception as e:
+        raise ResolverError(
+            f"resolver {callable_name(resolver)} failed while resolving {designator!r}: {e!r}",
+            designator=designator, resolver=resolver, cause=e) from e
+
+
+class LazyDesignator(Designator):
+    """A designator whose solutions come lazily from :meth:`_generate` (thesis' motion
+    designator resolution, generalized to every kind).
+
+    Subclasses implement ``_generate()`` (a generator of solutions) and may override
+    ``_resolvers_for_message()``. Solutions are cached in a :class:`GeneratorList` shared by all
+    designators of one ``next_solution`` chain; each designator holds the index of its solution.
+    """
+
+    #: Noun used in error messages, e.g. "motion designator".
+    kind_name = "designator"
+
+    def __init__(self, properties: Any = None, parent: Optional[Designator] = None,
+                 **kwargs: Any) -> None:
+        self._solutions: Optional[GeneratorList] = None
+        self._index = 0
+        super().__init__(properties, parent, **kwargs)
+
+    def _generate(self) -> Iterator[Any]:
+        raise NotImplementedError
+
+    def _resolvers_for_message(self) -> list[Any]:
+        return []
+
+    def _no_solution_message(self) -> str:
+        names = [callable_name(r) for r in self._resolvers_for_message()]
+        from pycram.robot import describe_active_robot
+        which = "no" if self._index == 0 else f"no solution #{self._index} (only {self._index})"
+        return (f"Cannot resolve {self.kind_name} {self!r}: {which} solutions "
+                f"from resolvers {names} ({describe_active_robot()})")
+
+    def _reference(self) -> Any:
+        if self._effective and self._solutions is None:
+            return self._data  # made effective by hand (make_effective)
+        if self._solutions is None:
+            self._solutions = GeneratorList(self._generate)
+        if self._effective:
+            return self._data
+        try:
+            self._data = self._solutions.get(self._index)
+        except StopIteration:
+            raise NoSolutionError(self._no_solution_message(), designator=self,
+                                  resolvers=self._resolvers_for_message()) from None
+        return self._data
+
+    def next_solution(self) -> Optional["LazyDesignator"]:
+        """A new designator, equated to this one, for the next solution; ``None`` if none.
+
+        Raises :class:`ResolverError` when a resolver fails while looking for the next solution.
+        """
+        try:
+            self.reference()
+        except ResolverError:
+            raise
+        except DesignatorError:
+            pass
+        if self._solutions is not None and self._solutions.has(self._index + 1):
+            desig = self.__class__(self._properties, self)
+            desig._solutions = self._solutions
+            desig._index = self._index + 1
+            return desig
+        return None

@@ -1,0 +1,37 @@
+"""Motion designators (thesis ch. 3.3): descriptions of motions for process modules."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, ClassVar, Iterator
+
+from pycram.designators.core import LazyDesignator, call_resolver, expand_solutions
+
+__all__ = ["MotionDesignator"]
+
+
+class MotionDesignator(LazyDesignator):
+    """A motion, e.g. ``MotionDesignator([('type', 'moving'), ('pose', p)])``.
+
+    ``MotionDesignator.resolvers`` is the thesis' global list of resolvers: functions
+    ``f(designator) -> list`` whose items are solutions, generators or generator functions
+    producing solutions. The active robot's ``motion_resolvers`` (then the active world's) are
+    asked before the global list (see :mod:`pycram.robot`); the set is fixed at the first
+    ``reference()``. Solutions are produced lazily and cached; ``reference()`` always returns the
+    same solution, ``next_solution()`` an equated designator for the next one.
+    """
+
+    resolvers: ClassVar[list[Callable[["MotionDesignator"], Any]]] = []
+    kind_name = "motion designator"
+
+    def _resolvers_for_message(self) -> list[Any]:
+        return getattr(self, "_used_resolvers", None) or self._current_resolvers()
+
+    def _current_resolvers(self) -> list[Any]:
+        from pycram.robot import gather
+        return gather("motion_resolvers", MotionDesignator.resolvers)
+
+    def _generate(self) -> Iterator[Any]:
+        self._used_resolvers = resolvers = self._current_resolvers()
+        for resolver in resolvers:
+            result = call_resolver(self, resolver)
+            yield from expand_solutions(self, resolver, result)
