@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections.abc import Mapping
 from inspect import isgenerator, isgeneratorfunction
 from typing import Any, Callable, Iterable, Iterator, Optional, Sequence
@@ -98,21 +97,14 @@ def callable_name(f: Any) -> str:
 
 
 def _now() -> float:
-    """Current time of the active pycram clock (wall clock when the runtime is unavailable)."""
-    try:
-        from pycram.runtime import current_clock
-    except ImportError:  # runtime not importable: fall back to the wall clock
-        return time.time()
+    """Current time [s] of the active pycram clock."""
+    from pycram.runtime import current_clock
     return current_clock().now()
 
 
 def _wait(condition: threading.Condition, predicate: Callable[[], bool]) -> None:
-    """Block on ``condition`` (held by the caller) until ``predicate()``; evaporable if possible."""
-    try:
-        from pycram.runtime import wait_until
-    except ImportError:
-        condition.wait_for(predicate)
-        return
+    """Block on ``condition`` until ``predicate()`` (evaluated with it held); evaporable."""
+    from pycram.runtime import wait_until
     wait_until(condition, predicate)
 
 
@@ -329,8 +321,14 @@ class Designator:
                 raise ResolverError(
                     f"{self!r}: a resolver called reference() on the designator it is resolving",
                     designator=self)
-            _wait(self._mutex, lambda: self._resolving is None)
-            self._resolving = me
+
+        def claim() -> bool:  # evaluated under self._mutex: atomic check-and-set
+            if self._resolving is None:
+                self._resolving = me
+                return True
+            return False
+
+        _wait(self._mutex, claim)
         try:
             ret = self._reference()
         finally:

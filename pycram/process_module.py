@@ -1,0 +1,446 @@
+"""Process modules (thesis ch. 3.4): the only place that talks to hardware or the simulator.
+
+A process module executes motion designators for one component of a robot (base, head, an arm,
+a gripper...). Subclasses override ``_execute(designator)`` (and optionally the cancel hook
+``_cancel(designator)``); plans call ``ProcessModule.perform(designator)`` or
+``pycram.designator.perform(designator)``, which picks a module through the resolvers::
+
+    class Pr2Navigation(ProcessModule):
+        def _execute(self, designator):
+            solution = designator.reference()
+            ...
+
+    ProcessModule.resolvers.append(lambda d: pr2_navigation
+                                   if d.check_constraints([('type', 'moving')]) else None)
+
+Guarantees
+----------
+- **One at a time, first come first served.** A module executes one designator at a time;
+  callers are served in arrival order. The claim of the module is atomic (no check-then-set):
+  it happens under the module's condition, in the predicate of the wait.
+- ``_execute`` runs in the calling task's thread (blocking ``execute``) or in a child task of
+  the caller (``execute_nowait``), so evaporating the caller evaporates the motion.
+- **Cancellation.** When the task waiting in ``execute`` is evaporated while queued, its entry
+  leaves the queue; while running, the cancel hook ``_cancel(designator)`` runs (protected from
+  evaporation), the module is freed and the next queued designator starts. ``Evaporated`` then
+  propagates to the caller.
+- **Failures.** An exception raised by ``_execute`` reaches the caller as
+  :class:`ProcessModuleFailure` (``cause`` / ``__cause__`` is the original exception); the module
+  is freed and its status becomes ``FAILED``.
+- **Status.** ``module.status`` is a :class:`~pycram.fluent.Fluent` of
+  :class:`ProcessModuleStatus`: ``WAITING`` (idle, ready) → ``RUNNING`` → ``SUCCEEDED`` /
+  ``FAILED`` / ``CANCELLED`` (outcome of the last designator; the module is idle again) →
+  ``RUNNING`` ...; ``OFFLINE`` after :meth:`ProcessModule.shutdown`. Every transition is set
+  while the module's state is consistent (under its condition).
+- **No module.** :class:`NoProcessModuleError` names the designator's properties, the resolvers
+  asked and the active robot.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import threading
+from collections import deque
+from enum import Enum
+from typing import Any, Callable, ClassVar, Optional
+
+from pycram.designators.core import DesignatorError, callable_name
+from pycram.fluent import Fluent
+from pycram.robot import current_robot, describe_active_robot, gather
+from pycram.runtime import Evaporated, no_evaporation, wait_until
+
+__all__ = [
+    "ProcessModule",
+    "ProcessModuleStatus",
+    "ProcessModuleError",
+    "ProcessModuleFailure",
+    "ProcessModuleOffline",
+    "NoProcessModuleError",
+    "ExecutionCancelled",
+    "Execution",
+]
+
+logger = logging.getLogger(__name__)
+
+_ids = itertools.count(1)
+
+
+class ProcessModuleStatus(Enum):
+    """Status of a process module (and of one :class:`Execution`)."""
+
+    OFFLINE = "offline"  #: shut down; performing on it raises ProcessModuleOffline
+    WAITING = "waiting"  #: idle and ready (for an execution: queued)
+    RUNNING = "running"  #: executing a designator
+    SUCCEEDED = "succeeded"  #: the last designator succeeded; idle
+    FAILED = "failed"  #: the last designator failed; idle
+    CANCELLED = "cancelled"  #: the last designator was cancelled (evaporated); idle
+
+    @property
+    def done(self) -> bool:
+        """True for the outcomes SUCCEEDED, FAILED and CANCELLED."""
+        return self in (ProcessModuleStatus.SUCCEEDED, ProcessModuleStatus.FAILED,
+                        ProcessModuleStatus.CANCELLED)
+
+
+class ProcessModuleError(Exception):
+    """Base class of process-module errors. Attributes: ``designator``, ``module``, ``cause``."""
+
+    def __init__(self, message: str, designator: Any = None, module: Any = None,
+                 cause: Optional[BaseException] = None) -> None:
+        super().__init__(message)
+        self.designator = designator
+        self.module = module
+        self.cause = cause
+
+
+class ProcessModuleFailure(ProcessModuleError):
+    """``_execute`` raised: the motion failed. ``cause`` is the original exception."""
+
+
+class ProcessModuleOffline(ProcessModuleError):
+    """The module was shut down (status ``OFFLINE``) before the designator could run."""
+
+
+class ExecutionCancelled(ProcessModuleError):
+    """The execution was cancelled through its handle (``Execution.cancel``)."""
+
+
+class NoProcessModuleError(ProcessModuleError, DesignatorError, LookupError):
+    """No resolver returned a process module for the designator."""
+
+
+class Execution:
+    """One designator submitted to one module: its place in the queue and its outcome.
+
+    Returned by :meth:`ProcessModule.execute_nowait` as a handle: ``status`` is a fluent of
+    :class:`ProcessModuleStatus` (``WAITING`` while queued, then ``RUNNING``, then an outcome),
+    ``wait()`` blocks for the outcome, ``cancel()`` stops it.
+    """
+
+    def __init__(self, module: "ProcessModule", designator: Any) -> None:
+        self.id = next(_ids)
+        self.module = module
+        self.designator = designator
+        self.status = Fluent(ProcessModuleStatus.WAITING,
+                             name=f"{module.name}.execution-{self.id}.status")
+        self.result: Any = None
+        self.exception: Optional[BaseException] = None
+        self._task: Any = None  # the child task of a nowait execution
+        self._group: Any = None
+        self._cancel_requested = False
+
+    @property
+    def done(self) -> bool:
+        return self.status.get_value().done
+
+    def wait(self, timeout: Optional[float] = None) -> Any:
+        """Block until the execution ended and return ``_execute``'s result.
+
+        Raises :class:`ProcessModuleFailure` if it failed, :class:`ExecutionCancelled` if it was
+        cancelled, ``TimeoutError`` if ``timeout`` [s] (active clock) passed first. Evaporable.
+        """
+        if not wait_until(self.module._cond, lambda: self.done, timeout):
+            raise TimeoutError(f"{self!r} did not end within {timeout} s")
+        if self._group is not None:
+            self._group.wait_all()  # the child thread ends right after the outcome is set
+            self._group = None
+        status = self.status.get_value()
+        if status is ProcessModuleStatus.SUCCEEDED:
+            return self.result
+        if status is ProcessModuleStatus.CANCELLED:
+            raise ExecutionCancelled(
+                f"execution of {self.designator!r} on {self.module.name} was cancelled",
+                designator=self.designator, module=self.module, cause=self.exception)
+        assert self.exception is not None
+        raise self.exception
+
+    def cancel(self) -> None:
+        """Stop the execution: leave the queue, or evaporate the running ``_execute`` (the
+        module's cancel hook runs). Returns at once; idempotent; no effect once done."""
+        self._cancel_requested = True
+        task = self._task
+        if task is not None:
+            task.evaporate()
+        with self.module._cond:
+            self.module._cond.notify_all()
+
+    def __repr__(self) -> str:
+        return (f"<Execution {self.id} of {self.designator!r} on {self.module.name} "
+                f"{self.status.get_value().value}>")
+
+
+class ProcessModule:
+    """A component of a robot that executes motion designators (thesis API).
+
+    Override ``_execute(designator)`` (required) and ``_cancel(designator)`` (cancel hook:
+    stop the base, stop the arm...). ``resolvers`` is the thesis' global list of functions
+    ``f(designator) -> ProcessModule | None``; the active robot's ``process_module_resolvers``
+    are asked first.
+    """
+
+    resolvers: ClassVar[list[Callable[[Any], Optional["ProcessModule"]]]] = []
+
+    def __init__(self, name: Optional[str] = None) -> None:
+        self.name = name or type(self).__name__
+        self._cond = threading.Condition(threading.Lock())
+        self._queue: deque[Execution] = deque()
+        self._current: Optional[Execution] = None
+        self._offline = False
+        self.status = Fluent(ProcessModuleStatus.WAITING, name=f"{self.name}.status")
+        self._running = Fluent(False, name=f"{self.name}.running")  # thesis attribute
+
+    # -- thesis API --------------------------------------------------------------------------
+
+    @staticmethod
+    def perform(designator: Any) -> Any:
+        """Execute ``designator`` on the first module a resolver returns; return its result.
+
+        Blocks until done, except for designators with the property ``('wait', False)``
+        (thesis): then returns an :class:`Execution` handle at once. Raises
+        :class:`NoProcessModuleError` when no resolver returns a module.
+        """
+        module = ProcessModule.resolve(designator)
+        if designator.prop_value("wait") is False:
+            return module.execute_nowait(designator)
+        return module.execute(designator)
+
+    @staticmethod
+    def perform_nowait(designator: Any) -> Execution:
+        """Like :meth:`perform` but never blocks: returns the :class:`Execution` handle."""
+        return ProcessModule.resolve(designator).execute_nowait(designator)
+
+    @staticmethod
+    def resolve(designator: Any) -> "ProcessModule":
+        """The module chosen for ``designator`` by the active robot's resolvers, then the
+        global ``ProcessModule.resolvers``. Raises :class:`NoProcessModuleError`."""
+        resolvers = gather("process_module_resolvers", ProcessModule.resolvers)
+        for resolver in resolvers:
+            try:
+                module = resolver(designator)
+            except Exception as e:
+                raise ProcessModuleError(
+                    f"process-module resolver {callable_name(resolver)} failed for "
+                    f"{designator!r} ({describe_active_robot()}): {e!r}",
+                    designator=designator, cause=e) from e
+            if module is None:
+                continue
+            if not isinstance(module, ProcessModule):
+                raise ProcessModuleError(
+                    f"process-module resolver {callable_name(resolver)} returned {module!r} "
+                    f"for {designator!r}, not a ProcessModule", designator=designator)
+            return module
+        robot = current_robot()
+        available = sorted(robot.process_modules) if robot is not None else []
+        raise NoProcessModuleError(
+            f"no process module for {designator!r} ({describe_active_robot()}"
+            + (f" with modules {available}" if robot is not None else "")
+            + f"); resolvers asked: {[callable_name(r) for r in resolvers]}",
+            designator=designator)
+
+    def _execute(self, designator: Any) -> Any:
+        """Execute ``designator`` (override). Runs in the caller's task; may be evaporated."""
+        return None
+
+    def _cancel(self, designator: Any) -> None:
+        """Cancel hook (override): called after ``_execute(designator)`` was evaporated, in the
+        same thread, protected from evaporation. Stop the hardware here."""
+
+    def execute(self, designator: Any) -> Any:
+        """Queue ``designator``, wait for its turn, run ``_execute`` and return its result.
+
+        Evaporable while queued and while running (see the module docstring). Raises
+        :class:`ProcessModuleFailure`, :class:`ProcessModuleOffline`.
+        """
+        execution = self._submit(designator)
+        self._run(execution)
+        if execution.status.get_value() is ProcessModuleStatus.SUCCEEDED:
+            return execution.result
+        if execution.exception is not None:
+            raise execution.exception
+        raise ExecutionCancelled(f"execution of {designator!r} on {self.name} was cancelled",
+                                 designator=designator, module=self)
+
+    def execute_nowait(self, designator: Any) -> Execution:
+        """Queue ``designator`` and return its :class:`Execution` handle at once.
+
+        The designator runs in a child task of the calling task (in a thread of its own), so
+        evaporating the caller cancels it. Wait on the handle (``wait()``) or cancel it; a
+        handle left alone keeps executing.
+        """
+        from pycram.runtime import TaskGroup
+
+        execution = self._submit(designator)
+        group = TaskGroup()
+        execution._group = group
+
+        def body() -> None:
+            try:
+                self._run(execution)
+            except (ProcessModuleError, Evaporated):
+                pass  # the outcome is recorded in the execution
+
+        execution._task = group.spawn(f"{self.name}: {_type_of(designator)}", body,
+                                      kind="process-module")
+        if execution._cancel_requested:
+            execution._task.evaporate()
+        return execution
+
+    # -- administration ----------------------------------------------------------------------
+
+    def shutdown(self) -> None:
+        """Take the module offline: queued designators fail with :class:`ProcessModuleOffline`,
+        new ones are refused; a running one finishes. Status becomes ``OFFLINE``."""
+        with self._cond:
+            self._offline = True
+            for execution in list(self._queue):
+                self._finish_locked(execution, ProcessModuleStatus.CANCELLED, ProcessModuleOffline(
+                    f"{self.name} went offline before {execution.designator!r} ran",
+                    designator=execution.designator, module=self))
+            self._queue.clear()
+            if self._current is None:
+                self.status.set_value(ProcessModuleStatus.OFFLINE)
+            self._cond.notify_all()
+
+    def start(self) -> None:
+        """Bring an offline module back online (status ``WAITING``)."""
+        with self._cond:
+            self._offline = False
+            if self._current is None:
+                self.status.set_value(ProcessModuleStatus.WAITING)
+            self._cond.notify_all()
+
+    @property
+    def queue_length(self) -> int:
+        """Number of designators waiting (not counting the running one)."""
+        with self._cond:
+            return len(self._queue)
+
+    @property
+    def current(self) -> Optional[Execution]:
+        """The running execution, if any."""
+        return self._current
+
+    @property
+    def _designators(self) -> list[Any]:
+        """Thesis attribute: the designators still to be processed (running one first)."""
+        with self._cond:
+            running = [self._current.designator] if self._current is not None else []
+            return running + [e.designator for e in self._queue]
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name} {self.status.get_value().value}>"
+
+    # -- internals ---------------------------------------------------------------------------
+
+    def _submit(self, designator: Any) -> Execution:
+        execution = Execution(self, designator)
+        with self._cond:
+            if self._offline:
+                raise ProcessModuleOffline(f"{self.name} is offline; cannot execute {designator!r}",
+                                           designator=designator, module=self)
+            self._queue.append(execution)
+        return execution
+
+    def _claim(self, execution: Execution) -> bool:
+        """Predicate run under ``_cond``: take the module if it is our turn (atomic)."""
+        if execution.done:
+            return True  # removed from the queue (offline / cancelled)
+        if execution._cancel_requested:
+            self._queue.remove(execution)
+            self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
+            self._cond.notify_all()
+            return True
+        if self._current is None and self._queue and self._queue[0] is execution:
+            self._queue.popleft()
+            self._current = execution
+            execution.status.set_value(ProcessModuleStatus.RUNNING)
+            self._running.set_value(True)
+            self.status.set_value(ProcessModuleStatus.RUNNING)
+            return True
+        return False
+
+    def _run(self, execution: Execution) -> None:
+        """Wait for the turn of ``execution``, then execute it; records the outcome in it.
+
+        Raises what the caller must see: ``Evaporated``, ProcessModuleFailure/Offline.
+        """
+        try:
+            wait_until(self._cond, lambda: self._claim(execution))
+        except BaseException:
+            with self._cond:  # evaporated while queued: leave the queue, let the next one go
+                if execution in self._queue:
+                    self._queue.remove(execution)
+                if not execution.done:
+                    self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
+                self._cond.notify_all()
+            raise
+        if execution.done:  # removed while queued
+            if execution.exception is not None:
+                raise execution.exception
+            return
+        designator = execution.designator
+        outcome, error, result = ProcessModuleStatus.FAILED, None, None
+        try:
+            try:
+                logger.debug("%s: executing %r", self.name, designator)
+                result = self._execute(designator)
+                outcome = ProcessModuleStatus.SUCCEEDED
+            except Exception as e:
+                error = ProcessModuleFailure(
+                    f"{self.name} failed to execute {designator!r}: {type(e).__name__}: {e}",
+                    designator=designator, module=self, cause=e)
+                error.__cause__ = e
+                outcome = ProcessModuleStatus.FAILED
+            except BaseException:
+                outcome = ProcessModuleStatus.CANCELLED
+                self._run_cancel_hook(designator)
+                raise
+        except BaseException:  # an asynchronous exception landing in the handlers above
+            if outcome is not ProcessModuleStatus.CANCELLED:
+                outcome = ProcessModuleStatus.CANCELLED
+                self._run_cancel_hook(designator)
+            raise
+        finally:
+            self._release(execution, outcome, error, result)
+        if error is not None:
+            raise error
+
+    def _run_cancel_hook(self, designator: Any) -> None:
+        try:
+            with no_evaporation():
+                try:
+                    logger.debug("%s: cancelling %r", self.name, designator)
+                    self._cancel(designator)
+                except Exception:
+                    logger.exception("%s: cancel hook failed for %r", self.name, designator)
+        except Evaporated:
+            pass  # the caller re-raises the original evaporation
+
+    def _release(self, execution: Execution, outcome: ProcessModuleStatus,
+                 error: Optional[BaseException], result: Any) -> None:
+        try:
+            with no_evaporation():
+                with self._cond:
+                    execution.result = result
+                    self._current = None
+                    self._finish_locked(execution, outcome, error)
+                    self._running.set_value(False)
+                    self.status.set_value(ProcessModuleStatus.OFFLINE if self._offline
+                                          else outcome)
+                    self._cond.notify_all()
+        except Evaporated:
+            if outcome is not ProcessModuleStatus.CANCELLED:
+                raise
+
+    def _finish_locked(self, execution: Execution, outcome: ProcessModuleStatus,
+                       error: Optional[BaseException]) -> None:
+        execution.exception = error
+        execution.status.set_value(outcome)
+
+
+def _type_of(designator: Any) -> str:
+    try:
+        return str(designator.prop_value("type"))
+    except AttributeError:
+        return type(designator).__name__

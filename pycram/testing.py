@@ -1,0 +1,135 @@
+"""Test doubles for designators and process modules (like py_trees' scripted behaviours).
+
+Nothing here touches hardware. These classes exist for tests and examples; they are named as
+doubles so that nobody mistakes them for real robot code.
+
+- :class:`ScriptedProcessModule` records every designator it executes, plays a script of
+  outcomes, can hold each execution until the test releases it, tracks concurrency, and records
+  cancel-hook calls.
+- :class:`CountingGenerator` is a resolver solution that counts how far it was advanced (to
+  prove lazy resolution).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import deque
+from typing import Any, Callable, Iterable, Iterator, Optional
+
+from pycram.process_module import ProcessModule
+from pycram.runtime import wait_until
+
+__all__ = ["ScriptedProcessModule", "CountingGenerator"]
+
+
+class ScriptedProcessModule(ProcessModule):
+    """A process module double.
+
+    - ``script``: outcomes consumed one per execution; an exception (instance) is raised, a
+      callable is called with the designator and its result returned, any other value is
+      returned. When the script is empty ``default(designator)`` is returned (by default the
+      designator's resolved solution if it resolves, else ``None``).
+    - ``hold=True``: each execution blocks (evaporably) in ``_execute`` until :meth:`release`.
+    - ``log``: list of ``(event, designator)`` with events ``'start'``, ``'end'``, ``'cancel'``,
+      in the order they happened. ``executed``: the designators whose execution started.
+    - ``max_concurrency``: the largest number of simultaneous ``_execute`` calls observed.
+    """
+
+    def __init__(self, name: Optional[str] = None, script: Iterable[Any] = (),
+                 hold: bool = False, default: Optional[Callable[[Any], Any]] = None) -> None:
+        super().__init__(name)
+        self.script: deque[Any] = deque(script)
+        self.hold = hold
+        self.default = default
+        self.log: list[tuple[str, Any]] = []
+        self.executed: list[Any] = []
+        self.cancelled: list[Any] = []
+        self.max_concurrency = 0
+        self._active = 0
+        self._releases = 0
+        self._started = 0
+        self._double_cv = threading.Condition(threading.Lock())
+
+    # -- test control -------------------------------------------------------------------------
+
+    def release(self, n: int = 1) -> None:
+        """Let ``n`` more held executions finish."""
+        with self._double_cv:
+            self._releases += n
+            self._double_cv.notify_all()
+
+    def wait_started(self, n: int, timeout: float = 5.0) -> bool:
+        """Block until ``n`` executions have started in total; ``False`` on timeout."""
+        return wait_until(self._double_cv, lambda: self._started >= n, timeout)
+
+    def wait_logged(self, n: int, timeout: float = 5.0) -> bool:
+        """Block until the log has ``n`` entries; ``False`` on timeout."""
+        return wait_until(self._double_cv, lambda: len(self.log) >= n, timeout)
+
+    # -- process module -----------------------------------------------------------------------
+
+    def _record(self, event: str, designator: Any) -> None:
+        with self._double_cv:
+            self.log.append((event, designator))
+            self._double_cv.notify_all()
+
+    def _execute(self, designator: Any) -> Any:
+        with self._double_cv:
+            self._active += 1
+            self.max_concurrency = max(self.max_concurrency, self._active)
+            self._started += 1
+            ticket = self._started
+            self.executed.append(designator)
+            self.log.append(("start", designator))
+            self._double_cv.notify_all()
+        try:
+            if self.hold:
+                wait_until(self._double_cv, lambda: self._releases >= ticket)
+            outcome = self.script.popleft() if self.script else _DEFAULT
+            if outcome is _DEFAULT:
+                result = self.default(designator) if self.default else _solution(designator)
+            elif isinstance(outcome, BaseException):
+                raise outcome
+            elif callable(outcome):
+                result = outcome(designator)
+            else:
+                result = outcome
+            self._record("end", designator)
+            return result
+        finally:
+            with self._double_cv:
+                self._active -= 1
+
+    def _cancel(self, designator: Any) -> None:
+        self.cancelled.append(designator)
+        self._record("cancel", designator)
+
+
+_DEFAULT = object()
+
+
+def _solution(designator: Any) -> Any:
+    from pycram.designators.core import DesignatorError
+
+    try:
+        return designator.reference()
+    except (DesignatorError, AttributeError):
+        return None
+
+
+class CountingGenerator:
+    """An iterator over ``items`` that counts how many items were taken (``advanced``).
+
+    Use it as a resolver solution: ``resolvers.append(lambda d: [CountingGenerator(...)])``
+    is not a generator, so wrap it with :meth:`generator`, which returns a real generator.
+    """
+
+    def __init__(self, items: Iterable[Any]) -> None:
+        self._items = iter(items)
+        self.advanced = 0
+
+    def generator(self) -> Iterator[Any]:
+        """A generator over the items that counts each advance."""
+        for item in self._items:
+            self.advanced += 1
+            yield item
