@@ -18,9 +18,11 @@ Guarantees of the transform:
 * The `as` name is bound to a fresh state Fluent *before* the branches start and is passed as
   `state=`; a branch can read `s.get_value()`.
 * `errors`: any expression that evaluates to a list; errors are appended to it. As in the
-  thesis (where the macro assigned the variable) a bare name that is still *unbound* is bound
-  to a new list: at module level always; in a function when the name is local to it (assigned
-  somewhere in it). A name the function only reads (a global or closure variable) must exist.
+  thesis (where the macro assigned the variable) a bare name that is still *unbound* when the
+  block starts is bound to a new list, in the block's scope: at module level always; in a
+  function when the name is local to it (assigned somewhere in it) or refers to nothing at
+  all when the code is transformed (then it becomes a local of the function). A name that
+  refers to a global or closure variable is only read: that list is used.
 * Branch code reads and assigns the variables of the enclosing function (via `nonlocal`) or
   module (via `global`); assignments made in a branch are visible after the block. A name that
   is only assigned inside a branch becomes a local of the enclosing function, exactly as if the
@@ -393,6 +395,8 @@ class _Scope:
     params: set[str] = field(default_factory=set)
     local_names: set[str] = field(default_factory=set)
     hoist: set[str] = field(default_factory=set)
+    first_param: str | None = None  # for rewriting zero-argument super() inside branches
+    enclosing: set[str] = field(default_factory=set)  # locals of enclosing functions (closures)
 
 
 # --------------------------------------------------------------------------------------------
@@ -443,13 +447,16 @@ class _Transformer:
         tree.body = self.stmts(tree.body, scope)
         self._drop_macros_imports(tree)
 
-    def function(self, node: ast.FunctionDef | ast.AsyncFunctionDef) -> None:
+    def function(self, node: ast.FunctionDef | ast.AsyncFunctionDef, outer: _Scope | None = None) -> None:
         scope = _Scope(
             "function",
+            enclosing=(outer.enclosing | outer.local_names) if outer is not None and outer.kind == "function" else set(),
             global_names=_declared(node.body, ast.Global),
             nonlocal_names=_declared(node.body, ast.Nonlocal),
             params=_parameters(node.args),
         )
+        positional = [*node.args.posonlyargs, *node.args.args]
+        scope.first_param = positional[0].arg if positional else None
         scope.local_names = (_bound_names(node.body) | scope.params) - scope.global_names - scope.nonlocal_names
         node.body = self.stmts(node.body, scope)
         hoist = sorted(scope.hoist - scope.params - scope.global_names - scope.nonlocal_names)
@@ -469,7 +476,7 @@ class _Transformer:
 
     def stmt(self, stmt: ast.stmt, scope: _Scope) -> list[ast.stmt]:
         if isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            self.function(stmt)
+            self.function(stmt, scope)
             return [stmt]
         if isinstance(stmt, ast.ClassDef):
             stmt.body = self.stmts(stmt.body, _Scope("class"))
@@ -591,6 +598,8 @@ class _Transformer:
     def _branch_def(self, gen_name: str, nice: str, body: list[ast.stmt], scope: _Scope, where: ast.AST, prelude: list[ast.stmt] = ()) -> ast.FunctionDef:  # type: ignore[assignment]
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
+        if scope.first_param is not None:
+            _explicit_super(body, scope.first_param)
         decls: list[ast.stmt] = []
         if scope.kind == "module":
             if names:
@@ -643,7 +652,14 @@ class _Transformer:
         if errors is not None:
             tmp = self._fresh("errors", line)
             if isinstance(errors, ast.Name) and (
-                scope.kind == "module" or errors.id in scope.local_names or errors.id in scope.global_names
+                scope.kind == "module"
+                or errors.id in scope.local_names
+                or errors.id in scope.global_names
+                or (
+                    errors.id not in scope.nonlocal_names
+                    and errors.id not in scope.enclosing
+                    and not self.resolver.is_bound(errors.id)
+                )
             ):
                 out += self._parse(
                     f"try:\n    {tmp} = {errors.id}\nexcept NameError:\n    {tmp} = {errors.id} = []"
@@ -737,6 +753,27 @@ class _Transformer:
                             stmt.names = kept
                             if not kept:
                                 stmts[i] = ast.copy_location(ast.Pass(), stmt)
+
+
+def _explicit_super(stmts: list[ast.stmt], first_param: str) -> None:
+    """Rewrite zero-argument `super()` (which needs the method's frame) to `super(__class__, self)`."""
+    stack: list[ast.AST] = list(stmts)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, _SCOPE_NODES) and not _is_generated_def(node):
+            continue
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id == "super"
+            and not node.args
+            and not node.keywords
+        ):
+            node.args = [
+                ast.copy_location(ast.Name("__class__", ast.Load()), node),
+                ast.copy_location(ast.Name(first_param, ast.Load()), node),
+            ]
+        stack.extend(ast.iter_child_nodes(node))
 
 
 def _has_docstring(body: list[ast.stmt]) -> bool:
