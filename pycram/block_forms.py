@@ -1,0 +1,41 @@
+"""Placeholders for the thesis' block syntax when it is not switched on.
+
+`with par(errors) as s:` only means "run each statement as a branch" after PyCRAM's block
+syntax has rewritten the code (see `pycram.macros`). Without that rewrite Python would simply
+call `par(errors)` and run the block once, sequentially — silently wrong. So the expression
+objects and `whenever(fluent)` refuse to be used as context managers and say how to switch
+the syntax on.
+"""
+
+from __future__ import annotations
+
+__all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE"]
+
+NOT_ENABLED_MESSAGE = (
+    "`with {form}:` is PyCRAM block syntax, which is not switched on for this code. "
+    "Switch it on in one of three ways: decorate the enclosing function with "
+    "`@plan` (from pycram.language import plan); run the script with "
+    "`pycram run FILE.py` or `python -m pycram FILE.py`; or `import pycram.activate` "
+    "before importing the module that holds the plan. Without it the block would run "
+    "sequentially as plain Python, so PyCRAM refuses to run it."
+)
+
+
+class BlockSyntaxNotEnabled(RuntimeError):
+    """A block form (`with par(...)`, `with whenever(...)`, ...) ran without the block syntax."""
+
+    def __init__(self, form: str) -> None:
+        super().__init__(NOT_ENABLED_MESSAGE.format(form=form))
+        self.form = form
+
+
+class BlockForm:
+    """Mixin: objects that are only meaningful as the head of a rewritten `with` block."""
+
+    _block_form_name = "block"
+
+    def __enter__(self) -> None:
+        raise BlockSyntaxNotEnabled(self._block_form_name)
+
+    def __exit__(self, *exc_info: object) -> bool:
+        return False

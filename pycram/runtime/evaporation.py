@@ -1,0 +1,286 @@
+"""Evaporation and the one blocking primitive every PyCRAM wait goes through.
+
+Evaporation stops a task from outside (CRAM's term: `pursue` evaporates the losers). It is
+delivered as the exception `Evaporated`, derived from `BaseException` so that `except
+Exception` in plan code does not swallow it:
+
+* at once inside any PyCRAM wait (`wait_until`, hence `Fluent.wait_for`, `whenever`, `sleep`,
+  process-module execution): the waiting thread's condition is notified;
+* in plain Python code (`while True: x += 1`) by an asynchronous exception injected into the
+  thread, which the interpreter raises within its switch interval (5 ms by default);
+* never inside a `no_evaporation()` block — it is delivered when the block ends.
+
+It is sticky: catching it does not save the task. Every later PyCRAM call made by an evaporating
+task (`check_evaporation`, waits, `sleep`, expressions, `retry`) raises it again.
+
+Every thread that runs PyCRAM code has a `Runner`: its current task and the state needed to
+interrupt it. This module knows tasks only through two attributes: `_evaporating` (bool) and
+`_runner`.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from contextlib import contextmanager
+from typing import Callable, Iterator
+
+from pycram.runtime.clock import current_clock
+
+__all__ = [
+    "Evaporated",
+    "check_evaporation",
+    "is_evaporating",
+    "no_evaporation",
+    "shielded",
+    "sleep",
+    "wait_until",
+]
+
+_USER = 0  # running user code: may be interrupted by an asynchronous exception
+_RUNTIME = 1  # inside the runtime or blocked in a wait: interrupted through its condition
+_SEALED = 2  # the task's thread is finishing: never interrupted again
+
+
+class Evaporated(BaseException):
+    """Raised in a task that was evaporated (stopped from outside).
+
+    Derives from `BaseException`: `except Exception` does not catch it. Catching it anyway does
+    not resurrect the task — every later PyCRAM call raises it again — so let it propagate and
+    put clean-up in `finally` blocks or context managers, which always run.
+    """
+
+
+class Runner:
+    """The per-thread execution state: current task, wait registration, interrupt state."""
+
+    __slots__ = ("task", "ident", "_mode", "_waiting_on", "_injected", "_protected", "_lock", "_sleep")
+
+    def __init__(self, task: object | None = None, ident: int | None = None) -> None:
+        self.task = task
+        self.ident = ident  # the thread's identifier once the runner is installed in it
+        self._mode = _USER
+        self._waiting_on: threading.Condition | None = None
+        self._injected = False
+        self._protected = 0
+        self._lock = threading.Lock()
+        self._sleep: threading.Condition | None = None
+
+    # -- state of the current task -------------------------------------------------------------
+
+    def evaporation_due(self) -> bool:
+        """True when the current task is evaporating and not inside `no_evaporation`."""
+        task = self.task
+        return task is not None and task._evaporating and not self._protected
+
+    # -- entering and leaving the runtime -----------------------------------------------------
+
+    def _enter_runtime(self, condition: threading.Condition | None = None) -> None:
+        with self._lock:
+            self._mode = _RUNTIME
+            self._waiting_on = condition
+            if self._injected:
+                self._injected = False
+                _clear_async_exception(self.ident)
+
+    def _leave_runtime(self) -> None:
+        with self._lock:
+            self._waiting_on = None
+            if self._mode == _RUNTIME:
+                self._mode = _USER
+
+    def seal(self) -> None:
+        """Mark the thread as finishing: no asynchronous exception can reach it after this."""
+        with self._lock:
+            self._mode = _SEALED
+            self._waiting_on = None
+            if self._injected:
+                self._injected = False
+                _clear_async_exception(self.ident)
+
+    # -- interrupting ---------------------------------------------------------------------------
+
+    def interrupt(self) -> None:
+        """Deliver evaporation to this thread if its current task is evaporating.
+
+        A thread blocked in a PyCRAM wait is woken through its condition; a thread running user
+        code gets an asynchronous `Evaporated`; a thread inside the runtime or inside
+        `no_evaporation` notices the flag at its next check.
+        """
+        if not self.evaporation_due():
+            return
+        injected = False
+        with self._lock:
+            condition = self._waiting_on
+            if condition is None and self._mode == _USER and not self._injected and self.ident is not None:
+                self._injected = injected = True
+                _inject_async_exception(self.ident)
+        if condition is not None:
+            with condition:
+                condition.notify_all()
+        elif injected and self.ident != threading.get_ident():
+            # CPython raises a pending asynchronous exception only when the target thread next
+            # handles its "eval breaker"; a thread busy in pure Python does that when another
+            # thread asks for the GIL. Releasing and re-taking the GIL once makes that request,
+            # so the exception lands within one switch interval instead of "eventually".
+            os.sched_yield()
+
+    def sleep_condition(self) -> threading.Condition:
+        condition = self._sleep
+        if condition is None:
+            condition = self._sleep = threading.Condition(threading.Lock())
+        return condition
+
+
+_local = threading.local()
+
+
+def current_runner() -> Runner:
+    """The calling thread's runner (created on first use for threads PyCRAM did not start)."""
+    try:
+        return _local.runner
+    except AttributeError:
+        runner = _local.runner = Runner(ident=threading.get_ident())
+        return runner
+
+
+def install_runner(runner: Runner) -> None:
+    """Make `runner` the calling thread's runner (used by the task module for new threads)."""
+    with runner._lock:
+        runner.ident = threading.get_ident()
+    _local.runner = runner
+
+
+def is_evaporating() -> bool:
+    """True when the calling task is evaporating (outside `no_evaporation`). Never raises."""
+    return current_runner().evaporation_due()
+
+
+def check_evaporation() -> None:
+    """Raise `Evaporated` if the calling task is evaporating.
+
+    Call it in long computations that make no other PyCRAM call; plain Python loops are also
+    interrupted asynchronously, but an explicit check is immediate and exact.
+    """
+    runner = current_runner()
+    if runner.evaporation_due():
+        raise Evaporated()
+
+
+@contextmanager
+def shielded() -> Iterator[Runner]:
+    """Hold evaporation back for the block, without raising at its end (runtime internal).
+
+    Used where the runtime must finish bookkeeping (starting a group of threads, waiting for
+    evaporated children to end) even though its own task is evaporating.
+    """
+    runner = current_runner()
+    with runner._lock:
+        runner._protected += 1
+        if runner._injected:  # an interrupt raced with entering: take it back
+            runner._injected = False
+            _clear_async_exception(runner.ident)
+    try:
+        yield runner
+    finally:
+        with runner._lock:
+            runner._protected -= 1
+
+
+@contextmanager
+def no_evaporation() -> Iterator[None]:
+    """Protect a critical section: evaporation is held back until the block ends.
+
+    Inside the block waits are not interrupted and no asynchronous exception is injected. If
+    the task was evaporated meanwhile, `Evaporated` is raised when the block ends (after the
+    block's own clean-up has run). Blocks nest.
+    """
+    with shielded() as runner:
+        yield
+    if runner.evaporation_due():
+        raise Evaporated()
+
+
+def wait_until(
+    condition: threading.Condition,
+    predicate: Callable[[], object],
+    timeout: float | None = None,
+) -> bool:
+    """Block until `predicate()` is true; the one blocking primitive of PyCRAM.
+
+    `predicate` is evaluated with `condition` held, first at once and then each time the
+    condition is notified. Returns True when the predicate holds, False when `timeout` [s] of
+    the active clock has passed. Raises `Evaporated` at once when the calling task is (or
+    becomes) evaporating. Never polls.
+    """
+    runner = current_runner()
+    if runner.evaporation_due():
+        raise Evaporated()
+    with condition:
+        if predicate():
+            return True
+        if timeout is not None and timeout <= 0:
+            return False
+        clock = current_clock()
+        deadline = None if timeout is None else clock.now() + timeout
+        handle = None if deadline is None else clock.register(deadline, condition)
+        runner._enter_runtime(condition)
+        try:
+            while True:
+                if runner.evaporation_due():
+                    raise Evaporated()
+                if predicate():
+                    return True
+                if deadline is not None and clock.now() >= deadline:
+                    return False
+                clock.wait(condition, deadline)
+        finally:
+            runner._leave_runtime()
+            if handle is not None:
+                clock.unregister(handle)
+
+
+def sleep(seconds: float) -> None:
+    """Sleep `seconds` [s] of the active clock (simulated time when a simulation runs).
+
+    Evaporable: raises `Evaporated` at once if the task is evaporated while sleeping.
+    """
+    runner = current_runner()
+    wait_until(runner.sleep_condition(), _never, seconds)
+
+
+def _never() -> bool:
+    return False
+
+
+_async_exc_api: tuple | None = None
+
+
+def prepare_interrupts() -> None:
+    """Load the C API used to interrupt busy threads (done before the first branch starts, so
+    that the first evaporation is not slowed down by importing ctypes under GIL contention)."""
+    _api()
+
+
+def _api() -> tuple:
+    """The C function `PyThreadState_SetAsyncExc`, typed once to set and once to clear."""
+    global _async_exc_api
+    if _async_exc_api is None:
+        import ctypes
+
+        setter = ctypes.PYFUNCTYPE(ctypes.c_int, ctypes.c_ulong, ctypes.py_object)(
+            ("PyThreadState_SetAsyncExc", ctypes.pythonapi)
+        )
+        clearer = ctypes.PYFUNCTYPE(ctypes.c_int, ctypes.c_ulong, ctypes.c_void_p)(
+            ("PyThreadState_SetAsyncExc", ctypes.pythonapi)
+        )
+        _async_exc_api = (setter, clearer)
+    return _async_exc_api
+
+
+def _inject_async_exception(ident: int) -> None:
+    _api()[0](ident, Evaporated)
+
+
+def _clear_async_exception(ident: int) -> None:
+    _api()[1](ident, None)  # NULL clears a pending asynchronous exception

@@ -1,0 +1,419 @@
+"""Tasks and the task tree.
+
+Every expression and every branch of an expression is a `Task`. A task runs either in its
+parent's thread (the steps of `seq`, the attempts of `failure_handling`) or in a thread of its
+own (the branches of `par`, `pursue`, `try_all`). Each thread has a root task, created the
+first time the thread touches the runtime, so `current_task()` always answers.
+
+A task's `status` is a `Fluent` that plans can wait on: CREATED → RUNNING → SUCCEEDED | FAILED
+| EVAPORATED. `evaporate()` stops a task and all its descendants (see
+`pycram.runtime.evaporation`). `TaskGroup` starts tasks in threads and guarantees that none of
+them outlives it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+from enum import Enum
+from typing import Any, Callable, Iterator, Protocol
+
+import pycram.fluent as _fluent  # imported as a module: pycram.fluent imports this package
+from pycram.runtime.clock import current_clock
+from pycram.runtime.evaporation import (
+    Evaporated,
+    Runner,
+    current_runner,
+    install_runner,
+    prepare_interrupts,
+    shielded,
+    wait_until,
+)
+from pycram.runtime.workers import submit
+
+__all__ = [
+    "Task",
+    "TaskStatus",
+    "TaskGroup",
+    "TaskListener",
+    "add_task_listener",
+    "remove_task_listener",
+    "current_task",
+    "run_subtask",
+    "task_scope",
+    "format_task_tree",
+]
+
+
+class TaskStatus(Enum):
+    CREATED = "created"
+    RUNNING = "running"
+    SUCCEEDED = "succeeded"
+    FAILED = "failed"
+    EVAPORATED = "evaporated"
+
+    @property
+    def done(self) -> bool:
+        return self in _DONE
+
+
+_DONE = frozenset((TaskStatus.SUCCEEDED, TaskStatus.FAILED, TaskStatus.EVAPORATED))
+
+# Guards the tree's structure: children lists and the spreading of evaporation flags.
+_tree_lock = threading.Lock()
+_ids = itertools.count(1)
+
+
+class TaskListener(Protocol):
+    """Observer of the task runtime (the recorder is one). Called in the task's own thread."""
+
+    def task_started(self, task: Task) -> None: ...
+
+    def task_ended(self, task: Task) -> None: ...
+
+
+_listeners: tuple[TaskListener, ...] = ()
+
+
+def add_task_listener(listener: TaskListener) -> None:
+    """Call `listener.task_started(task)` / `task_ended(task)` for every task from now on.
+
+    Listeners run synchronously in the task's thread: keep them O(1) and never block.
+    """
+    global _listeners
+    with _tree_lock:
+        _listeners = _listeners + (listener,)
+
+
+def remove_task_listener(listener: TaskListener) -> None:
+    """Stop notifying `listener` (no error if it was not added)."""
+    global _listeners
+    with _tree_lock:
+        _listeners = tuple(x for x in _listeners if x is not listener)
+
+
+class Task:
+    """A node of the task tree.
+
+    Attributes: `name`, `kind` (e.g. "seq", "par", "branch", "step", "attempt", "root"),
+    `parent`, `children`, `status` (a `Fluent` of `TaskStatus`), `start_time` / `end_time`
+    (active clock [s]), `exception` (the exception that failed it), `result`, `info` (free-form
+    details, e.g. the source line or the attempt count).
+    """
+
+    __slots__ = (
+        "id",
+        "name",
+        "kind",
+        "parent",
+        "children",
+        "status",
+        "start_time",
+        "end_time",
+        "exception",
+        "result",
+        "info",
+        "_evaporating",
+        "_runner",
+        "_path",
+    )
+
+    def __init__(self, name: str, kind: str = "task", parent: Task | None = None) -> None:
+        self.id = next(_ids)
+        self.name = name
+        self.kind = kind
+        self.parent = parent
+        self.children: list[Task] = []
+        self.status = _fluent.Fluent(TaskStatus.CREATED)
+        self.start_time: float | None = None
+        self.end_time: float | None = None
+        self.exception: BaseException | None = None
+        self.result: Any = None
+        self.info: dict[str, Any] = {}
+        self._runner: Runner | None = None
+        self._path: str | None = None
+        if parent is None:
+            self._evaporating = False
+        else:
+            with _tree_lock:
+                self._evaporating = parent._evaporating
+                parent.children.append(self)
+
+    # -- tree -----------------------------------------------------------------------------------
+
+    @property
+    def path(self) -> str:
+        """Slash-separated names from the root, e.g. `/main/par/branch-2:grab`."""
+        if self._path is None:
+            prefix = self.parent.path if self.parent is not None else ""
+            self._path = f"{prefix}/{self.name}"
+        return self._path
+
+    def walk(self) -> Iterator[Task]:
+        """This task and all its descendants, depth first, in creation order."""
+        yield self
+        for child in list(self.children):
+            yield from child.walk()
+
+    @property
+    def done(self) -> bool:
+        return self.status.get_value() in _DONE
+
+    @property
+    def duration(self) -> float | None:
+        """End minus start time [s], or None while not both are known."""
+        if self.start_time is None or self.end_time is None:
+            return None
+        return self.end_time - self.start_time
+
+    @property
+    def evaporating(self) -> bool:
+        """True once `evaporate()` reached this task."""
+        return self._evaporating
+
+    # -- life cycle -----------------------------------------------------------------------------
+
+    def _start(self, runner: Runner) -> None:
+        self._runner = runner
+        self.start_time = current_clock().now()
+        self.status.set_value(TaskStatus.RUNNING)
+        for listener in _listeners:
+            listener.task_started(self)
+
+    def _end(self, status: TaskStatus, exception: BaseException | None = None) -> None:
+        self.end_time = current_clock().now()
+        self.exception = exception
+        self.status.set_value(status)
+        for listener in _listeners:
+            listener.task_ended(self)
+
+    def evaporate(self) -> None:
+        """Stop this task and all its descendants; returns at once (idempotent).
+
+        Each affected thread gets `Evaporated`: at once if it waits in PyCRAM, within the
+        interpreter's switch interval if it runs plain Python code, at the end of a
+        `no_evaporation` block if it is in one. Wait for `status` to know when it ended.
+        """
+        runners: list[Runner] = []
+        with _tree_lock:
+            stack = [self]
+            while stack:
+                task = stack.pop()
+                task._evaporating = True
+                if task._runner is not None and task._runner not in runners:
+                    runners.append(task._runner)
+                stack.extend(task.children)
+        for runner in runners:
+            runner.interrupt()
+
+    def __repr__(self) -> str:
+        return f"<Task {self.path} {self.status.get_value().value}>"
+
+
+def _root_task_for_this_thread(runner: Runner) -> Task:
+    thread = threading.current_thread()
+    task = Task(thread.name, kind="root")
+    task._runner = runner
+    task.start_time = current_clock().now()
+    task.status.set_value(TaskStatus.RUNNING)
+    runner.task = task
+    return task
+
+
+def current_task() -> Task:
+    """The innermost task of the calling thread (a root task outside any expression)."""
+    runner = current_runner()
+    task = runner.task
+    if task is None:
+        task = _root_task_for_this_thread(runner)
+    return task
+
+
+def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", **kwargs: Any) -> Any:
+    """Run `fn(*args, **kwargs)` as a child task of the current task, in the calling thread.
+
+    Returns fn's result or re-raises its exception; the child ends SUCCEEDED, FAILED or
+    EVAPORATED accordingly. Raises `Evaporated` before starting if the caller is evaporating.
+    """
+    runner = current_runner()
+    parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
+    if parent._evaporating and not runner._protected:
+        raise Evaporated()
+    task = Task(name, kind, parent)
+    task._start(runner)
+    runner.task = task
+    try:
+        result = fn(*args, **kwargs)
+    except Evaporated as exc:
+        runner.task = parent
+        task._end(TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED, exc)
+        raise
+    except BaseException as exc:
+        runner.task = parent
+        task._end(TaskStatus.FAILED, exc)
+        raise
+    runner.task = parent
+    task.result = result
+    task._end(TaskStatus.SUCCEEDED)
+    return result
+
+
+class task_scope:
+    """Run the block as a child task of the current task, in the calling thread.
+
+    Usage: `with task_scope("par", "par") as scope: ...; scope.fail(error)`. The task ends
+    EVAPORATED if `Evaporated` leaves the block while it is evaporating, FAILED if another
+    exception leaves it or `scope.fail()` was called, SUCCEEDED otherwise. Raises `Evaporated`
+    on entry if the caller is evaporating.
+    """
+
+    __slots__ = ("task", "error", "_parent", "_runner")
+
+    def __init__(self, name: str, kind: str = "task") -> None:
+        runner = current_runner()
+        parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
+        if parent._evaporating and not runner._protected:
+            raise Evaporated()
+        self._runner = runner
+        self._parent = parent
+        self.task = Task(name, kind, parent)
+        self.error: BaseException | None = None
+
+    def fail(self, error: BaseException | None) -> None:
+        """End the task FAILED (with `error` as its exception) when the block ends normally."""
+        self.error = error if error is not None else RuntimeError("failed")
+
+    def __enter__(self) -> task_scope:
+        self.task._start(self._runner)
+        self._runner.task = self.task
+        return self
+
+    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
+        task = self.task
+        self._runner.task = self._parent
+        if exc is None:
+            if self.error is None:
+                task._end(TaskStatus.SUCCEEDED)
+            else:
+                task._end(TaskStatus.FAILED, self.error)
+        elif isinstance(exc, Evaporated) and task._evaporating:
+            task._end(TaskStatus.EVAPORATED, exc)
+        else:
+            task._end(TaskStatus.FAILED, exc)
+        return False
+
+
+class TaskGroup:
+    """Runs child tasks concurrently, each on a worker thread; none of them outlives the group.
+
+    `spawn` starts a child of the calling thread's current task. `wait_all` returns only after
+    every spawned thread has ended — even when the waiting task is evaporated meanwhile: it
+    then evaporates the children, waits for them and re-raises `Evaporated`.
+
+    `on_end(task)` is called in the child's thread when a child ends, under the group's
+    condition (keep it short, never block); use it to decide the outcome of an expression.
+    """
+
+    def __init__(self, on_end: Callable[[Task], None] | None = None) -> None:
+        prepare_interrupts()
+        self.parent = current_task()
+        self.tasks: list[Task] = []
+        self._cv = threading.Condition(threading.Lock())
+        self._running = 0
+        self._on_end = on_end
+
+    def spawn(self, name: str, fn: Callable[[], Any], kind: str = "branch") -> Task:
+        """Start `fn` as a child task on a worker thread of its own; returns the task."""
+        task = Task(name, kind, self.parent)
+        runner = Runner(task)
+        task._runner = runner
+        with self._cv:
+            self._running += 1
+        self.tasks.append(task)
+        submit(lambda: self._thread_main(task, runner, fn))
+        return task
+
+    def _thread_main(self, task: Task, runner: Runner, fn: Callable[[], Any]) -> None:
+        install_runner(runner)
+        status, error, result = TaskStatus.FAILED, None, None
+        try:
+            try:
+                task._start(runner)
+                if task._evaporating:  # evaporated before this thread got to run it
+                    raise Evaporated()
+                result = fn()
+                status = TaskStatus.SUCCEEDED
+            except Evaporated as exc:
+                status, error = (TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED), exc
+            except BaseException as exc:
+                status, error = TaskStatus.FAILED, exc
+        except BaseException as late:  # an asynchronous exception landing in the handlers above
+            status, error = TaskStatus.EVAPORATED, late
+        while True:  # at most one asynchronous exception can still be pending
+            try:
+                runner.seal()
+                break
+            except BaseException:
+                status = TaskStatus.EVAPORATED if task._evaporating else status
+        task.result = result
+        task._end(status, error)
+        with self._cv:
+            self._running -= 1
+            if self._on_end is not None:
+                self._on_end(task)
+            self._cv.notify_all()
+
+    def evaporate(self, except_task: Task | None = None) -> None:
+        """Evaporate every child (but `except_task`)."""
+        for task in self.tasks:
+            if task is not except_task and not task.done:
+                task.evaporate()
+
+    def wait_all(self) -> None:
+        """Block until every child has ended (see the class doc for evaporation)."""
+        try:
+            wait_until(self._cv, self._all_ended)
+        except Evaporated:
+            self.evaporate()
+            with shielded():
+                wait_until(self._cv, self._all_ended)
+            raise
+
+    def _all_ended(self) -> bool:
+        return self._running == 0
+
+
+_STATUS_MARK = {
+    TaskStatus.CREATED: "·",
+    TaskStatus.RUNNING: "▶",
+    TaskStatus.SUCCEEDED: "✔",
+    TaskStatus.FAILED: "✘",
+    TaskStatus.EVAPORATED: "~",
+}
+
+
+def format_task_tree(task: Task | None = None, *, show_errors: bool = True) -> str:
+    """The tree under `task` (default: the current thread's root) as indented text.
+
+    One line per task: status mark, name, kind, status, duration, and the failure if any.
+    """
+    if task is None:
+        task = current_task()
+        while task.parent is not None:
+            task = task.parent
+    lines: list[str] = []
+
+    def visit(node: Task, depth: int) -> None:
+        status = node.status.get_value()
+        duration = node.duration
+        text = f"{'  ' * depth}{_STATUS_MARK[status]} {node.name} [{node.kind}] {status.value}"
+        if duration is not None:
+            text += f" {duration * 1000:.1f} ms" if duration < 1 else f" {duration:.2f} s"
+        if show_errors and status is TaskStatus.FAILED and node.exception is not None:
+            text += f" — {type(node.exception).__name__}: {node.exception}"
+        lines.append(text)
+        for child in list(node.children):
+            visit(child, depth + 1)
+
+    visit(task, 0)
+    return "\n".join(lines)
