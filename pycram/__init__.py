@@ -1,9 +1,34 @@
-"""PyCRAM: concurrent, reactive plans for mobile manipulation robots."""
+"""PyCRAM: concurrent, reactive plans for mobile manipulation robots.
+
+`import pycram` is fast and has no side effects: names are loaded on first use.
+The layers: `pycram.fluent` (observable values), `pycram.runtime` (tasks, evaporation,
+clocks), `pycram.language` (seq, par, pursue, try_all, try_in_order, failure_handling),
+`pycram.designator` and `pycram.process_module` (symbolic descriptions and the hardware
+abstraction), `pycram.sim` (the MuJoCo kitchen), `pycram.trace` (run recording).
+"""
+
+from typing import Any
+
+__version__ = "0.1.0"
+
+_LAZY = {
+    "perform": "pycram.designator",
+    "sleep": "pycram.runtime",
+    "current_task": "pycram.runtime",
+    "Evaporated": "pycram.runtime",
+    "Fluent": "pycram.fluent",
+    "State": "pycram.language",
+}
 
 
-def __getattr__(name: str):  # lazy exports: `import pycram` stays fast and side-effect free
-    if name == "perform":
-        from pycram.designator import perform
+def __getattr__(name: str) -> Any:  # lazy exports keep `import pycram` cheap
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pycram' has no attribute {name!r}")
+    import importlib
 
-        return perform
-    raise AttributeError(f"module 'pycram' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + list(_LAZY))
