@@ -159,11 +159,10 @@ class Execution:
         """Stop the execution: leave the queue, or evaporate the running ``_execute`` (the
         module's cancel hook runs). Returns at once; idempotent; no effect once done."""
         self._cancel_requested = True
+        self.module._abandon(self)
         task = self._task
         if task is not None:
             task.evaporate()
-        with self.module._cond:
-            self.module._cond.notify_all()
 
     def __repr__(self) -> str:
         return (f"<Execution {self.id} of {self.designator!r} on {self.module.name} "
@@ -188,6 +187,8 @@ class ProcessModule:
         self._current: Optional[Execution] = None
         self._offline = False
         self.status = Fluent(ProcessModuleStatus.WAITING, name=f"{self.name}.status")
+        #: Number of designators waiting in the queue (not counting the running one).
+        self.queued = Fluent(0, name=f"{self.name}.queued")
         self._running = Fluent(False, name=f"{self.name}.running")  # thesis attribute
 
     # -- thesis API --------------------------------------------------------------------------
@@ -271,7 +272,9 @@ class ProcessModule:
         from pycram.runtime import TaskGroup
 
         execution = self._submit(designator)
-        group = TaskGroup()
+        # on_end runs when the child task ends -- also if it was evaporated before its body ran:
+        # then the execution must not stay in the queue and block the module.
+        group = TaskGroup(on_end=lambda task: self._abandon(execution))
         execution._group = group
 
         def body() -> None:
@@ -298,6 +301,7 @@ class ProcessModule:
                     f"{self.name} went offline before {execution.designator!r} ran",
                     designator=execution.designator, module=self))
             self._queue.clear()
+            self.queued.set_value(0)
             if self._current is None:
                 self.status.set_value(ProcessModuleStatus.OFFLINE)
             self._cond.notify_all()
@@ -340,7 +344,17 @@ class ProcessModule:
                 raise ProcessModuleOffline(f"{self.name} is offline; cannot execute {designator!r}",
                                            designator=designator, module=self)
             self._queue.append(execution)
+            self.queued.set_value(len(self._queue))
         return execution
+
+    def _abandon(self, execution: Execution) -> None:
+        """Remove a queued ``execution`` whose owner gave up (cancelled, or its task ended)."""
+        with self._cond:
+            if execution in self._queue:
+                self._queue.remove(execution)
+                self.queued.set_value(len(self._queue))
+                self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
+            self._cond.notify_all()
 
     def _claim(self, execution: Execution) -> bool:
         """Predicate run under ``_cond``: take the module if it is our turn (atomic)."""
@@ -348,11 +362,13 @@ class ProcessModule:
             return True  # removed from the queue (offline / cancelled)
         if execution._cancel_requested:
             self._queue.remove(execution)
+            self.queued.set_value(len(self._queue))
             self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
             self._cond.notify_all()
             return True
         if self._current is None and self._queue and self._queue[0] is execution:
             self._queue.popleft()
+            self.queued.set_value(len(self._queue))
             self._current = execution
             execution.status.set_value(ProcessModuleStatus.RUNNING)
             self._running.set_value(True)
@@ -371,6 +387,7 @@ class ProcessModule:
             with self._cond:  # evaporated while queued: leave the queue, let the next one go
                 if execution in self._queue:
                     self._queue.remove(execution)
+                    self.queued.set_value(len(self._queue))
                 if not execution.done:
                     self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
                 self._cond.notify_all()

@@ -29,7 +29,8 @@ class ScriptedProcessModule(ProcessModule):
       callable is called with the designator and its result returned, any other value is
       returned. When the script is empty ``default(designator)`` is returned (by default the
       designator's resolved solution if it resolves, else ``None``).
-    - ``hold=True``: each execution blocks (evaporably) in ``_execute`` until :meth:`release`.
+    - ``hold=True``: each execution blocks (evaporably) in ``_execute`` until it can take one
+      of the releases granted by :meth:`release` (an evaporated execution takes none).
     - ``log``: list of ``(event, designator)`` with events ``'start'``, ``'end'``, ``'cancel'``,
       in the order they happened. ``executed``: the designators whose execution started.
     - ``max_concurrency``: the largest number of simultaneous ``_execute`` calls observed.
@@ -47,6 +48,7 @@ class ScriptedProcessModule(ProcessModule):
         self.max_concurrency = 0
         self._active = 0
         self._releases = 0
+        self._consumed = 0
         self._started = 0
         self._double_cv = threading.Condition(threading.Lock())
 
@@ -78,13 +80,12 @@ class ScriptedProcessModule(ProcessModule):
             self._active += 1
             self.max_concurrency = max(self.max_concurrency, self._active)
             self._started += 1
-            ticket = self._started
             self.executed.append(designator)
             self.log.append(("start", designator))
             self._double_cv.notify_all()
         try:
             if self.hold:
-                wait_until(self._double_cv, lambda: self._releases >= ticket)
+                wait_until(self._double_cv, self._take_release)
             outcome = self.script.popleft() if self.script else _DEFAULT
             if outcome is _DEFAULT:
                 result = self.default(designator) if self.default else _solution(designator)
@@ -99,6 +100,12 @@ class ScriptedProcessModule(ProcessModule):
         finally:
             with self._double_cv:
                 self._active -= 1
+
+    def _take_release(self) -> bool:  # predicate under _double_cv: consume one release
+        if self._releases > self._consumed:
+            self._consumed += 1
+            return True
+        return False
 
     def _cancel(self, designator: Any) -> None:
         self.cancelled.append(designator)

@@ -347,7 +347,7 @@ def test_concurrent_reference_resolves_once():
 
 
 def test_concurrent_next_solution_chains_share_cache_safely():
-    MotionDesignator.resolvers.append(lambda d: [(i for i in range(1000))])
+    MotionDesignator.resolvers.append(lambda d: [(i for i in range(300))])
     d = MotionDesignator([('type', 'x')])
     out = []
 
@@ -359,4 +359,4 @@ def test_concurrent_next_solution_chains_share_cache_safely():
         t.start()
     for t in threads:
         t.join(10)
-    assert out == [list(range(1000))] * 4
+    assert out == [list(range(300))] * 4
