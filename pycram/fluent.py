@@ -86,8 +86,8 @@ class Fluent:
 
     def __bool__(self) -> bool:
         raise TypeError(
-            f"a Fluent has no truth value (fluent {self.name!r}); use fluent.get_value() to read it "
-            "or fluent.wait_for() to wait until it is not None"
+            "a Fluent has no truth value (`if f > 3:` would always be true): read it with "
+            "f.get_value() or wait for it with f.wait_for()"
         )
 
     def __repr__(self) -> str:

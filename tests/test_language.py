@@ -1,0 +1,436 @@
+"""Expressions: seq, try_in_order, par, try_all, pursue, failure_handling, with_timeout (thesis 3.2.3)."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from pycram.block_forms import BlockSyntaxNotEnabled
+from pycram.fluent import Fluent, whenever
+from pycram.language import (
+    State,
+    current_attempt,
+    failure_handling,
+    par,
+    pursue,
+    retry,
+    seq,
+    try_all,
+    try_in_order,
+    with_timeout,
+)
+from pycram.runtime import Evaporated, TaskStatus, current_task, no_evaporation, sleep
+
+WAIT = 5.0
+
+
+class Boom(Exception):
+    pass
+
+
+def fail(message: str = "boom"):
+    def failing():
+        raise Boom(message)
+
+    failing.__name__ = f"fail_{message}"
+    return failing
+
+
+def record(log: list, value):
+    def recording():
+        log.append(value)
+        return value
+
+    recording.__name__ = f"record_{value}"
+    return recording
+
+
+def block_forever():
+    Fluent().wait_for()
+
+
+def last_expression_task():
+    return current_task().children[-1]
+
+
+def statuses(task):
+    return [child.status.get_value() for child in task.children]
+
+
+# -- seq and try_in_order -----------------------------------------------------------------------------
+
+
+def test_seq_runs_in_order_and_succeeds():
+    log = []
+    errors = []
+    s = seq(record(log, 1), record(log, 2), record(log, 3), errors=errors)
+    assert s.get_value() is State.SUCCEEDED
+    assert log == [1, 2, 3] and errors == []
+
+
+def test_seq_stops_at_first_failure_and_never_raises():
+    log, errors = [], []
+    s = seq(record(log, 1), fail("s2"), record(log, 3), errors=errors)
+    assert s.get_value() is State.FAILED
+    assert log == [1]
+    assert [str(e) for e in errors] == ["s2"]
+    task = last_expression_task()
+    assert task.kind == "seq" and task.status.get_value() is TaskStatus.FAILED
+    assert statuses(task) == [TaskStatus.SUCCEEDED, TaskStatus.FAILED]
+
+
+def test_try_in_order_stops_at_first_success():
+    log, errors = [], []
+    s = try_in_order(fail("a"), record(log, "b"), record(log, "c"), errors=errors)
+    assert s.get_value() is State.SUCCEEDED
+    assert log == ["b"] and [str(e) for e in errors] == ["a"]
+
+
+def test_try_in_order_fails_only_if_all_fail():
+    errors = []
+    s = try_in_order(fail("a"), fail("b"), errors=errors)
+    assert s.get_value() is State.FAILED
+    assert [str(e) for e in errors] == ["a", "b"]
+
+
+# -- par -----------------------------------------------------------------------------------------------
+
+
+def test_par_runs_branches_concurrently():
+    barrier = threading.Barrier(3, timeout=WAIT)  # all three must be running at the same time
+    s = par(barrier.wait, barrier.wait, barrier.wait)
+    assert s.get_value() is State.SUCCEEDED
+
+
+def test_par_first_failure_evaporates_siblings():
+    errors = []
+    s = par(block_forever, fail("x"), block_forever, errors=errors)
+    assert s.get_value() is State.FAILED
+    assert [str(e) for e in errors] == ["x"]  # evaporated branches add nothing
+    task = last_expression_task()
+    assert statuses(task) == [TaskStatus.EVAPORATED, TaskStatus.FAILED, TaskStatus.EVAPORATED]
+
+
+def test_thesis_par_branch_polls_state_fluent():
+    errors = []
+    seen = []
+
+    def s1():
+        raise Boom("s1 failed")
+
+    def watcher():
+        while True:
+            if s.get_value() == State.FAILED:
+                seen.append("state is FAILED")
+                break
+
+    s = Fluent()
+    par(s1, watcher, errors=errors, state=s)
+    assert s.get_value() is State.FAILED
+    # The watcher either saw the state or was evaporated while polling: both are CRAM-correct.
+    assert seen in ([], ["state is FAILED"])
+    assert [str(e) for e in errors] == ["s1 failed"]
+
+
+def test_thesis_par_with_if_true_grouping_equivalent():
+    log = []
+
+    def group():  # `if True: s1; s2` — one branch of two statements
+        log.append("s1")
+        log.append("s2")
+
+    s = par(group, record(log, "s3"))
+    assert s.get_value() is State.SUCCEEDED
+    assert log.index("s1") < log.index("s2") and "s3" in log
+
+
+def test_state_fluent_is_bound_before_branches_start():
+    s = Fluent()
+    observed = []
+    par(lambda: observed.append(s.get_value()), state=s)
+    assert observed == [None] and s.get_value() is State.SUCCEEDED
+
+
+# -- try_all and pursue -----------------------------------------------------------------------------------
+
+
+def after_sibling(index: int, status: TaskStatus):
+    """A branch that succeeds once its sibling number `index` has ended with `status`."""
+
+    def waiting():
+        sibling = current_task().parent.children[index]
+        assert (sibling.status == status).wait_for(timeout=WAIT)
+
+    return waiting
+
+
+def test_try_all_first_success_evaporates_the_rest():
+    errors = []
+    s = try_all(fail("a"), after_sibling(0, TaskStatus.FAILED), block_forever, errors=errors)
+    assert s.get_value() is State.SUCCEEDED
+    assert [str(e) for e in errors] == ["a"]
+    assert statuses(last_expression_task())[1:] == [TaskStatus.SUCCEEDED, TaskStatus.EVAPORATED]
+
+
+def test_try_all_fails_when_all_fail():
+    errors = []
+    s = try_all(fail("a"), fail("b"), errors=errors)
+    assert s.get_value() is State.FAILED
+    assert sorted(str(e) for e in errors) == ["a", "b"]
+
+
+def test_pursue_first_to_end_decides_success():
+    s = pursue(block_forever, lambda: None)
+    assert s.get_value() is State.SUCCEEDED
+    assert statuses(last_expression_task()) == [TaskStatus.EVAPORATED, TaskStatus.SUCCEEDED]
+
+
+def test_pursue_first_to_end_decides_failure():
+    errors = []
+    s = pursue(block_forever, fail("first"), errors=errors)
+    assert s.get_value() is State.FAILED
+    assert [str(e) for e in errors] == ["first"]
+
+
+def test_errors_list_is_optional_and_type_checked():
+    assert par(fail()).get_value() is State.FAILED
+    with pytest.raises(TypeError, match="errors must be a list"):
+        par(lambda: None, errors=())
+    with pytest.raises(TypeError, match="branch 2 must be a callable"):
+        seq(lambda: None, 42)
+
+
+# -- nesting and the task tree -----------------------------------------------------------------------------
+
+
+def test_nested_expressions_form_one_task_tree():
+    s = par(lambda: seq(lambda: None, lambda: None, name="inner"), name="outer")
+    assert s.get_value() is State.SUCCEEDED
+    outer = last_expression_task()
+    assert outer.name == "outer" and outer.kind == "par"
+    branch = outer.children[0]
+    inner = branch.children[0]
+    assert inner.name == "inner" and inner.parent is branch
+    assert inner.path.endswith("/outer/1:<lambda>/inner") or inner.path.endswith("/outer/1/inner")
+    assert all(t.done for t in outer.walk())
+    assert all(t.start_time is not None and t.end_time >= t.start_time for t in outer.walk())
+
+
+def test_expression_returns_only_after_all_descendants_ended():
+    finished = []
+    started = [Fluent(), Fluent()]
+
+    def slow_cleanup(index):
+        try:
+            started[index].set_value(True)
+            Fluent().wait_for()
+        finally:
+            with no_evaporation():  # clean-up that itself waits must shield itself
+                sleep(0.02)
+                finished.append("cleanup")
+
+    def winner():
+        assert started[0].AND(started[1]).wait_for(timeout=WAIT)
+
+    pursue(lambda: par(lambda: slow_cleanup(0), lambda: slow_cleanup(1)), winner)
+    assert finished == ["cleanup", "cleanup"]
+
+
+def test_evaporation_is_sticky_and_finally_blocks_run():
+    events = []
+    started = Fluent()
+
+    def stubborn():
+        try:
+            started.set_value(True)
+            try:
+                Fluent().wait_for()
+            except BaseException:  # a bare except cannot save the task ...
+                events.append("caught")
+            sleep(1)  # ... every later pycram call raises again
+            events.append("resurrected")
+        finally:
+            events.append("finally")
+
+    s = pursue(stubborn, lambda: started.wait_for(timeout=WAIT))
+    assert s.get_value() is State.SUCCEEDED
+    assert events == ["caught", "finally"]
+
+
+def test_no_evaporation_delays_delivery_to_the_end_of_the_block():
+    events = []
+    inside = Fluent()
+
+    def critical():
+        with no_evaporation():
+            inside.set_value(True)
+            sleep(0.03)  # not interrupted
+            events.append("critical done")
+        events.append("after")  # never reached: Evaporated is raised when the block ends
+
+    def winner():
+        inside.wait_for(timeout=WAIT)
+
+    pursue(critical, winner)
+    assert events == ["critical done"]
+    assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
+
+
+def test_busy_python_loop_is_evaporated():
+    def spin():
+        x = 0
+        while True:
+            x += 1
+
+    s = with_timeout(0.05, spin)
+    assert s.get_value() is State.FAILED
+    assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
+
+
+def test_retry_does_not_restart_an_evaporating_body():
+    runs = Fluent(0)
+
+    def body():
+        runs.set_value(runs.get_value() + 1)
+        try:
+            Fluent().wait_for()
+        except BaseException:
+            retry()  # raises Evaporated again instead of restarting
+
+    pursue(lambda: failure_handling(body), lambda: (runs >= 1).wait_for(timeout=WAIT))
+    assert runs.get_value() == 1
+
+
+def test_evaporation_is_delivered_in_waits_sleep_and_whenever():
+    for blocked in (lambda: Fluent().wait_for(), lambda: sleep(60), lambda: whenever(Fluent(), lambda: None)):
+        s = pursue(blocked, lambda: None)
+        assert s.get_value() is State.SUCCEEDED
+        assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
+
+
+# -- failure_handling and retry --------------------------------------------------------------------------------
+
+
+def test_thesis_failure_handling_with_limit_runs_body_limit_plus_one_times():
+    runs = []
+
+    def body():
+        runs.append(current_attempt())
+        try:
+            raise Boom("c")
+        except Exception:
+            retry()
+
+    failure_handling(body, 5)
+    assert runs == [1, 2, 3, 4, 5, 6]
+    task = last_expression_task()
+    assert task.info["attempts"] == 6 and len(task.children) == 6
+
+
+def test_failure_handling_unlimited_until_success():
+    runs = []
+
+    def body():
+        runs.append(1)
+        try:
+            if len(runs) < 4:
+                raise Boom("not yet")
+            return "done"
+        except Boom:
+            retry()
+
+    assert failure_handling(body) == "done"
+    assert len(runs) == 4
+
+
+def test_ten_thousand_retries_do_not_grow_the_stack():
+    import sys
+
+    depths = []
+
+    def body():
+        depths.append(len(_stack(sys._getframe())))
+        if len(depths) <= 10_000:
+            retry()
+
+    failure_handling(body)
+    assert len(depths) == 10_001
+    assert max(depths) == min(depths)
+
+
+def _stack(frame):
+    frames = []
+    while frame is not None:
+        frames.append(frame)
+        frame = frame.f_back
+    return frames
+
+
+def test_retry_outside_failure_handling_is_an_error():
+    with pytest.raises(RuntimeError, match="outside any failure_handling"):
+        retry()
+
+
+def test_retry_from_a_par_branch_restarts_the_enclosing_body():
+    runs = []
+
+    def body():
+        runs.append(1)
+
+        def branch():
+            if len(runs) < 3:
+                retry()
+
+        par(branch, lambda: None)
+
+    failure_handling(body)
+    assert len(runs) == 3
+
+
+def test_other_exceptions_of_the_body_propagate():
+    with pytest.raises(Boom):
+        failure_handling(fail("boom"))
+
+
+# -- with_timeout ----------------------------------------------------------------------------------------------
+
+
+def test_with_timeout_evaporates_body_at_deadline():
+    errors = []
+    s = with_timeout(0.05, block_forever, errors=errors)
+    assert s.get_value() is State.FAILED
+    assert len(errors) == 1 and isinstance(errors[0], TimeoutError)
+    body = last_expression_task().children[0]
+    assert body.status.get_value() is TaskStatus.EVAPORATED
+
+
+def test_with_timeout_in_time_succeeds():
+    errors = []
+    assert with_timeout(5, lambda: None, errors=errors).get_value() is State.SUCCEEDED
+    assert errors == []
+
+
+# -- block forms without block syntax -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: par,
+        lambda: seq,
+        lambda: par([]),
+        lambda: try_all([]),
+        lambda: failure_handling(5),
+        lambda: failure_handling(),
+        lambda: whenever(Fluent()),
+    ],
+)
+def test_block_forms_without_block_syntax_refuse_and_explain(make):
+    with pytest.raises(BlockSyntaxNotEnabled, match="@plan.*pycram run.*pycram.activate"):
+        with make():
+            pass
+
+
+def test_evaporated_is_a_base_exception():
+    assert issubclass(Evaporated, BaseException) and not issubclass(Evaporated, Exception)
