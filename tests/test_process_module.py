@@ -355,3 +355,39 @@ def test_handle_cancel_while_running_and_while_queued():
     assert [d.prop_value('n') for d in module.executed] == [1, 3]
     running.cancel()  # idempotent, no effect once done
     assert running.status.get_value() is S.CANCELLED
+
+
+def test_cancel_while_running_plain_python_execute():
+    """An _execute that never calls into pycram is stopped by the injected evaporation."""
+
+    class Busy(ProcessModule):
+        def __init__(self):
+            super().__init__('busy')
+            self.started = threading.Event()
+            self.stopped = []
+
+        def _execute(self, designator):
+            self.started.set()
+            x = 0
+            while True:  # plain Python: no pycram wait to wake up
+                x += 1
+
+        def _cancel(self, designator):
+            self.stopped.append(designator.prop_value('n'))
+
+    module = Busy()
+    route_all_to(module)
+    state = pursue(lambda: perform(motion(1)), lambda: module.started.wait(TIMEOUT))
+    assert state.get_value() is State.SUCCEEDED
+    assert module.stopped == [1] and module.status.get_value() is S.CANCELLED
+    assert module.current is None and module.queued.get_value() == 0
+
+
+def test_public_surface():
+    import pycram.process_module as pm
+    import pycram.robot as robot_module
+    import pycram.testing as testing
+
+    for module in (pm, robot_module, testing):
+        for name in module.__all__:
+            assert hasattr(module, name), (module.__name__, name)
