@@ -1,0 +1,1 @@
+"""Per-robot packages: descriptions (data), simulated hardware settings, resolvers and process modules."""

@@ -1,0 +1,1 @@
+"""The PR2: description data and robot-specific modules."""

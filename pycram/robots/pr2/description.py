@@ -1,0 +1,115 @@
+"""PR2 description: names and numbers of the PR2 as used by the simulated world and process modules.
+
+Pure data, no imports: every constant here can be read by resolvers and process modules without
+loading a simulator. Angles in [rad], lengths in [m], velocities in [m/s] / [rad/s], forces in [N].
+The model is `example-robot-data`'s PR2 URDF (loaded from the installed package, never copied).
+"""
+
+NAME = "pr2"
+
+#: URDF path relative to the `example-robot-data` share directory.
+URDF = "robots/pr2_description/urdf/pr2.urdf"
+#: Root link of the URDF; it is mounted on an omnidirectional base (slide x, slide y, hinge yaw).
+ROOT_LINK = "base_footprint"
+
+#: Base limits and the links that count as "the base" when checking for collisions while driving.
+BASE = {
+    "max_linear_velocity": 0.6,  # [m/s]
+    "max_angular_velocity": 1.0,  # [rad/s]
+    "linear_acceleration": 0.8,  # [m/s^2]
+    "angular_acceleration": 1.5,  # [rad/s^2]
+    "radius": 0.47,  # [m] circumscribed radius of the footprint (corner of the 0.67 m square)
+    "collision_links": ("base_link", "torso_lift_link"),
+}
+
+TORSO = {"joint": "torso_lift_joint", "range": (0.0, 0.31), "default": 0.2}  # [m]
+
+HEAD = {
+    "pan_joint": "head_pan_joint",
+    "tilt_joint": "head_tilt_joint",
+    #: link whose +x axis is the camera's viewing direction and +z its up direction
+    "camera_link": "high_def_frame",
+    "fovy": 55.0,  # [deg] vertical field of view
+    "resolution": (320, 240),  # [px] width, height
+}
+
+ARM_JOINT_SUFFIXES = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "upper_arm_roll_joint",
+    "elbow_flex_joint",
+    "forearm_roll_joint",
+    "wrist_flex_joint",
+    "wrist_roll_joint",
+)
+
+#: Arms: joint names in the order of the thesis' `set_arm_joints`, the tool frame (x: approach
+#: direction, y: finger opening direction) and the gripper mounted on it.
+ARMS = {
+    "right": {
+        "joints": tuple("r_" + s for s in ARM_JOINT_SUFFIXES),
+        "tool_link": "r_gripper_tool_frame",
+        "gripper": "right",
+    },
+    "left": {
+        "joints": tuple("l_" + s for s in ARM_JOINT_SUFFIXES),
+        "tool_link": "l_gripper_tool_frame",
+        "gripper": "left",
+    },
+}
+DEFAULT_ARM = "right"
+
+
+def _gripper(p: str) -> dict:
+    return {
+        #: the actuated joint; the others follow it (URDF mimic) with factor 1
+        "joint": f"{p}_gripper_l_finger_joint",
+        "coupled_joints": (
+            f"{p}_gripper_r_finger_joint",
+            f"{p}_gripper_l_finger_tip_joint",
+            f"{p}_gripper_r_finger_tip_joint",
+        ),
+        "joint_range": (0.0, 0.548),  # [rad] closed .. open
+        #: the opening is the distance between these two links minus `pad_offset`
+        "pad_links": (f"{p}_gripper_l_finger_tip_link", f"{p}_gripper_r_finger_tip_link"),
+        "pad_offset": 0.0299,  # [m] link distance when fully closed
+        "palm_link": f"{p}_gripper_palm_link",
+        "finger_links": (
+            f"{p}_gripper_l_finger_tip_link",
+            f"{p}_gripper_r_finger_tip_link",
+        ),
+        "max_opening": 0.09,  # [m]
+        "effort_lever": 0.06,  # [m] effort [N] at the finger tips x lever = joint torque [Nm]
+        "default_effort": 25.0,  # [N]
+    }
+
+
+GRIPPERS = {"right": _gripper("r"), "left": _gripper("l")}
+
+#: Named arm configurations (joint order as in ARMS[arm]["joints"]).
+ARM_CONFIGURATIONS = {
+    "right": {
+        "park": (-1.712, -0.256, -1.463, -2.12, 1.766, -0.07, 0.051),
+        "carry": (-0.40, 0.30, -0.60, -1.90, 0.0, -0.40, 0.0),
+        "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    },
+    "left": {
+        "park": (1.712, -0.256, 1.463, -2.12, -1.766, -0.07, -0.051),
+        "carry": (0.40, 0.30, 0.60, -1.90, 0.0, -0.40, 0.0),
+        "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    },
+}
+
+#: Initial joint positions when a world is created (arms parked, torso up, head straight).
+INITIAL_CONFIGURATION = {
+    **dict(zip(ARMS["right"]["joints"], ARM_CONFIGURATIONS["right"]["park"])),
+    **dict(zip(ARMS["left"]["joints"], ARM_CONFIGURATIONS["left"]["park"])),
+    "torso_lift_joint": 0.2,
+}
+
+#: Base poses (x [m], y [m], yaw [rad]) in the simulated kitchen's map frame from which the default
+#: arm reaches the cooker areas (the thesis' own numbers, ch. 4).
+KITCHEN_BASE_POSES = {
+    "cooker #2": (0.1, -0.6, -1.5708),
+    "cooker #1": (-0.1, 1.9, 3.1416),
+}

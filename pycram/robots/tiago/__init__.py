@@ -1,0 +1,1 @@
+"""TIAGo (one arm): description data and robot-specific modules."""

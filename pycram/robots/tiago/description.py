@@ -1,0 +1,84 @@
+"""TIAGo description (one 7-DoF arm): names and numbers used by the simulated world and process modules.
+
+Pure data, no imports. Angles in [rad], lengths in [m], velocities in [m/s] / [rad/s], forces in [N].
+The model is `example-robot-data`'s `tiago_no_hand.urdf` (loaded from the installed package) plus
+a simple two-finger parallel gripper of our own on `arm_tool_link`, described in `GRIPPER_MODEL`,
+so that its opening is measured like the PR2's.
+"""
+
+NAME = "tiago"
+
+URDF = "robots/tiago_description/robots/tiago_no_hand.urdf"
+ROOT_LINK = "base_footprint"
+
+BASE = {
+    "max_linear_velocity": 0.6,  # [m/s]
+    "max_angular_velocity": 1.0,  # [rad/s]
+    "linear_acceleration": 0.8,  # [m/s^2]
+    "angular_acceleration": 1.5,  # [rad/s^2]
+    "radius": 0.28,  # [m]
+    "collision_links": ("base_link", "torso_fixed_link", "torso_fixed_column_link"),
+}
+
+TORSO = {"joint": "torso_lift_joint", "range": (0.0, 0.35), "default": 0.25}  # [m]
+
+HEAD = {
+    "pan_joint": "head_1_joint",
+    "tilt_joint": "head_2_joint",
+    "camera_link": "xtion_rgb_frame",
+    "fovy": 50.0,  # [deg]
+    "resolution": (320, 240),  # [px]
+}
+
+ARMS = {
+    "right": {
+        "joints": tuple(f"arm_{i}_joint" for i in range(1, 8)),
+        "tool_link": "gripper_tool_link",
+        "gripper": "right",
+    },
+}
+DEFAULT_ARM = "right"
+
+#: Our own parallel gripper, mounted on `mount_link` (x: approach direction, y: opening direction).
+GRIPPER_MODEL = {
+    "mount_link": "arm_tool_link",
+    "palm_size": (0.03, 0.05, 0.025),  # [m] half sizes of the palm box (x, y, z)
+    "finger_size": (0.04, 0.007, 0.012),  # [m] half sizes of each finger box
+    "stroke": 0.045,  # [m] travel of each finger from closed (touching) to open
+    "tool_offset": 0.10,  # [m] tool frame along x from the mount link (between the finger tips)
+    "mass": 0.4,  # [kg] palm mass; fingers 0.05 kg each
+}
+
+GRIPPERS = {
+    "right": {
+        "joint": "gripper_left_finger_joint",
+        "coupled_joints": ("gripper_right_finger_joint",),
+        "joint_range": (0.0, 0.045),  # [m] per finger: closed .. open
+        "pad_links": ("gripper_left_finger_link", "gripper_right_finger_link"),
+        "pad_offset": 0.014,  # [m] distance of the finger body frames when closed (2 x half thickness)
+        "palm_link": "gripper_palm_link",
+        "finger_links": ("gripper_left_finger_link", "gripper_right_finger_link"),
+        "max_opening": 0.09,  # [m]
+        "effort_lever": 1.0,  # prismatic fingers: effort [N] is the joint force
+        "default_effort": 25.0,  # [N]
+    },
+}
+
+ARM_CONFIGURATIONS = {
+    "right": {
+        "park": (0.20, -1.34, -0.20, 1.94, -1.57, 1.37, 0.0),
+        "carry": (0.80, -0.60, -1.30, 1.90, 1.57, -0.60, 0.0),
+        "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    },
+}
+
+INITIAL_CONFIGURATION = {
+    **dict(zip(ARMS["right"]["joints"], ARM_CONFIGURATIONS["right"]["park"])),
+    "torso_lift_joint": 0.25,
+}
+
+#: Base poses (x, y, yaw) in the simulated kitchen's map frame from which the arm reaches the cookers.
+KITCHEN_BASE_POSES = {
+    "cooker #2": (0.25, -0.55, -1.5708),
+    "cooker #1": (-0.1, 2.05, 3.1416),
+}

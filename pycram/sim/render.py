@@ -1,0 +1,85 @@
+"""Rendering in the simulation thread: RGB and segmentation images, animation frames, files.
+
+Renderers are created lazily in the simulation thread (GL contexts belong to a thread) and
+closed by it. Writing files happens in the caller's thread from plain arrays.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Sequence
+
+import mujoco
+import numpy as np
+
+_log = logging.getLogger(__name__)
+
+
+class Renderers:
+    """One `mujoco.Renderer` per image size, owned by the simulation thread."""
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        self.model = model
+        self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
+
+    def get(self, width: int, height: int) -> mujoco.Renderer:
+        key = (width, height)
+        r = self._renderers.get(key)
+        if r is None:
+            r = mujoco.Renderer(self.model, height=height, width=width)
+            self._renderers[key] = r
+        return r
+
+    def rgb(self, data: mujoco.MjData, camera: int | str, width: int, height: int) -> np.ndarray:
+        """An RGB image (height x width x 3, uint8) from `camera`."""
+        r = self.get(width, height)
+        r.disable_segmentation_rendering()
+        r.update_scene(data, camera=camera)
+        return r.render().copy()
+
+    def segmentation(self, data: mujoco.MjData, camera: int | str, width: int, height: int) -> np.ndarray:
+        """Geom ids per pixel (height x width, int; -1 for background) from `camera`."""
+        r = self.get(width, height)
+        r.enable_segmentation_rendering()
+        try:
+            r.update_scene(data, camera=camera)
+            seg = r.render()
+        finally:
+            r.disable_segmentation_rendering()
+        ids = seg[:, :, 0].astype(np.int64)
+        ids[seg[:, :, 1] != int(mujoco.mjtObj.mjOBJ_GEOM)] = -1
+        return ids
+
+    def close(self) -> None:
+        for r in self._renderers.values():
+            try:
+                r.close()
+            except Exception:  # pragma: no cover - best effort at shutdown
+                _log.debug("renderer close failed", exc_info=True)
+        self._renderers.clear()
+
+
+def write_png(path: str | Path, image: np.ndarray) -> Path:
+    """Write an RGB image to a PNG file; returns the path."""
+    import imageio.v3 as iio
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    iio.imwrite(path, image)
+    return path
+
+
+def write_animation(path: str | Path, frames: Sequence[np.ndarray], fps: float) -> Path:
+    """Write frames to an animated GIF (or any format imageio knows by the suffix)."""
+    import imageio.v3 as iio
+
+    if not frames:
+        raise ValueError("no frames recorded")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix.lower() == ".gif":
+        iio.imwrite(path, np.stack(frames), duration=1000.0 / fps, loop=0)
+    else:
+        iio.imwrite(path, np.stack(frames), fps=fps)
+    return path

@@ -1,0 +1,478 @@
+"""`World`: a simulated kitchen with one robot, run by its own simulation thread.
+
+The simulation thread is the only thread that touches MuJoCo. Other threads
+
+- send commands (`drive_to`, `move_arm`, `reach`, `set_gripper`, `track_point`, ...), each of
+  which returns a `CommandHandle` at once (its `result` fluent gets the `Outcome`), and
+- read sensor fluents, updated at `sensor_rate` [Hz] of simulated time: `base_pose`,
+  `joint_states`, `gripper_openings[g]`, `gripper_states[g]`, `tool_poses`, `item_poses`,
+  `sim_time`, and `camera_image` (on request).
+
+While it runs, the world's `ManualClock` is the active PyCRAM clock: `pycram.sleep` and fluent
+time-outs follow simulated time. Headless it runs as fast as it can; `realtime=True` paces it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import queue
+import threading
+import time
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ._runtime import Fluent, ManualClock, use_clock
+from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
+                          JointTrajectory, Reach)
+from .engine import Engine
+from .errors import UnknownNameError, WorldClosedError
+from .handle import CommandHandle
+from .items import ItemSpec
+from .kitchen import OBSTACLE_PARKING
+from .render import Renderers, write_animation, write_png
+from .robot_model import HEAD_CAMERA
+from .scene import build_scene
+from .types import Outcome, Pose, Pose2D, VisibleItem
+
+_log = logging.getLogger(__name__)
+
+DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)  # [m, m, rad] on the free floor between the counters
+
+
+class World:
+    """The kitchen, a robot ("pr2" or "tiago") and items, simulated in a background thread.
+
+    Construction builds the scene (< 1 s) and starts the thread. `close()` (or leaving the
+    `with` block) stops it and joins it; every command still running ends with reason "closed".
+    All public methods are thread-safe and never block unless documented (`snapshot`,
+    `stop_recording`, `wait_*`).
+    """
+
+    def __init__(self, robot: str = "pr2", items: Sequence[ItemSpec] | None = None, *,
+                 base_pose: tuple[float, float, float] = DEFAULT_BASE_POSE, realtime: bool = False,
+                 realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
+                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
+        self.scene = build_scene(robot, items, offscreen_size)
+        self.description = self.scene.description
+        self.robot = robot
+        self.realtime, self.realtime_factor = realtime, realtime_factor
+        self._steps_per_tick = max(1, round(control_period / self.scene.model.opt.timestep))
+        self._sensor_period = 1.0 / sensor_rate
+        self.clock = ManualClock(0.0)
+        self._engine = Engine(self.scene, base_pose)  # touched only by the simulation thread from now on
+        eng = self._engine
+        # --- sensor fluents
+        self.sim_time = Fluent(0.0, name="sim_time")
+        self.base_pose = Fluent(eng.base_pose(), name="base_pose")
+        self.joint_states = Fluent(eng.joint_states(), name="joint_states")
+        self.gripper_openings = {g: Fluent(eng.gripper_state(g).opening, name=f"{g}_gripper_opening")
+                                 for g in eng.grippers}
+        self.gripper_states = {g: Fluent(eng.gripper_state(g), name=f"{g}_gripper_state") for g in eng.grippers}
+        self.tool_poses = Fluent(self._tool_poses(), name="tool_poses")
+        self.item_poses = Fluent(self._item_poses(), name="item_poses")
+        self.camera_image = Fluent(None, name="camera_image")
+        # --- command plumbing
+        self._inbox: queue.SimpleQueue = queue.SimpleQueue()
+        self._lock = threading.Lock()
+        self._closed = False
+        self._stop = threading.Event()
+        self._active: dict[str, tuple[Controller, CommandHandle]] = {}
+        self._recording: dict[str, Any] | None = None
+        self._renderers: Renderers | None = None
+        self.error: BaseException | None = None
+        self._clock_ctx = contextlib.ExitStack()
+        if activate_clock:
+            self._clock_ctx.enter_context(use_clock(self.clock))
+        self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
+        self._thread.start()
+
+    # ------------------------------------------------------------------ lifecycle
+    def __enter__(self) -> "World":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def running(self) -> bool:
+        """True while the simulation thread runs."""
+        return self._thread.is_alive()
+
+    def close(self, timeout: float = 10.0) -> None:
+        """Stop the simulation thread and wait for it [s of wall time]; idempotent.
+
+        Commands still running end with reason "closed"; the previous clock is re-activated.
+        """
+        self._stop.set()
+        if self._thread.is_alive() and threading.current_thread() is not self._thread:
+            self._thread.join(timeout)
+            if self._thread.is_alive():  # pragma: no cover
+                _log.error("simulation thread did not stop within %.1f s", timeout)
+        self._clock_ctx.close()
+
+    # ------------------------------------------------------------------ the thread
+    def _run(self) -> None:
+        eng = self._engine
+        next_sensor = 0.0
+        wall0, sim0 = time.monotonic(), eng.time
+        try:
+            while not self._stop.is_set():
+                self._drain_inbox()
+                t = eng.time
+                for channel, (ctrl, handle) in list(self._active.items()):
+                    out = ctrl.update(eng, t)
+                    if out is not None:
+                        self._end(channel, out, stop=not out.succeeded)
+                eng.step(self._steps_per_tick)
+                self.clock.advance_to(eng.time)
+                if eng.time >= next_sensor:
+                    next_sensor = eng.time + self._sensor_period
+                    self._publish()
+                if self._recording is not None and eng.time >= self._recording["next"]:
+                    self._record_frame()
+                if self.realtime:
+                    ahead = (eng.time - sim0) / self.realtime_factor - (time.monotonic() - wall0)
+                    if ahead > 0:
+                        self._stop.wait(ahead)
+        except BaseException as exc:  # noqa: BLE001 - reported through handles and `error`
+            self.error = exc
+            _log.exception("simulation thread failed")
+        finally:
+            self._shutdown()
+
+    def _shutdown(self) -> None:
+        reason = "error" if self.error else "closed"
+        with self._lock:
+            self._closed = True
+        for channel in list(self._active):
+            self._end(channel, Outcome(False, reason, "world closed"), stop=False)
+        while True:
+            try:
+                kind, a, b = self._inbox.get_nowait()
+            except queue.Empty:
+                break
+            if kind == "start":
+                b._finish(Outcome(False, reason, "world closed"))
+        if self._renderers is not None:
+            self._renderers.close()
+        # wake anybody waiting on simulated time one last time
+        self.clock.advance_to(self._engine.time + 1e9)
+
+    def _drain_inbox(self) -> None:
+        eng = self._engine
+        while True:
+            try:
+                kind, ctrl, handle = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            if kind == "cancel":
+                for channel, (c, h) in list(self._active.items()):
+                    if h is handle:
+                        self._end(channel, Outcome(False, "cancelled", "cancelled"), stop=True)
+                continue
+            try:
+                if ctrl.channel is not None and ctrl.channel in self._active:
+                    self._end(ctrl.channel, Outcome(False, "preempted", f"preempted by {handle.name}"), stop=False)
+                out = ctrl.start(eng)
+            except Exception as exc:  # a bad command must not kill the world
+                _log.exception("command %s failed to start", handle.name)
+                out = Outcome(False, "error", f"{type(exc).__name__}: {exc}")
+            if out is not None:
+                if not out.succeeded:
+                    ctrl.stop(eng)
+                handle._finish(out)
+            elif ctrl.channel is None:
+                handle._finish(Outcome(True, "succeeded"))
+            else:
+                self._active[ctrl.channel] = (ctrl, handle)
+
+    def _end(self, channel: str, outcome: Outcome, stop: bool) -> None:
+        ctrl, handle = self._active.pop(channel)
+        if stop or not outcome.succeeded:
+            ctrl.stop(self._engine)
+        handle._finish(outcome)
+
+    def _tool_poses(self) -> dict[str, Pose]:
+        eng = self._engine
+        return {arm: eng.site_pose(s) for arm, s in eng.tool_sites.items()}
+
+    def _item_poses(self) -> dict[str, Pose]:
+        eng = self._engine
+        return {name: eng.item_pose(name) for name in eng.item_bodies}
+
+    def _publish(self) -> None:
+        eng = self._engine
+        self.sim_time.set_value(eng.time)
+        self.base_pose.set_value(eng.base_pose())
+        self.joint_states.set_value(eng.joint_states())
+        for g in eng.grippers:
+            state = eng.gripper_state(g)
+            self.gripper_states[g].set_value(state)
+            self.gripper_openings[g].set_value(state.opening)
+        self.tool_poses.set_value(self._tool_poses())
+        self.item_poses.set_value(self._item_poses())
+
+    # ------------------------------------------------------------------ submitting
+    def submit(self, ctrl: Controller, name: str) -> CommandHandle:
+        """Queue a controller for the simulation thread; returns its handle at once."""
+        handle = CommandHandle(name, self._cancel)
+        with self._lock:
+            if self._closed or self._stop.is_set():
+                raise WorldClosedError(f"world is closed; cannot run {name}")
+            self._inbox.put(("start", ctrl, handle))
+        return handle
+
+    def _cancel(self, handle: CommandHandle) -> None:
+        with self._lock:
+            if not self._closed:
+                self._inbox.put(("cancel", None, handle))
+
+    def _call(self, name: str, fn: Callable[..., Any], *args: Any) -> CommandHandle:
+        return self.submit(Instant(fn, *args), name)
+
+    def _check_arm(self, arm: str) -> str:
+        if arm not in self.description.ARMS:
+            raise UnknownNameError("arm", arm, self.description.ARMS)
+        return arm
+
+    def _check_gripper(self, gripper: str) -> str:
+        if gripper not in self.description.GRIPPERS:
+            raise UnknownNameError("gripper", gripper, self.description.GRIPPERS)
+        return gripper
+
+    # ------------------------------------------------------------------ robot commands
+    def drive_to(self, x: float, y: float, yaw: float) -> CommandHandle:
+        """Drive the base to the map pose (x [m], y [m], yaw [rad]) with the base's limits.
+
+        Ends with "collision"/"blocked" (stopped where it is) or "timeout"; value: final `Pose2D`.
+        """
+        return self.submit(BaseDrive(Pose2D(x, y, yaw)), "drive_to")
+
+    def move_base(self, pose: Pose2D) -> CommandHandle:
+        """`drive_to` with a `Pose2D`."""
+        return self.drive_to(pose.x, pose.y, pose.yaw)
+
+    def set_torso(self, height: float, duration: float | None = None) -> CommandHandle:
+        """Move the torso lift joint to `height` [m]."""
+        joint = self.description.TORSO["joint"]
+        return self.submit(JointTrajectory("torso", [joint], [height], duration, max_velocity=0.1,
+                                           tolerance=0.005), "set_torso")
+
+    def move_arm(self, arm: str, positions: Sequence[float], duration: float | None = None) -> CommandHandle:
+        """Move the joints of `arm` (order: `description.ARMS[arm]["joints"]`) to `positions` [rad]."""
+        joints = self.description.ARMS[self._check_arm(arm)]["joints"]
+        if len(positions) != len(joints):
+            raise ValueError(f"{arm} arm has {len(joints)} joints, got {len(positions)} positions")
+        return self.submit(JointTrajectory(f"arm:{arm}", joints, positions, duration), f"move_arm:{arm}")
+
+    def move_arm_to(self, arm: str, configuration: str, duration: float | None = None) -> CommandHandle:
+        """Move `arm` to a named configuration of `description.ARM_CONFIGURATIONS[arm]`."""
+        configs = self.description.ARM_CONFIGURATIONS[self._check_arm(arm)]
+        if configuration not in configs:
+            raise UnknownNameError("arm configuration", configuration, configs)
+        return self.move_arm(arm, configs[configuration], duration)
+
+    def reach(self, arm: str, position: Sequence[float], orientation: Sequence[float] | None = None,
+              duration: float | None = None, tolerance: float = 0.01) -> CommandHandle:
+        """Move the tool frame of `arm` to `position` [m] (and `orientation` (w, x, y, z) if given).
+
+        Ends with "unreachable" when inverse kinematics finds no solution within the joint limits;
+        value: the reached tool `Pose`.
+        """
+        self._check_arm(arm)
+        goal = Pose(tuple(map(float, position)),
+                    tuple(map(float, orientation)) if orientation is not None else (1.0, 0.0, 0.0, 0.0))
+        return self.submit(Reach(arm, goal, orientation is not None, duration, tolerance), f"reach:{arm}")
+
+    def point_head(self, point: Sequence[float]) -> CommandHandle:
+        """Turn the head camera to `point` [m, map frame]; succeeds when it looks at it (< ~1 deg)."""
+        return self.submit(HeadPointing(point), "point_head")
+
+    def track_point(self, point: Sequence[float]) -> CommandHandle:
+        """Keep the head camera on `point` [m, map frame], also while driving, until cancelled."""
+        return self.submit(HeadPointing(point, track=True), "track_point")
+
+    def set_gripper(self, gripper: str, opening: float, effort: float | None = None) -> CommandHandle:
+        """Open/close `gripper` to `opening` [m] with at most `effort` [N]; value: measured opening [m].
+
+        Closing on an item (both fingers touching) grasps it; opening wider releases it.
+        """
+        return self.submit(GripperCommand(self._check_gripper(gripper), opening, effort), f"gripper:{gripper}")
+
+    def cancel(self, part: str) -> CommandHandle:
+        """Cancel whatever runs on `part` ("base", "torso", "head", "arm:<arm>", "gripper:<g>")."""
+
+        def fn(eng: Engine) -> bool:
+            if part in self._active:
+                self._end(part, Outcome(False, "cancelled", "cancelled"), stop=True)
+                return True
+            return False
+
+        return self._call(f"cancel:{part}", fn)
+
+    # ------------------------------------------------------------------ cameras and perception
+    def _get_renderers(self) -> Renderers:
+        if self._renderers is None:
+            self._renderers = Renderers(self.scene.model)
+        return self._renderers
+
+    def request_image(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
+        """Render an RGB image (height x width x 3, uint8) from `camera`; also set `camera_image`."""
+        self.scene.camera(camera)
+
+        def fn(eng: Engine) -> np.ndarray:
+            img = self._get_renderers().rgb(eng.data, camera, width, height)
+            self.camera_image.set_value(img)
+            return img
+
+        return self._call(f"image:{camera}", fn)
+
+    def snapshot(self, path: str | Path, camera: str = "overview", width: int = 640, height: int = 480,
+                 timeout: float = 30.0) -> Path:
+        """Render `camera` and write a PNG to `path` (blocks up to `timeout` [s of wall time])."""
+        handle = self.request_image(camera, width, height)
+        _wait_wall(handle, timeout)
+        out = handle.outcome
+        if out is None or not out.succeeded:
+            raise WorldClosedError(f"snapshot failed: {out}")
+        return write_png(path, out.value)
+
+    def perceive(self, min_pixels: int = 20, width: int = 320, height: int = 240) -> CommandHandle:
+        """Items visible to the head camera (segmentation render): value `list[VisibleItem]`,
+        most visible first. An item hidden behind others or outside the view is not reported."""
+
+        def fn(eng: Engine) -> list[VisibleItem]:
+            ids = self._get_renderers().segmentation(eng.data, HEAD_CAMERA, width, height)
+            counts = np.bincount(ids[ids >= 0].ravel(), minlength=eng.model.ngeom)
+            seen = []
+            for name, geom in eng.item_geoms.items():
+                n = int(counts[geom]) if geom < len(counts) else 0
+                if n >= min_pixels:
+                    seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), n))
+            return sorted(seen, key=lambda v: -v.pixels)
+
+        return self._call("perceive", fn)
+
+    def start_recording(self, camera: str = "overview", fps: float = 10.0, width: int = 320,
+                        height: int = 240) -> CommandHandle:
+        """Start recording frames of `camera` every 1/`fps` s of simulated time."""
+        self.scene.camera(camera)
+
+        def fn(eng: Engine) -> None:
+            self._recording = {"camera": camera, "fps": fps, "size": (width, height), "frames": [],
+                               "next": eng.time}
+
+        return self._call("start_recording", fn)
+
+    def _record_frame(self) -> None:
+        rec = self._recording
+        assert rec is not None
+        w, h = rec["size"]
+        rec["frames"].append(self._get_renderers().rgb(self._engine.data, rec["camera"], w, h))
+        rec["next"] += 1.0 / rec["fps"]
+
+    def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
+        """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
+
+        Blocks up to `timeout` [s of wall time].
+        """
+
+        def fn(eng: Engine) -> tuple[list[np.ndarray], float]:
+            rec, self._recording = self._recording, None
+            return (rec["frames"], rec["fps"]) if rec else ([], 1.0)
+
+        handle = self._call("stop_recording", fn)
+        _wait_wall(handle, timeout)
+        out = handle.outcome
+        if out is None or not out.succeeded:
+            raise WorldClosedError(f"stop_recording failed: {out}")
+        frames, fps = out.value
+        if path is not None:
+            write_animation(path, frames, fps)
+        return frames
+
+    # ------------------------------------------------------------------ fault injection
+    def take_item(self, gripper: str | None = None, item: str | None = None,
+                  to: Sequence[float] | None = None) -> CommandHandle:
+        """Take an item away, as a person would: out of `gripper` (the item it holds) or `item` by name.
+
+        The item goes to `to` [m] or aside onto the floor out of the kitchen. The gripper keeps
+        its command, so a closed gripper closes fully. Value: the item's name (None if nothing).
+        """
+        if gripper is not None:
+            self._check_gripper(gripper)
+        if item is not None:
+            self.scene.item(item)
+
+        def fn(eng: Engine) -> str | None:
+            name = item
+            if name is None and gripper is not None:
+                name = eng.grippers[gripper].holding
+            if name is None:
+                return None
+            eng.set_item_pose(name, tuple(to) if to is not None else eng.aside_position(name))
+            return name
+
+        return self._call("take_item", fn)
+
+    def give_item(self, item: str, gripper: str, close: bool = True) -> CommandHandle:
+        """Hand `item` into `gripper` (opened first if needed) and, with `close`, close the gripper on it."""
+        self.scene.item(item)
+        self._check_gripper(gripper)
+        arm = next(a for a, s in self.description.ARMS.items() if s["gripper"] == gripper)
+        return self.submit(GiveItem(item, gripper, arm, close), "give_item")
+
+    def move_item(self, item: str, position: Sequence[float],
+                  orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)) -> CommandHandle:
+        """Put `item` at `position` [m] / `orientation` (w, x, y, z), releasing any grasp."""
+        self.scene.item(item)
+        return self._call("move_item", lambda eng: eng.set_item_pose(item, tuple(position), tuple(orientation)))
+
+    def place_obstacle(self, x: float, y: float) -> CommandHandle:
+        """Put a 0.3 x 0.3 x 1 m box on the floor centred at (x, y) [m]; value: its name."""
+
+        def fn(eng: Engine) -> str:
+            free = [n for n in eng.obstacles if n not in eng.obstacles_used]
+            if not free:
+                raise RuntimeError(f"all {len(eng.obstacles)} obstacles are in use")
+            name = free[0]
+            eng.obstacles_used.add(name)
+            eng.place_obstacle(name, x, y)
+            return name
+
+        return self._call("place_obstacle", fn)
+
+    def remove_obstacle(self, name: str) -> CommandHandle:
+        """Take the obstacle `name` away again."""
+
+        def fn(eng: Engine) -> None:
+            if name not in eng.obstacles:
+                raise UnknownNameError("obstacle", name, eng.obstacles)
+            eng.obstacles_used.discard(name)
+            eng.remove_obstacle(name, OBSTACLE_PARKING)
+
+        return self._call("remove_obstacle", fn)
+
+    # ------------------------------------------------------------------ conveniences
+    def kitchen_base_pose(self, place: str) -> Pose2D:
+        """The description's base pose in front of `place` ("cooker #1", "cooker #2")."""
+        poses = self.description.KITCHEN_BASE_POSES
+        if place not in poses:
+            raise UnknownNameError("place", place, poses)
+        return Pose2D(*poses[place])
+
+    def __repr__(self) -> str:
+        return f"<World {self.robot} t={self.sim_time.get_value():.2f}s {'running' if self.running else 'closed'}>"
+
+
+def _wait_wall(handle: CommandHandle, timeout: float) -> None:
+    """Wait for `handle` by wall time (for blocking conveniences that must not hang on sim time)."""
+    deadline = time.monotonic() + timeout
+    while not handle.done and time.monotonic() < deadline:
+        handle.wait(0.05)  # wakes on completion or after 0.05 s of the active clock
+
+
+__all__ = ["World", "DEFAULT_BASE_POSE"]
