@@ -581,11 +581,20 @@ class _Transformer:
     # -- code generation --------------------------------------------------------------------------
 
     def _located(self, nodes: list[ast.stmt], where: ast.AST) -> list[ast.stmt]:
-        """Put every node of generated `nodes` on the line of `where` (the user's `with`)."""
+        """Put every node of generated `nodes` on the first line of `where` (the user's `with`).
+
+        The end position is the same line too: CPython attributes some instructions (attribute
+        loads) to a node's end line, and a debugger must not see the block's last line here.
+        """
+        lineno = where.lineno  # type: ignore[attr-defined]
+        col = where.col_offset  # type: ignore[attr-defined]
+        text = self.lines[lineno - 1] if 0 < lineno <= len(self.lines) else ""
+        end_col = max(len(text.rstrip().encode("utf-8")), col + 1)
         for node in nodes:
             for child in ast.walk(node):
                 if "lineno" in child._attributes:
-                    ast.copy_location(child, where)
+                    child.lineno, child.col_offset = lineno, col  # type: ignore[attr-defined]
+                    child.end_lineno, child.end_col_offset = lineno, end_col  # type: ignore[attr-defined]
         return nodes
 
     def _parse(self, code: str) -> list[ast.stmt]:
@@ -612,7 +621,7 @@ class _Transformer:
             if nonlocals:
                 decls.append(ast.Nonlocal(nonlocals))
                 scope.hoist.update(nonlocals)
-        self._located(decls, where)
+        self._located([*decls], where)
         fn = ast.FunctionDef(
             name=gen_name,
             args=ast.arguments(posonlyargs=[], args=[], vararg=None, kwonlyargs=[], kw_defaults=[], kwarg=None, defaults=[]),
@@ -621,7 +630,8 @@ class _Transformer:
             returns=None,
             type_comment=None,
         )
-        ast.copy_location(fn, where)
+        header = self._located([ast.Pass()], where)[0]  # the def's own position; its body stays the user's
+        ast.copy_location(fn, header)
         self.names[gen_name] = nice
         return fn
 

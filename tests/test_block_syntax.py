@@ -486,3 +486,25 @@ def test_import_hook_transforms_only_opted_in_modules(tmp_path: Path, monkeypatc
     assert plan_mod.s.get_value() is State.SUCCEEDED and plan_mod.__pycram_transformed__
     assert plain_mod.y == 1 and not hasattr(plain_mod, "__pycram_transformed__")
     assert plan(plan_mod.f) is plan_mod.f and plan_mod.f() == 2  # already transformed by the hook
+
+
+def test_debugger_breakpoint_inside_a_branch_stops_at_the_user_line(tmp_path: Path) -> None:
+    import bdb
+
+    path = _write(tmp_path / "dbg.py", HEADER + "hits = []\nwith seq as s:\n    hits.append(1)\n    hits.append(2)\n")
+    stops: list[tuple[str, int, str]] = []
+
+    class Recorder(bdb.Bdb):
+        def user_line(self, frame: types.FrameType) -> None:
+            if self.break_here(frame):
+                stops.append((frame.f_code.co_filename, frame.f_lineno, frame.f_code.co_name))
+            self.set_continue()
+
+    debugger = Recorder()
+    debugger.set_break(str(path), 6)
+    code = compile_source(path.read_text(), str(path))
+    ns: dict[str, Any] = {"__name__": "dbg"}
+    debugger.runctx(code, ns, ns)  # seq runs its steps in the calling thread
+    threading.settrace(None)
+    assert ns["hits"] == [1, 2]
+    assert stops == [(str(path), 6, "seq@dbg.py:4#2")]
