@@ -380,75 +380,60 @@ class ProcessModule:
         """Wait for the turn of ``execution``, then execute it; records the outcome in it.
 
         Raises what the caller must see: ``Evaporated``, ProcessModuleFailure/Offline.
+        Whatever happens -- evaporation while queued, while running, or an asynchronous
+        ``Evaporated`` landing between two statements -- the ``finally`` clause leaves the
+        queue, frees the module and settles the outcome (under ``no_evaporation``).
         """
+        designator = execution.designator
+        outcome, error, result = ProcessModuleStatus.CANCELLED, None, None
+        started = False
         try:
             wait_until(self._cond, lambda: self._claim(execution))
-        except BaseException:
-            with self._cond:  # evaporated while queued: leave the queue, let the next one go
+            if self._current is execution:
+                started = True
+                logger.debug("%s: executing %r", self.name, designator)
+                try:
+                    result = self._execute(designator)
+                    outcome = ProcessModuleStatus.SUCCEEDED
+                except Exception as e:
+                    failure = ProcessModuleFailure(
+                        f"{self.name} failed to execute {designator!r}: {type(e).__name__}: {e}",
+                        designator=designator, module=self, cause=e)
+                    failure.__cause__ = e
+                    error, outcome = failure, ProcessModuleStatus.FAILED
+        finally:
+            self._settle(execution, started, outcome, error, result)
+        if error is not None:
+            raise error
+        if not started and execution.exception is not None:
+            raise execution.exception  # e.g. ProcessModuleOffline while queued
+
+    def _settle(self, execution: Execution, started: bool, outcome: ProcessModuleStatus,
+                error: Optional[BaseException], result: Any) -> None:
+        """Run the cancel hook if a started execution did not end by itself, then free the
+        module / leave the queue and record the outcome. Idempotent for a settled execution.
+        Raises ``Evaporated`` at the end if the calling task is evaporating."""
+        with no_evaporation():
+            if started and outcome is ProcessModuleStatus.CANCELLED:
+                try:
+                    logger.debug("%s: cancelling %r", self.name, execution.designator)
+                    self._cancel(execution.designator)
+                except Exception:
+                    logger.exception("%s: cancel hook failed for %r", self.name,
+                                     execution.designator)
+            with self._cond:
                 if execution in self._queue:
                     self._queue.remove(execution)
                     self.queued.set_value(len(self._queue))
-                if not execution.done:
-                    self._finish_locked(execution, ProcessModuleStatus.CANCELLED, None)
-                self._cond.notify_all()
-            raise
-        if execution.done:  # removed while queued
-            if execution.exception is not None:
-                raise execution.exception
-            return
-        designator = execution.designator
-        outcome, error, result = ProcessModuleStatus.FAILED, None, None
-        try:
-            try:
-                logger.debug("%s: executing %r", self.name, designator)
-                result = self._execute(designator)
-                outcome = ProcessModuleStatus.SUCCEEDED
-            except Exception as e:
-                error = ProcessModuleFailure(
-                    f"{self.name} failed to execute {designator!r}: {type(e).__name__}: {e}",
-                    designator=designator, module=self, cause=e)
-                error.__cause__ = e
-                outcome = ProcessModuleStatus.FAILED
-            except BaseException:
-                outcome = ProcessModuleStatus.CANCELLED
-                self._run_cancel_hook(designator)
-                raise
-        except BaseException:  # an asynchronous exception landing in the handlers above
-            if outcome is not ProcessModuleStatus.CANCELLED:
-                outcome = ProcessModuleStatus.CANCELLED
-                self._run_cancel_hook(designator)
-            raise
-        finally:
-            self._release(execution, outcome, error, result)
-        if error is not None:
-            raise error
-
-    def _run_cancel_hook(self, designator: Any) -> None:
-        try:
-            with no_evaporation():
-                try:
-                    logger.debug("%s: cancelling %r", self.name, designator)
-                    self._cancel(designator)
-                except Exception:
-                    logger.exception("%s: cancel hook failed for %r", self.name, designator)
-        except Evaporated:
-            pass  # the caller re-raises the original evaporation
-
-    def _release(self, execution: Execution, outcome: ProcessModuleStatus,
-                 error: Optional[BaseException], result: Any) -> None:
-        try:
-            with no_evaporation():
-                with self._cond:
-                    execution.result = result
+                if self._current is execution:
                     self._current = None
-                    self._finish_locked(execution, outcome, error)
+                    execution.result = result
                     self._running.set_value(False)
                     self.status.set_value(ProcessModuleStatus.OFFLINE if self._offline
                                           else outcome)
-                    self._cond.notify_all()
-        except Evaporated:
-            if outcome is not ProcessModuleStatus.CANCELLED:
-                raise
+                if not execution.done:
+                    self._finish_locked(execution, outcome, error)
+                self._cond.notify_all()
 
     def _finish_locked(self, execution: Execution, outcome: ProcessModuleStatus,
                        error: Optional[BaseException]) -> None:
