@@ -360,3 +360,25 @@ def test_concurrent_next_solution_chains_share_cache_safely():
     for t in threads:
         t.join(10)
     assert out == [list(range(300))] * 4
+
+
+def test_resolution_interrupted_by_evaporation_restarts_on_next_reference():
+    from pycram.fluent import Fluent
+    from pycram.language import State, pursue
+
+    ready = Fluent(None)
+    entered = Fluent(None)
+
+    def waiting_resolver(d):
+        def gen():
+            entered.set_value(True)
+            ready.wait_for()  # evaporable wait inside resolution
+            yield 'solution'
+        return [gen]
+
+    MotionDesignator.resolvers.append(waiting_resolver)
+    d = MotionDesignator([('type', 'x')])
+    state = pursue(d.reference, lambda: entered.wait_for(5))
+    assert state.get_value() is State.SUCCEEDED  # the resolution was evaporated midway
+    ready.set_value(True)
+    assert d.reference() == 'solution'

@@ -384,8 +384,9 @@ class GeneratorList:
     ``get(i)`` advances the generator until ``i`` elements exist and raises ``StopIteration``
     when it is exhausted first. An exception raised by the generator is remembered and re-raised
     by every later ``get`` beyond the cached elements (a generator cannot be resumed after
-    raising); an interruption by a ``BaseException`` (e.g. evaporation) is reported as a
-    :class:`DesignatorError` on later calls.
+    raising). An interruption by a ``BaseException`` (e.g. evaporation) sets ``interrupted``;
+    later ``get`` beyond the cached elements raise :class:`DesignatorError` (a
+    :class:`LazyDesignator` then starts a fresh resolution instead).
     """
 
     def __init__(self, generator: Any) -> None:
@@ -397,12 +398,15 @@ class GeneratorList:
         self._done = False
         self._error: Optional[BaseException] = None
         self._advancing = False
+        self.interrupted = False
 
     def get(self, index: int = 0) -> Any:
         with self._lock:
             while len(self._generated) <= index:
                 if self._error is not None:
                     raise self._error
+                if self.interrupted:
+                    raise DesignatorError("resolution was interrupted (evaporated)")
                 if self._done:
                     raise StopIteration
                 if self._advancing:
@@ -417,7 +421,7 @@ class GeneratorList:
                     self._error = e
                     raise
                 except BaseException:
-                    self._error = DesignatorError("resolution was interrupted (evaporated)")
+                    self.interrupted = True
                     raise
                 finally:
                     self._advancing = False
@@ -430,6 +434,11 @@ class GeneratorList:
             return True
         except StopIteration:
             return False
+
+    def cached(self, index: int) -> bool:
+        """``True`` iff the element at ``index`` was already generated."""
+        with self._lock:
+            return index < len(self._generated)
 
     @property
     def generated(self) -> list[Any]:
@@ -528,7 +537,9 @@ class LazyDesignator(Designator):
     def _reference(self) -> Any:
         if self._effective and self._solutions is None:
             return self._data  # made effective by hand (make_effective)
-        if self._solutions is None:
+        if self._solutions is None or (self._solutions.interrupted
+                                       and not self._solutions.cached(self._index)):
+            # first resolution, or the previous one was evaporated midway: resolve afresh
             self._solutions = GeneratorList(self._generate)
         if self._effective:
             return self._data
