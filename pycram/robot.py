@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import Any, Callable, Iterable, Iterator, Optional
+from typing import Any, Callable, Iterable, Optional
 
 __all__ = [
     "ResolverSet",
@@ -187,8 +187,3 @@ def describe_active_robot() -> str:
     if robot is None:
         return "no active robot (global resolver lists)"
     return f"active robot {robot.name!r}"
-
-
-def _iter_names(functions: Iterable[Any]) -> Iterator[str]:
-    for f in functions:
-        yield getattr(f, "__qualname__", None) or repr(f)

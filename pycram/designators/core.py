@@ -42,7 +42,6 @@ logger = logging.getLogger("pycram.designator")
 
 Property = tuple[Any, Any]
 
-_MISSING = object()
 
 
 # --------------------------------------------------------------------------- errors

@@ -19,15 +19,12 @@ resolution stops with ``NoSolutionError`` saying so.
 
 from __future__ import annotations
 
-import logging
 from typing import Any, Callable, ClassVar, Iterator
 
-from pycram.designators.core import (LazyDesignator, NoSolutionError, ResolverError,
-                                     callable_name, call_resolver, expand_solutions)
+from pycram.designators.core import (LazyDesignator, NoSolutionError, call_resolver,
+                                     callable_name, expand_solutions)
 
 __all__ = ["LocationDesignator"]
-
-logger = logging.getLogger("pycram.designator")
 
 
 class LocationDesignator(LazyDesignator):
