@@ -70,7 +70,12 @@ Branch = Callable[[], Any]
 
 def _label(fn: Branch, index: int) -> str:
     """Task name of the index-th branch: its given name, its function name, or its number."""
-    name = getattr(fn, "__pycram_name__", None) or getattr(fn, "__name__", None)
+    given = getattr(fn, "__pycram_name__", None)
+    if given:
+        return given
+    name = getattr(fn, "__name__", None)
+    if name and "@" in name:  # named after its source line by the block syntax: unique already
+        return name
     if not name or name == "<lambda>":
         return str(index + 1)
     return f"{index + 1}:{name}"
@@ -158,11 +163,11 @@ def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: 
 # -- concurrent expressions ------------------------------------------------------------------------
 
 
-class _Retry(BaseException):
-    """Raised by `retry()`; caught by the failure_handling it belongs to."""
+class RetryRequested(BaseException):
+    """Raised by `retry()`; caught by the failure_handling it belongs to (ends the attempt)."""
 
     def __init__(self, handler: _FailureHandler) -> None:
-        super().__init__("retry")
+        super().__init__("retry() restarts the failure_handling body")
         self.handler = handler
 
 
@@ -175,7 +180,7 @@ class _Concurrent:
         self.state = state
         self.outcome: State | None = None
         self.first_error: BaseException | None = None
-        self.retry: _Retry | None = None
+        self.retry: RetryRequested | None = None
         self.succeeded = 0
         self.failed = 0
         self.count = 0
@@ -184,7 +189,7 @@ class _Concurrent:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
         status = task.status.get_value()
         if status is TaskStatus.FAILED:
-            if isinstance(task.exception, _Retry):
+            if isinstance(task.exception, RetryRequested):
                 self.retry = self.retry or task.exception
                 self._decide(State.FAILED)
                 return
@@ -339,7 +344,7 @@ def failure_handling(body: Branch | int | None = None, max_retries: int = -1, na
             scope.task.info["attempts"] = number
             try:
                 return run_subtask(f"attempt {number}", attempt, kind="attempt")
-            except _Retry as request:
+            except RetryRequested as request:
                 if request.handler is not handler:
                     raise
 
@@ -369,7 +374,7 @@ def retry() -> None:
     if 0 <= handler.max_retries <= handler.retries:
         return
     handler.retries += 1
-    raise _Retry(handler)
+    raise RetryRequested(handler)
 
 
 def current_attempt() -> int:
