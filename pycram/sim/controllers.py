@@ -155,11 +155,13 @@ class JointTrajectory(Controller):
         for j, v in zip(self.joints, self.q0 + s * (self.goal - self.q0)):
             eng.set_target(j, float(v))
         if s >= 1.0:
-            err = max(abs(eng.q(j) - g) for j, g in zip(self.joints, self.goal))
+            errs = [abs(eng.q(j) - g) for j, g in zip(self.joints, self.goal)]
+            err = max(errs)
             if err <= self.tol:
                 return ok(err)
             if t - self.t0 > self.duration + self.settle:
-                return fail("blocked", f"joints stopped {err:.3f} from the goal", err)
+                worst = self.joints[errs.index(err)]
+                return fail("blocked", f"joints stopped {err:.3f} from the goal ({worst})", err)
         return None
 
     def stop(self, eng: Engine) -> None:
@@ -355,7 +357,13 @@ class GiveItem(Controller):
                     self.closer.start(eng)
             return None
         if g.holding == self.item:
-            return ok(g.opening(eng.data))
+            if self.closer.update(eng, t) is not None:
+                return ok(g.opening(eng.data))
+            return None
+        if self.close and self.item in eng._touching_items(g, either=True):
+            # the person lets go as soon as a finger presses the item against the other one
+            eng.weld(g, self.item)
+            return None
         self._put(eng)
         if t - self.t0 > 5.0:
             return fail("timeout", f"gripper {self.gripper} did not take {self.item}")

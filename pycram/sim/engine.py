@@ -198,8 +198,8 @@ class Engine:
         return out
 
     # --- grasping -------------------------------------------------------------------------
-    def _touching_items(self, g: Gripper) -> set[str]:
-        """Items touched by both fingers of `g`."""
+    def _touching_items(self, g: Gripper, either: bool = False) -> set[str]:
+        """Items touched by both fingers of `g` (by either finger with `either`)."""
         touched: tuple[set[str], set[str]] = (set(), set())
         bodyid = self.model.geom_bodyid
         for i in range(self.data.ncon):
@@ -213,7 +213,7 @@ class Engine:
                 for side in (0, 1):
                     if body in g.sides[side]:
                         touched[side].add(item)
-        return touched[0] & touched[1]
+        return (touched[0] | touched[1]) if either else (touched[0] & touched[1])
 
     def _update_grasps(self) -> None:
         for g in self.grippers.values():

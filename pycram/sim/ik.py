@@ -26,7 +26,7 @@ class IKSolution:
 
 def solve_ik(eng: Engine, arm: str, goal: Pose, use_orientation: bool = True,
              seeds: Sequence[Sequence[float]] = (), position_tolerance: float = 0.002,
-             orientation_tolerance: float = 0.02, iterations: int = 150, damping: float = 0.05,
+             orientation_tolerance: float = 0.02, iterations: int = 400, damping: float = 0.02,
              rng_seed: int = 0) -> IKSolution | None:
     """Arm joint positions that put the tool site of `arm` at `goal` (map frame), or None.
 

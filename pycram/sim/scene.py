@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Sequence
@@ -149,7 +150,9 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
                                    objtype=mujoco.mjtObj.mjOBJ_BODY, name1=g["palm_link"], name2=it.name)
             eq.active = False
             eq.solref = [0.01, 1.0]
-    model = spec.compile()
+    with warnings.catch_warnings():  # "empty prefix" when attaching the robot: we never save the spec
+        warnings.simplefilter("ignore", UserWarning)
+        model = spec.compile()
     mount = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base_mount")
     robot_bodies = _subtree_bodies(model, mount)
     base_bodies = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in desc.BASE["collision_links"]}

@@ -63,6 +63,8 @@ class VisibleItem:
     type: str
     pose: Pose
     pixels: int = 0
+    #: mean pixel (u: column, v: row) of the item in the head camera image [px]
+    centroid: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)

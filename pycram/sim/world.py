@@ -80,6 +80,7 @@ class World:
         self._closed = False
         self._stop = threading.Event()
         self._active: dict[str, tuple[Controller, CommandHandle]] = {}
+        self._finished: list[tuple[CommandHandle, Outcome]] = []
         self._recording: dict[str, Any] | None = None
         self._renderers: Renderers | None = None
         self.error: BaseException | None = None
@@ -128,9 +129,13 @@ class World:
                         self._end(channel, out, stop=not out.succeeded)
                 eng.step(self._steps_per_tick)
                 self.clock.advance_to(eng.time)
-                if eng.time >= next_sensor:
+                if eng.time >= next_sensor or self._finished:
                     next_sensor = eng.time + self._sensor_period
                     self._publish()
+                    # outcomes are delivered after the sensors show the state they ended in
+                    finished, self._finished = self._finished, []
+                    for handle, outcome in finished:
+                        handle._finish(outcome)
                 if self._recording is not None and eng.time >= self._recording["next"]:
                     self._record_frame()
                 if self.realtime:
@@ -149,6 +154,9 @@ class World:
             self._closed = True
         for channel in list(self._active):
             self._end(channel, Outcome(False, reason, "world closed"), stop=False)
+        finished, self._finished = self._finished, []
+        for handle, outcome in finished:
+            handle._finish(outcome)
         while True:
             try:
                 kind, a, b = self._inbox.get_nowait()
@@ -183,9 +191,9 @@ class World:
             if out is not None:
                 if not out.succeeded:
                     ctrl.stop(eng)
-                handle._finish(out)
+                self._finished.append((handle, out))
             elif ctrl.channel is None:
-                handle._finish(Outcome(True, "succeeded"))
+                self._finished.append((handle, Outcome(True, "succeeded")))
             else:
                 self._active[ctrl.channel] = (ctrl, handle)
 
@@ -193,7 +201,7 @@ class World:
         ctrl, handle = self._active.pop(channel)
         if stop or not outcome.succeeded:
             ctrl.stop(self._engine)
-        handle._finish(outcome)
+        self._finished.append((handle, outcome))
 
     def _tool_poses(self) -> dict[str, Pose]:
         eng = self._engine
@@ -346,15 +354,22 @@ class World:
 
         def fn(eng: Engine) -> list[VisibleItem]:
             ids = self._get_renderers().segmentation(eng.data, HEAD_CAMERA, width, height)
-            counts = np.bincount(ids[ids >= 0].ravel(), minlength=eng.model.ngeom)
             seen = []
             for name, geom in eng.item_geoms.items():
-                n = int(counts[geom]) if geom < len(counts) else 0
-                if n >= min_pixels:
-                    seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), n))
+                rows, cols = np.nonzero(ids == geom)
+                if len(rows) >= min_pixels:
+                    seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), len(rows),
+                                            (float(cols.mean()), float(rows.mean()))))
             return sorted(seen, key=lambda v: -v.pixels)
 
         return self._call("perceive", fn)
+
+    def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
+                             height: int = 240) -> CommandHandle:
+        """Render geom ids per pixel (height x width, -1: background) from `camera`."""
+        self.scene.camera(camera)
+        return self._call(f"segmentation:{camera}",
+                          lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height))
 
     def start_recording(self, camera: str = "overview", fps: float = 10.0, width: int = 320,
                         height: int = 240) -> CommandHandle:

@@ -90,12 +90,12 @@ GRIPPERS = {"right": _gripper("r"), "left": _gripper("l")}
 ARM_CONFIGURATIONS = {
     "right": {
         "park": (-1.712, -0.256, -1.463, -2.12, 1.766, -0.07, 0.051),
-        "carry": (-0.40, 0.30, -0.60, -1.90, 0.0, -0.40, 0.0),
+        "carry": (-0.571, -0.524, -2.081, -2.019, 3.252, -1.27, -0.893),  # gripper 0.6 m ahead, 1 m high
         "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     },
     "left": {
         "park": (1.712, -0.256, 1.463, -2.12, -1.766, -0.07, -0.051),
-        "carry": (0.40, 0.30, 0.60, -1.90, 0.0, -0.40, 0.0),
+        "carry": (0.571, -0.524, 2.081, -2.019, -3.252, -1.27, 0.893),
         "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     },
 }
@@ -107,9 +107,10 @@ INITIAL_CONFIGURATION = {
     "torso_lift_joint": 0.2,
 }
 
-#: Base poses (x [m], y [m], yaw [rad]) in the simulated kitchen's map frame from which the default
-#: arm reaches the cooker areas (the thesis' own numbers, ch. 4).
+#: Base poses (x [m], y [m], yaw [rad]) in the simulated kitchen's map frame from which the right
+#: arm reaches the cooker centres comfortably (shoulder in line with the cooker, ~0.65 m away).
+#: The thesis (ch. 4) used (0.1, -0.6, -pi/2) and (-0.1, 1.9, pi) in its lab kitchen.
 KITCHEN_BASE_POSES = {
-    "cooker #2": (0.1, -0.6, -1.5708),
-    "cooker #1": (-0.1, 1.9, 3.1416),
+    "cooker #2": (0.29, -0.55, -1.5708),
+    "cooker #1": (-0.12, 1.71, 3.1416),
 }

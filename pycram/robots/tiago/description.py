@@ -67,7 +67,7 @@ GRIPPERS = {
 ARM_CONFIGURATIONS = {
     "right": {
         "park": (0.20, -1.34, -0.20, 1.94, -1.57, 1.37, 0.0),
-        "carry": (0.80, -0.60, -1.30, 1.90, 1.57, -0.60, 0.0),
+        "carry": (0.321, -0.092, -1.773, 2.215, -1.374, -0.978, -0.263),  # gripper 0.6 m ahead, 1 m high
         "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     },
 }
@@ -79,6 +79,6 @@ INITIAL_CONFIGURATION = {
 
 #: Base poses (x, y, yaw) in the simulated kitchen's map frame from which the arm reaches the cookers.
 KITCHEN_BASE_POSES = {
-    "cooker #2": (0.25, -0.55, -1.5708),
-    "cooker #1": (-0.1, 2.05, 3.1416),
+    "cooker #2": (0.25, -0.45, -1.5708),
+    "cooker #1": (-0.02, 1.75, 3.1416),
 }
