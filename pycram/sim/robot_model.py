@@ -113,19 +113,17 @@ def _position_actuator(spec: mujoco.MjSpec, joint: str, kp: float, kv: float, fo
 
 
 def add_robot(spec: mujoco.MjSpec, desc: ModuleType) -> None:
-    """Mount the robot of `desc` on an omnidirectional base in `spec` and add its actuators.
+    """Give the robot of `desc` (already in `spec`, see `build_robot_spec`) an omnidirectional base
+    (slide x, slide y, hinge yaw on its root link) and add its actuators.
 
     Actuators are position servos named after their joints: `base_x`, `base_y`, `base_yaw`, the
     torso, head, arm joints and each gripper's driven finger joint. Their force limits make a
     blocked base or a closing gripper stall instead of pushing through.
     """
-    robot_spec = build_robot_spec(desc)
-    mount = spec.worldbody.add_body(name="base_mount", mass=20.0, inertia=[2.0, 2.0, 2.0])
+    mount = spec.body(desc.ROOT_LINK)
     mount.add_joint(name="base_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0], damping=[50.0, 0, 0])
     mount.add_joint(name="base_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0], damping=[50.0, 0, 0])
     mount.add_joint(name="base_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], damping=[20.0, 0, 0])
-    frame = mount.add_frame()
-    frame.attach_body(robot_spec.body(desc.ROOT_LINK), "", "")
     # base servos: stiff but force-limited, so a counter or obstacle stops the robot
     _position_actuator(spec, "base_x", kp=4e4, kv=8e3, force=2500.0)
     _position_actuator(spec, "base_y", kp=4e4, kv=8e3, force=2500.0)

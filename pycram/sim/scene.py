@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import logging
 import time
-import warnings
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Sequence
@@ -18,7 +17,7 @@ import numpy as np
 from . import kitchen
 from .errors import UnknownNameError
 from .items import DEFAULT_ITEMS, ItemSpec, add_item
-from .robot_model import BASE_JOINTS, HEAD_CAMERA, add_robot, load_description, pad_site, tool_site
+from .robot_model import BASE_JOINTS, HEAD_CAMERA, add_robot, build_robot_spec, load_description, pad_site, tool_site
 
 _log = logging.getLogger(__name__)
 
@@ -130,7 +129,7 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     names = [it.name for it in items]
     if len(set(names)) != len(names):
         raise ValueError(f"item names must be unique: {names}")
-    spec = mujoco.MjSpec()
+    spec = build_robot_spec(desc)  # the robot's spec becomes the scene's (no attach, no renaming)
     spec.modelname = f"kitchen_{robot}"
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -150,10 +149,8 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
                                    objtype=mujoco.mjtObj.mjOBJ_BODY, name1=g["palm_link"], name2=it.name)
             eq.active = False
             eq.solref = [0.01, 1.0]
-    with warnings.catch_warnings():  # "empty prefix" when attaching the robot: we never save the spec
-        warnings.simplefilter("ignore", UserWarning)
-        model = spec.compile()
-    mount = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base_mount")
+    model = spec.compile()
+    mount = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, desc.ROOT_LINK)
     robot_bodies = _subtree_bodies(model, mount)
     base_bodies = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in desc.BASE["collision_links"]}
     geoms_of = lambda bodies: frozenset(  # noqa: E731

@@ -190,7 +190,7 @@ def test_images_are_not_blank_and_show_the_robot(world, tmp_path):
     assert img.shape == (480, 640, 3) and img.std() > 10
     seg = ok(world.request_segmentation("overview", 320, 240))
     model = world.scene.model
-    mount = model.body("base_mount").id
+    mount = model.body(world.description.ROOT_LINK).id
     robot_bodies = {b for b in range(model.nbody) if model.body_rootid[b] == mount or b == mount}
     robot_pixels = sum(int(np.count_nonzero(seg == g)) for g in range(model.ngeom)
                        if model.geom_bodyid[g] in robot_bodies)
