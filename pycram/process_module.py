@@ -274,7 +274,7 @@ class ProcessModule:
         execution = self._submit(designator)
         # on_end runs when the child task ends -- also if it was evaporated before its body ran:
         # then the execution must not stay in the queue and block the module.
-        group = TaskGroup(on_end=lambda task: self._abandon(execution))
+        group = TaskGroup(on_end=lambda task: self._abandon(execution), detached=True)
         execution._group = group
 
         def body() -> None:

@@ -287,13 +287,19 @@ def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
         tasks.append(current_task())
         perform(motion('A'))
 
+    def releaser():  # the stopper's branch waits for its non-waited execution before ending
+        if module.wait_started(2, TIMEOUT):
+            module.release()
+
+    helper = threading.Thread(target=releaser, daemon=True)
+    helper.start()
     state = pursue(mover, stopper)
+    helper.join(TIMEOUT)
     assert state.get_value() is State.SUCCEEDED
     assert [d.prop_value('n') for d in module.cancelled] == ['A']
     assert tasks[0].status.get_value().name == 'EVAPORATED'
-    # the module was freed and the next queued designator started
-    assert module.wait_started(2, TIMEOUT)
-    module.release()
+    # the module was freed, the next queued designator started and ran before pursue returned
+    assert queued[0].done
     assert queued[0].wait(TIMEOUT) is None
     assert [e for e, _ in module.log] == ['start', 'cancel', 'start', 'end']
     assert module.status.get_value() is S.SUCCEEDED

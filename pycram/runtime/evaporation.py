@@ -54,11 +54,12 @@ class Evaporated(BaseException):
 class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
-    __slots__ = ("task", "ident", "_mode", "_waiting_on", "_injected", "_protected", "_lock", "_sleep")
+    __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_protected", "_lock", "_sleep")
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
         self.ident = ident  # the thread's identifier once the runner is installed in it
+        self.detached: list = []  # task groups started without waiting (see TaskGroup)
         self._mode = _USER
         self._waiting_on: threading.Condition | None = None
         self._injected = False

@@ -312,15 +312,23 @@ class TaskGroup:
 
     `on_end(task)` is called in the child's thread when a child ends, under the group's
     condition (keep it short, never block); use it to decide the outcome of an expression.
+
+    A `detached` group is one its creator will not necessarily wait for (a process-module
+    execution started with `('wait', False)`). It still does not outlive the branch that
+    started it: before that branch's thread ends, it waits for the group — after evaporating it
+    if the branch failed or was evaporated.
     """
 
-    def __init__(self, on_end: Callable[[Task], None] | None = None) -> None:
+    def __init__(self, on_end: Callable[[Task], None] | None = None, detached: bool = False) -> None:
         prepare_interrupts()
         self.parent = current_task()
         self.tasks: list[Task] = []
         self._cv = threading.Condition(threading.Lock())
         self._running = 0
         self._on_end = on_end
+        if detached:  # nobody may wait for it: the branch thread that started it will
+            runner = current_runner()
+            runner.detached = [g for g in runner.detached if g._running] + [self]
 
     def spawn(self, name: str, fn: Callable[[], Any], kind: str = "branch") -> Task:
         """Start `fn` as a child task on a worker thread of its own; returns the task."""
@@ -357,10 +365,14 @@ class TaskGroup:
                 status = TaskStatus.EVAPORATED if task._evaporating else status
         task.result = result
         task._end(status, error)
+        if self._on_end is not None:
+            with self._cv:  # report the outcome at once: the expression may decide on it
+                self._on_end(task)
+                self._cv.notify_all()
+        if runner.detached:
+            _settle_detached(runner, stop=status is not TaskStatus.SUCCEEDED)
         with self._cv:
             self._running -= 1
-            if self._on_end is not None:
-                self._on_end(task)
             self._cv.notify_all()
 
     def evaporate(self, except_task: Task | None = None) -> None:
@@ -381,6 +393,18 @@ class TaskGroup:
 
     def _all_ended(self) -> bool:
         return self._running == 0
+
+
+def _settle_detached(runner: Runner, stop: bool) -> None:
+    """Before a branch thread ends: wait for the groups it started without waiting (e.g. a
+    process-module execution with `('wait', False)`), evaporating them first if `stop`."""
+    with shielded():
+        for group in runner.detached:
+            if stop:
+                group.evaporate()
+            wait_until(group._cv, group._all_ended)
+        runner.detached = []
+        runner.seal()  # waiting left the runtime mode: seal the thread again before it ends
 
 
 _STATUS_MARK = {
