@@ -1,0 +1,555 @@
+"""The run recorder: stores a run's task tree, performed designators, process-module
+executions and sampled fluents in a database, without ever making a plan wait for it.
+
+    recorder = Recorder(plan="fetch and place").start()   # or start_recording(...)
+    recorder.watch(robot_pose, "robot pose", max_rate_hz=5)
+    ...run the plan...
+    run_id = recorder.finish("succeeded")
+
+Guarantees
+----------
+- Every callback that runs in a plan thread (`task_started`, `task_ended`, the event
+  subscribers, the fluent samplers) is O(1) and never blocks on the database: it appends a
+  tuple to an unbounded queue. A background writer thread turns the queue into rows and commits
+  a batch every `flush_interval` seconds (0.25 s by default) — so a process killed with SIGKILL
+  loses at most the last batch window (SQLite: WAL mode).
+- `start()` connects synchronously and raises `TraceDatabaseError` for unusable databases, so
+  a bad URL is reported before the plan runs.
+- `finish()` stops listening, writes everything queued, records the outcome and returns the
+  run id. It is idempotent and also runs at interpreter exit for recorders never finished.
+- Fluents are observed through a child fluent that the watched fluent pulses (no polling);
+  samples are rate limited per fluent to `max_rate_hz`; the last value of a burst is written
+  once its window passed (so the final value is never lost).
+- Database errors in the writer are logged, never raised into the plan.
+"""
+
+from __future__ import annotations
+
+import atexit
+import datetime as _dt
+import json
+import logging
+import os
+import queue
+import socket
+import sys
+import threading
+import time
+import uuid
+import weakref
+from enum import Enum
+from typing import Any, Iterable
+
+from pycram import events
+from pycram.fluent import Fluent
+from pycram.runtime import Task, add_task_listener, current_clock, current_task, remove_task_listener
+
+log = logging.getLogger(__name__)
+
+__all__ = ["Recorder", "start_recording", "recording_enabled"]
+
+_TEXT_LIMIT = 4000
+_current_thread = threading.current_thread
+
+
+def recording_enabled(default: bool) -> bool:
+    """Whether to record: `$PYCRAM_RECORD` ("1"/"0", "true"/"false", "on"/"off") if set, else
+    `default` (True for `pycram run` / `pycram demo`, False for library use)."""
+    value = os.environ.get("PYCRAM_RECORD")
+    if value is None or value.strip() == "":
+        return default
+    return value.strip().lower() not in ("0", "false", "no", "off")
+
+
+def _now_utc() -> _dt.datetime:
+    return _dt.datetime.now(_dt.timezone.utc)
+
+
+def _short(text: str, limit: int = _TEXT_LIMIT) -> str:
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _text(value: Any) -> str | None:
+    if value is None:
+        return None
+    if isinstance(value, Enum):
+        value = value.value
+    if isinstance(value, str):
+        return _short(value)
+    try:
+        return _short(repr(value))
+    except Exception as e:  # a broken __repr__ must not stop the writer
+        return f"<unrepresentable {type(value).__name__}: {type(e).__name__}>"
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, Enum):
+        value = value.value
+    if isinstance(value, bool):
+        return float(value)
+    if isinstance(value, (int, float)):
+        return float(value)
+    return None
+
+
+def _error_fields(error: BaseException | None) -> tuple[str | None, str | None]:
+    if error is None:
+        return None, None
+    try:
+        message = str(error)
+    except Exception:
+        message = ""
+    return type(error).__name__, _short(message)
+
+
+def _designator_type(designator: Any) -> str | None:
+    try:
+        value = designator.prop_value("type")
+    except Exception:
+        return None
+    return None if value is None else _short(str(value), 255)
+
+
+class _Sampler(Fluent):
+    """A child fluent of a watched fluent: its pulse hands the parent's value to the recorder."""
+
+    __slots__ = ("_watch",)
+
+    def pulse(self) -> None:  # called by the parent's pulse, in the thread that set the value
+        watch = self._watch
+        if watch is not None:
+            watch.sample()
+
+    def get_value(self) -> Any:
+        return None
+
+
+class _Watch:
+    """Rate-limited sampling of one fluent (see the module guarantees)."""
+
+    def __init__(self, recorder: Recorder, fluent: Fluent, name: str, max_rate_hz: float | None) -> None:
+        self.recorder = recorder
+        self.fluent = fluent
+        self.name = name
+        self.min_interval = 0.0 if not max_rate_hz or max_rate_hz <= 0 else 1.0 / max_rate_hz
+        self.last_emit = -1e18  # time.monotonic() of the last enqueued sample
+        self.pending: tuple[Any, float] | None = None  # (value, clock time) held back by the limit
+        self.lock = threading.Lock()
+        self.sampler = _Sampler(name=f"recorder sampler of {name}")
+        self.sampler._watch = self
+        self.active = True
+
+    def sample(self) -> None:
+        if not self.active:
+            return
+        value = self.fluent.get_value()
+        t = current_clock().now()
+        now = time.monotonic()
+        with self.lock:
+            if now - self.last_emit >= self.min_interval:
+                self.last_emit = now
+                self.pending = None
+                self.recorder._put(("f", self.name, value, t))
+            else:
+                self.pending = (value, t)
+                self.recorder._pending_watches = True
+
+    def due(self, now: float, force: bool = False) -> tuple[Any, float] | None:
+        """The held-back sample if its window passed (or `force`); clears it."""
+        with self.lock:
+            if self.pending is None or (not force and now - self.last_emit < self.min_interval):
+                return None
+            pending, self.pending = self.pending, None
+            self.last_emit = now
+            return pending
+
+
+class Recorder:
+    """Records one run into the trace database (see the module docstring).
+
+    `url`: any SQLAlchemy URL (None: `$PYCRAM_DB_URL` or the default SQLite file).
+    `plan`, `robot`: run metadata (also settable later with `set_run_info`).
+    `scope`: record only tasks below this task (default: every task of the process).
+    `flush_interval`: seconds between batched commits.
+    """
+
+    def __init__(self, url: str | None = None, *, plan: str | None = None, robot: str | None = None,
+                 scope: Task | None = None, flush_interval: float = 0.25, command: str | None = None,
+                 info: dict[str, Any] | None = None) -> None:
+        from pycram.trace.db import resolve_url
+
+        self.url = resolve_url(url)
+        self.plan = plan
+        self.robot = robot
+        self.scope = scope
+        self.flush_interval = float(flush_interval)
+        self.command = command if command is not None else " ".join(sys.argv)
+        self.info: dict[str, Any] = dict(info or {})
+        self.run_id: int | None = None
+        self.run_uuid = str(uuid.uuid4())
+        self.outcome: str | None = None
+        self._queue: queue.SimpleQueue[tuple] = queue.SimpleQueue()
+        self._put = self._queue.put
+        self._wake = threading.Event()
+        self._watches: dict[str, _Watch] = {}
+        self._pending_watches = False
+        self._writer: threading.Thread | None = None
+        self._engine: Any = None
+        self._unsubscribe: list[Any] = []
+        self._started_wall = 0.0
+        self._finished = False
+        self._lock = threading.Lock()
+        self.write_errors = 0
+
+    # -- life cycle -------------------------------------------------------------------------------
+
+    def start(self) -> Recorder:
+        """Connect, create the schema if needed, insert the run row, start listening.
+
+        Raises `TraceDatabaseError` if the database cannot be used. Returns self.
+        """
+        from pycram.trace.db import connect, runs_table
+
+        if self._engine is not None:
+            return self
+        engine = connect(self.url)
+        self._started_wall = time.monotonic()
+        self.clock_origin = current_clock().now()
+        now = _now_utc()
+        with engine.begin() as conn:
+            result = conn.execute(runs_table.insert().values(
+                uuid=self.run_uuid, plan=_short(self.plan or "", 255) or None, robot=self.robot,
+                host=_short(socket.gethostname(), 255), pid=os.getpid(), command=_short(self.command),
+                started_at=now, last_seen_at=now, clock_origin=self.clock_origin,
+                info=json.dumps(self.info, default=str) if self.info else None))
+            self.run_id = int(result.inserted_primary_key[0])
+        self._engine = engine
+        self._writer = threading.Thread(target=self._writer_main, name=f"pycram-recorder-{self.run_id}", daemon=True)
+        self._writer.start()
+        add_task_listener(self)
+        self._unsubscribe = [
+            events.subscribe(events.DESIGNATOR_PERFORMED, self._on_designator),
+            events.subscribe(events.PROCESS_MODULE_EXECUTED, self._on_execution),
+        ]
+        _live_recorders.add(self)
+        log.info("recording run %s into %s", self.run_id, _display(self.url))
+        return self
+
+    def set_run_info(self, plan: str | None = None, robot: str | None = None, **info: Any) -> None:
+        """Update the run's metadata (written with the next batch); None leaves a field as is."""
+        if plan is not None:
+            self.plan = plan
+        if robot is not None:
+            self.robot = robot
+        self.info.update(info)
+        self._put(("r", self.plan, self.robot, dict(self.info)))
+
+    def watch(self, fluent: Fluent, name: str | None = None, max_rate_hz: float | None = 10.0) -> None:
+        """Sample `fluent` whenever it is set, at most `max_rate_hz` times per second
+        (None or 0: every change). The current value is recorded at once.
+
+        Raises ValueError if a different fluent is already watched under `name`.
+        """
+        name = name or fluent.name
+        existing = self._watches.get(name)
+        if existing is not None:
+            if existing.fluent is fluent:
+                return
+            raise ValueError(f"a fluent is already watched as {name!r}; choose another name")
+        watch = _Watch(self, fluent, name, max_rate_hz)
+        self._watches[name] = watch
+        fluent.add_child(watch.sampler)  # held weakly by the fluent, strongly by the watch
+        watch.sample()
+
+    def unwatch(self, name: str) -> None:
+        """Stop sampling the fluent watched as `name` (its held-back sample is written)."""
+        watch = self._watches.pop(name, None)
+        if watch is not None:
+            self._flush_watch(watch, force=True)
+            watch.active = False
+
+    def flush(self, timeout: float | None = 10.0) -> bool:
+        """Block until everything recorded so far is committed; False on timeout."""
+        if self._writer is None or not self._writer.is_alive():
+            return False
+        for watch in list(self._watches.values()):
+            self._flush_watch(watch, force=True)
+        done = threading.Event()
+        self._put(("flush", done))
+        self._wake.set()
+        return done.wait(timeout)
+
+    def finish(self, outcome: str | None = None, error: BaseException | str | None = None) -> int | None:
+        """Stop recording, write everything, record `outcome` ("succeeded", "failed", ...; None:
+        "finished") and the wall-clock duration; return the run id. Idempotent."""
+        with self._lock:
+            if self._finished or self._engine is None:
+                return self.run_id
+            self._finished = True
+        remove_task_listener(self)
+        for unsubscribe in self._unsubscribe:
+            unsubscribe()
+        for watch in list(self._watches.values()):
+            self._flush_watch(watch, force=True)
+            watch.active = False
+        self.outcome = outcome or "finished"
+        duration = time.monotonic() - self._started_wall
+        if isinstance(error, BaseException):
+            error = f"{type(error).__name__}: {error}"
+        self._put(("end", self.outcome, duration, _short(error) if error else None))
+        self._put(("stop",))
+        self._wake.set()
+        if self._writer is not None:
+            self._writer.join(60.0)
+            if self._writer.is_alive():
+                log.warning("trace writer of run %s did not finish within 60 s", self.run_id)
+        _live_recorders.discard(self)
+        self._engine.dispose()
+        log.info("run %s recorded (%s, %.2f s)", self.run_id, self.outcome, duration)
+        return self.run_id
+
+    def __enter__(self) -> Recorder:
+        return self.start()
+
+    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: Any) -> bool:
+        self.finish("succeeded" if exc is None else "failed", exc)
+        return False
+
+    # -- callbacks in plan threads (O(1), never block) ------------------------------------------
+
+    def task_started(self, task: Task) -> None:
+        self._put(("s", task, _current_thread().name))
+
+    def task_ended(self, task: Task) -> None:
+        self._put(("e", task))
+
+    def _on_designator(self, designator: Any, solution: Any = None, error: BaseException | None = None) -> None:
+        self._put(("d", current_task(), current_clock().now(), designator, solution, error))
+
+    def _on_execution(self, module: Any, designator: Any, outcome: Any, start: float | None,
+                      end: float | None, error: BaseException | None = None) -> None:
+        self._put(("x", current_task(), module, designator, outcome, start, end, error))
+
+    # -- writer thread ----------------------------------------------------------------------------
+
+    def _flush_watch(self, watch: _Watch, force: bool) -> None:
+        pending = watch.due(time.monotonic(), force)
+        if pending is not None:
+            self._put(("f", watch.name, pending[0], pending[1]))
+
+    def _writer_main(self) -> None:
+        state = _WriterState(self)
+        stop = False
+        while not stop:
+            timeout = self.flush_interval if self._pending_watches else None
+            try:
+                first = self._queue.get(timeout=timeout)
+                items = [first]
+            except queue.Empty:
+                items = []
+            if items and items[0][0] not in ("flush", "stop"):
+                self._wake.wait(self.flush_interval)  # collect a batch (cut short by flush/finish)
+            self._wake.clear()
+            if self._pending_watches:
+                self._pending_watches = False
+                for watch in list(self._watches.values()):
+                    self._flush_watch(watch, force=False)
+                    if watch.pending is not None:
+                        self._pending_watches = True
+            while True:
+                try:
+                    items.append(self._queue.get_nowait())
+                except queue.Empty:
+                    break
+            flushes = [item[1] for item in items if item[0] == "flush"]
+            stop = any(item[0] == "stop" for item in items)
+            try:
+                state.write(items)
+            except Exception:
+                self.write_errors += 1
+                log.exception("trace writer: could not write %d events of run %s", len(items), self.run_id)
+            for done in flushes:
+                done.set()
+
+
+class _WriterState:
+    """Turns queued events into rows (runs only in the writer thread)."""
+
+    def __init__(self, recorder: Recorder) -> None:
+        self.recorder = recorder
+        self.run_id = recorder.run_id
+        self.written: set[int] = set()  # task ids inserted
+        self.threads: dict[int, str] = {}  # task id -> name of the thread that started it
+        self.in_scope: dict[int, bool] = {}
+        self.last_heartbeat = time.monotonic()
+
+    def _task_row(self, task: Task) -> dict[str, Any]:
+        parent = task.parent
+        status = task.status.get_value()
+        error_type, error_message = _error_fields(task.exception) if status.value != "succeeded" else (None, None)
+        thread = self.threads.get(task.id)
+        return {
+            "run_id": self.run_id,
+            "task_id": task.id,
+            "parent_id": parent.id if parent is not None else None,
+            "name": _short(str(task.name), 512),
+            "kind": _short(str(task.kind), 64),
+            "path": _short(task.path),
+            "thread": _short(thread, 255) if thread else None,
+            "status": status.value,
+            "start": task.start_time,
+            "end": task.end_time,
+            "duration": task.duration,
+            "error_type": error_type,
+            "error_message": error_message,
+        }
+
+    def _wanted(self, task: Task) -> bool:
+        scope = self.recorder.scope
+        if scope is None:
+            return True
+        chain: list[int] = []
+        node: Task | None = task
+        answer = False
+        while node is not None:
+            known = self.in_scope.get(node.id)
+            if known is not None:
+                answer = known
+                break
+            chain.append(node.id)
+            if node is scope:
+                answer = True
+                break
+            node = node.parent
+        for task_id in chain:
+            self.in_scope[task_id] = answer
+        return answer
+
+    def write(self, items: Iterable[tuple]) -> None:
+        import sqlalchemy as sa
+
+        from pycram.trace.db import (designators_table, executions_table, fluent_samples_table,
+                                     runs_table, tasks_table)
+
+        inserts: dict[int, dict[str, Any]] = {}
+        updates: dict[int, dict[str, Any]] = {}
+        designators: list[dict[str, Any]] = []
+        executions: list[dict[str, Any]] = []
+        samples: list[dict[str, Any]] = []
+        run_update: dict[str, Any] = {}
+        run_id = self.run_id
+
+        def ensure(task: Task) -> None:  # insert the task (and unrecorded ancestors, e.g. thread roots)
+            chain = []
+            node: Task | None = task
+            while node is not None and node.id not in self.written and node.id not in inserts:
+                chain.append(node)
+                if self.recorder.scope is not None and node is self.recorder.scope:
+                    break
+                node = node.parent
+            for node in reversed(chain):
+                inserts[node.id] = self._task_row(node)
+
+        for item in items:
+            tag = item[0]
+            if tag == "s" or tag == "e":
+                task = item[1]
+                if not self._wanted(task):
+                    continue
+                if tag == "s":
+                    self.threads[task.id] = item[2]
+                if task.id in self.written:
+                    if tag == "e":
+                        row = self._task_row(task)
+                        updates[task.id] = {k: row[k] for k in ("status", "start", "end", "duration",
+                                                                 "error_type", "error_message")}
+                else:
+                    ensure(task)
+                    if tag == "e":
+                        inserts[task.id] = self._task_row(task)
+                if tag == "e":
+                    self.threads.pop(task.id, None)
+            elif tag == "f":
+                _, name, value, t = item
+                samples.append({"run_id": run_id, "name": name, "time": t, "value": _text(value),
+                                "number": _number(value)})
+            elif tag == "d":
+                _, task, t, designator, solution, error = item
+                error_type, error_message = _error_fields(error)
+                designators.append({
+                    "run_id": run_id, "task_id": task.id if task is not None else None, "time": t,
+                    "designator_class": type(designator).__name__, "designator_type": _designator_type(designator),
+                    "designator": _text(designator), "solution": _text(_solution_text(solution)),
+                    "error_type": error_type, "error_message": error_message})
+            elif tag == "x":
+                _, task, module, designator, outcome, start, end, error = item
+                error_type, error_message = _error_fields(error)
+                executions.append({
+                    "run_id": run_id, "task_id": task.id if task is not None else None,
+                    "module": _short(str(getattr(module, "name", module)), 255),
+                    "designator_type": _designator_type(designator), "designator": _text(designator),
+                    "outcome": _text(outcome), "start": start, "end": end,
+                    "duration": (end - start) if start is not None and end is not None else None,
+                    "error_type": error_type, "error_message": error_message})
+            elif tag == "r":
+                _, plan, robot, info = item
+                run_update.update(plan=_short(plan, 255) if plan else None, robot=robot,
+                                  info=json.dumps(info, default=str) if info else None)
+            elif tag == "end":
+                _, outcome, duration, error = item
+                run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc())
+
+        now = time.monotonic()
+        if not (inserts or updates or designators or executions or samples or run_update):
+            return
+        if now - self.last_heartbeat > 1.0 or run_update:
+            run_update.setdefault("last_seen_at", _now_utc())
+            self.last_heartbeat = now
+        with self.recorder._engine.begin() as conn:
+            if inserts:
+                conn.execute(tasks_table.insert(), list(inserts.values()))
+            if updates:
+                stmt = (tasks_table.update()
+                        .where(tasks_table.c.run_id == sa.bindparam("b_run"))
+                        .where(tasks_table.c.task_id == sa.bindparam("b_task")))
+                conn.execute(stmt, [{"b_run": run_id, "b_task": task_id, **values}
+                                    for task_id, values in updates.items()])
+            if designators:
+                conn.execute(designators_table.insert(), designators)
+            if executions:
+                conn.execute(executions_table.insert(), executions)
+            if samples:
+                conn.execute(fluent_samples_table.insert(), samples)
+            if run_update:
+                conn.execute(runs_table.update().where(runs_table.c.id == run_id).values(**run_update))
+        self.written.update(inserts)
+
+
+def _solution_text(solution: Any) -> Any:
+    if callable(solution) and hasattr(solution, "__qualname__"):
+        return f"{getattr(solution, '__module__', '')}.{solution.__qualname__}"
+    return solution
+
+
+def _display(url: str) -> str:
+    from pycram.trace.db import display_url
+
+    return display_url(url)
+
+
+_live_recorders: weakref.WeakSet[Recorder] = weakref.WeakSet()
+
+
+@atexit.register
+def _finish_live_recorders() -> None:
+    for recorder in list(_live_recorders):
+        try:
+            recorder.finish("interrupted")
+        except Exception:
+            log.exception("could not finish recording run %s at exit", recorder.run_id)
+
+
+def start_recording(url: str | None = None, plan: str | None = None, robot: str | None = None,
+                    **kwargs: Any) -> Recorder:
+    """Create and start a `Recorder` (see its docstring); raises `TraceDatabaseError`."""
+    return Recorder(url, plan=plan, robot=robot, **kwargs).start()
