@@ -1,2 +1,296 @@
-def main() -> None:  # replaced by the real CLI
-    raise SystemExit("pycram CLI not built yet")
+"""The `pycram` command line (typer + rich).
+
+    pycram run FILE.py [ARGS...]        run a plan script (block syntax on), recorded by default
+    pycram demo [--robot pr2|tiago]...  the thesis demo in the simulated kitchen, recorded by default
+    pycram runs                         recorded runs, newest first, one line each
+    pycram show [RUN]                   a run's task tree with statuses, durations, failures
+    pycram graph [RUN] -o tree.svg      the task tree as an SVG picture
+    pycram timeline [RUN] -o tl.png     which branches ran when (Gantt chart)
+
+The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
+`pycram.trace.db`). Recording for `run`/`demo` is on unless `--no-record` or `PYCRAM_RECORD=0`.
+Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the commands that
+need them.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import logging
+import sys
+from pathlib import Path
+from typing import Any, Optional
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.tree import Tree
+
+app = typer.Typer(
+    name="pycram",
+    help="PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+console = Console(highlight=False)
+err = Console(stderr=True, highlight=False)
+
+_STYLE = {
+    "succeeded": "green",
+    "failed": "bold red",
+    "evaporated": "grey62",
+    "running": "blue",
+    "unfinished": "yellow",
+    "interrupted": "yellow",
+    "created": "grey50",
+}
+_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·"}
+
+DbOption = typer.Option(None, "--db", help="SQLAlchemy URL of the trace database (default: $PYCRAM_DB_URL or "
+                                           "~/.local/share/pycram/runs.sqlite3).", metavar="URL")
+RunArgument = typer.Argument(None, help="Run id (default: the newest run).", show_default=False)
+
+
+def _fail(message: str, code: int = 1) -> None:
+    err.print(f"[bold red]error:[/bold red] {escape(message)}", soft_wrap=True)
+    raise typer.Exit(code)
+
+
+def _trace_errors(fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """Call fn, turning database and lookup errors into a clear message and exit code 1."""
+    try:
+        from pycram.trace.db import TraceDatabaseError
+    except ImportError as e:  # the db extra is missing
+        _fail(f"run traces need the 'db' extra (pip install 'pycram[db]'): {e}")
+    from pycram.trace.query import RunNotFound
+
+    try:
+        return fn(*args, **kwargs)
+    except (TraceDatabaseError, RunNotFound) as e:
+        _fail(str(e))
+
+
+def _duration(seconds: float | None) -> str:
+    if seconds is None:
+        return "–"
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.0f} µs"
+    if seconds < 1:
+        return f"{seconds * 1000:.1f} ms"
+    if seconds < 120:
+        return f"{seconds:.2f} s"
+    return f"{seconds / 60:.1f} min"
+
+
+def _local(when: _dt.datetime | None) -> str:
+    return when.astimezone().strftime("%Y-%m-%d %H:%M:%S") if when is not None else "–"
+
+
+def _record_flag(record: Optional[bool]) -> bool:
+    if record is not None:
+        return record
+    from pycram.trace.recorder import recording_enabled
+
+    return recording_enabled(True)
+
+
+# -- inspecting runs ------------------------------------------------------------------------------
+
+@app.command("runs")
+def runs_command(
+    limit: int = typer.Option(20, "--limit", "-n", help="Show at most this many runs (0: all)."),
+    plan: Optional[str] = typer.Option(None, "--plan", help="Only runs whose plan name contains this."),
+    db: Optional[str] = DbOption,
+) -> None:
+    """List recorded runs, newest first: id, start, plan, robot, outcome, duration."""
+    from pycram.trace import query
+
+    found = _trace_errors(query.runs, db, limit or None, plan)
+    if not found:
+        err.print("no runs recorded yet (run `pycram run FILE.py` or `pycram demo`)")
+        return
+    for run in found:
+        state = run.state
+        style = _STYLE.get(state, "white")
+        console.print(f"{run.id}  {_local(run.started_at)}  {escape(run.plan or '–')}  "
+                      f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {_duration(run.elapsed)}", soft_wrap=True)
+
+
+def _label(record: Any) -> str:
+    if record.kind == "root":
+        return f"[bold]{escape(record.name)}[/bold] [grey50](thread)[/grey50]"
+    style = _STYLE.get(record.status, "white")
+    text = (f"[{style}]{_MARK.get(record.status, '?')}[/{style}] {escape(record.name)} "
+            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] "
+            f"{_duration(record.duration)}")
+    if record.error_type and record.status != "succeeded":
+        text += f" [red]— {escape(record.error or '')}[/red]"
+    return text
+
+
+@app.command("show")
+def show_command(
+    run: Optional[int] = RunArgument,
+    max_nodes: int = typer.Option(2000, "--max-nodes", help="Stop printing after this many tasks."),
+    db: Optional[str] = DbOption,
+) -> None:
+    """Print a run's task tree with statuses, durations and failures."""
+    from pycram.trace import query
+
+    info = _trace_errors(query.get_run, run, db)
+    records = _trace_errors(query.tasks, info.id, db)
+    executions = _trace_errors(query.executions, info.id, url=db)
+    state = info.state
+    style = _STYLE.get(state, "white")
+    title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
+             f"[{style}]{state}[/{style}] · {_duration(info.elapsed)} · started {_local(info.started_at)}")
+    tree = Tree(title)
+    shown = 0
+    branches: dict[int, Tree] = {}
+    for root in query.build_tree(records):
+        for node, _depth in root.walk():
+            if shown >= max_nodes:
+                break
+            r = node.record
+            parent = branches.get(r.parent_id) if r.parent_id is not None else None
+            branches[r.task_id] = (parent or tree).add(_label(r))
+            shown += 1
+    console.print(tree)
+    failed = sum(1 for r in records if r.status == "failed")
+    summary = f"{len(records)} tasks, {failed} failed"
+    if executions:
+        summary += f", {len(executions)} process-module executions"
+    if shown < len(records):
+        summary += f" ({len(records) - shown} not shown; raise --max-nodes)"
+    console.print(summary)
+    if info.error:
+        console.print(f"[red]{escape(info.error)}[/red]")
+
+
+@app.command("graph")
+def graph_command(
+    run: Optional[int] = RunArgument,
+    output: Path = typer.Option(Path("task-tree.svg"), "--output", "-o", help="SVG file to write."),
+    db: Optional[str] = DbOption,
+) -> None:
+    """Draw a run's task tree as an SVG picture."""
+    from pycram.trace.pictures import write_tree_svg
+
+    path = _trace_errors(write_tree_svg, run, output, db)
+    console.print(f"wrote {path}")
+
+
+@app.command("timeline")
+def timeline_command(
+    run: Optional[int] = RunArgument,
+    output: Path = typer.Option(Path("timeline.png"), "--output", "-o", help="PNG file to write."),
+    max_rows: int = typer.Option(200, "--max-rows", help="At most this many task rows (deeper tasks are left out)."),
+    db: Optional[str] = DbOption,
+) -> None:
+    """Draw which branches ran when (a Gantt chart, one row per task) as a PNG picture."""
+    from pycram.trace.pictures import write_timeline_png
+
+    path = _trace_errors(write_timeline_png, run, output, db, max_rows)
+    console.print(f"wrote {path}")
+
+
+# -- running plans --------------------------------------------------------------------------------
+
+@app.command("run", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def run_command(
+    ctx: typer.Context,
+    file: Path = typer.Argument(..., help="Plan script to run (block syntax is switched on).", exists=True,
+                                dir_okay=False),
+    record: Optional[bool] = typer.Option(None, "--record/--no-record",
+                                          help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
+    db: Optional[str] = DbOption,
+    plan: Optional[str] = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
+    robot: Optional[str] = typer.Option(None, "--robot", help="Robot name recorded for the run."),
+) -> None:
+    """Run a plan script; arguments after FILE go to the script (in sys.argv)."""
+    from pycram.macros import run_script
+
+    recorder = None
+    if _record_flag(record):
+        from pycram.trace.recorder import Recorder
+
+        recorder = _trace_errors(lambda: Recorder(db, plan=plan or file.name, robot=robot,
+                                                  command=" ".join(["pycram run", str(file), *ctx.args])).start())
+    outcome, error, code = "succeeded", None, 0
+    try:
+        run_script(file, list(ctx.args))
+    except SystemExit as e:
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+        outcome = "succeeded" if code == 0 else "failed"
+        error = None if code == 0 else f"SystemExit: {e.code}"
+    except KeyboardInterrupt as e:
+        outcome, error, code = "interrupted", e, 130
+        raise
+    except BaseException as e:
+        outcome, error, code = "failed", e, 1
+        raise
+    finally:
+        if recorder is not None:
+            _robot_from_active(recorder)
+            run_id = recorder.finish(outcome, error)
+            err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+    raise typer.Exit(code)
+
+
+def _robot_from_active(recorder: Any) -> None:
+    if recorder.robot is not None:
+        return
+    try:
+        from pycram.robot import current_robot
+
+        robot = current_robot()
+    except Exception:
+        return
+    if robot is not None:
+        recorder.set_run_info(robot=str(getattr(robot, "name", robot)))
+
+
+@app.command("demo")
+def demo_command(
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
+    item_at: int = typer.Option(1, "--item-at", help="Where the item starts: position 1, 2 or 3 (0: no item)."),
+    steal: int = typer.Option(0, "--steal", help="How many times the item is taken away while the robot fetches it."),
+    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
+    interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
+    record: Optional[bool] = typer.Option(None, "--record/--no-record",
+                                          help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
+    db: Optional[str] = DbOption,
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
+) -> None:
+    """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
+    try:
+        from pycram.demos.kitchen import main as demo_main
+    except ModuleNotFoundError as e:
+        if e.name and e.name.startswith("pycram.demos"):
+            _fail("the kitchen demo (pycram.demos.kitchen) is not available in this installation")
+        _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
+    kwargs = dict(robot=robot, output=output, item_at=item_at, steal=steal, seed=seed, realtime=realtime,
+                  interactive=interactive, db=db, record=_record_flag(record))
+    import inspect
+
+    if "quiet" in inspect.signature(demo_main).parameters:
+        kwargs["quiet"] = quiet
+    code = _trace_errors(demo_main, **kwargs)
+    raise typer.Exit(int(code or 0))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `pycram` script. Returns the exit code (also when typer exits)."""
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        app(args=argv, prog_name="pycram", standalone_mode=True)
+    except SystemExit as e:
+        return e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -40,6 +40,7 @@ STATUS_COLORS = {
     "evaporated": "#9e9e9e",
     "running": "#1e88e5",
     "created": "#cfd8dc",
+    "thread": "#607d8b",
 }
 _LIGHT = {
     "succeeded": "#e8f5e9",
@@ -47,6 +48,7 @@ _LIGHT = {
     "evaporated": "#f5f5f5",
     "running": "#e3f2fd",
     "created": "#fafafa",
+    "thread": "#eceff1",
 }
 
 
@@ -67,7 +69,8 @@ def _clip(text: str, limit: int) -> str:
 
 
 def _status_of(record: TaskRecord) -> str:
-    return "running" if record.kind == "root" and record.status == "running" else record.status
+    """The status to show: a thread's root task never ends, it is shown as "thread"."""
+    return "thread" if record.kind == "root" else record.status
 
 
 # -- task tree (SVG) ------------------------------------------------------------------------------
@@ -91,7 +94,8 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
             depth_of[r.task_id] = depth
             order.append(node)
             lines1[r.task_id] = _clip(r.name, max_label)
-            detail = f"{r.kind or 'task'} · {_status_of(r)} · {_fmt_duration(r.duration)}"
+            detail = ("thread" if r.kind == "root" else
+                      f"{r.kind or 'task'} · {_status_of(r)} · {_fmt_duration(r.duration)}")
             if r.error_type and r.status != "succeeded":
                 detail += f" · {r.error_type}"
             lines2[r.task_id] = _clip(detail, max_label + 10)
