@@ -11,7 +11,7 @@ Guarantees
 - Every callback that runs in a plan thread (`task_started`, `task_ended`, the event
   subscribers, the fluent samplers) is O(1) and never blocks on the database: it appends a
   tuple to an unbounded queue. A background writer thread turns the queue into rows and commits
-  a batch every `flush_interval` seconds (0.25 s by default) — so a process killed with SIGKILL
+  a batch every `flush_interval` seconds (0.5 s by default) — so a process killed with SIGKILL
   loses at most the last batch window (SQLite: WAL mode).
 - `start()` connects synchronously and raises `TraceDatabaseError` for unusable databases, so
   a bad URL is reported before the plan runs.
@@ -174,7 +174,7 @@ class Recorder:
     """
 
     def __init__(self, url: str | None = None, *, plan: str | None = None, robot: str | None = None,
-                 scope: Task | None = None, flush_interval: float = 0.25, command: str | None = None,
+                 scope: Task | None = None, flush_interval: float = 0.5, command: str | None = None,
                  info: dict[str, Any] | None = None) -> None:
         from pycram.trace.db import resolve_url
 
@@ -190,6 +190,9 @@ class Recorder:
         self.outcome: str | None = None
         self._queue: queue.SimpleQueue[tuple] = queue.SimpleQueue()
         self._put = self._queue.put
+        # TaskListener methods: O(1), never block, no Python-level frame (see the writer)
+        self.task_started = self._queue.put
+        self.task_ended = self._queue.put
         self._wake = threading.Event()
         self._watches: dict[str, _Watch] = {}
         self._pending_watches = False
@@ -317,11 +320,8 @@ class Recorder:
 
     # -- callbacks in plan threads (O(1), never block) ------------------------------------------
 
-    def task_started(self, task: Task) -> None:
-        self._put(("s", task, _current_thread().name))
-
-    def task_ended(self, task: Task) -> None:
-        self._put(("e", task))
+    # `task_started` / `task_ended` are the queue's own `put` (set in __init__): no Python frame
+    # per call. A task is enqueued itself (not in a tuple); the writer upserts its current state.
 
     def _on_designator(self, designator: Any, solution: Any = None, error: BaseException | None = None) -> None:
         self._put(("d", current_task(), current_clock().now(), designator, solution, error))
@@ -347,7 +347,7 @@ class Recorder:
                 items = [first]
             except queue.Empty:
                 items = []
-            if items and items[0][0] not in ("flush", "stop"):
+            if items and not (isinstance(first, tuple) and first[0] in ("flush", "stop")):
                 self._wake.wait(self.flush_interval)  # collect a batch (cut short by flush/finish)
             self._wake.clear()
             if self._pending_watches:
@@ -361,8 +361,9 @@ class Recorder:
                     items.append(self._queue.get_nowait())
                 except queue.Empty:
                     break
-            flushes = [item[1] for item in items if item[0] == "flush"]
-            stop = any(item[0] == "stop" for item in items)
+            controls = [item for item in items if isinstance(item, tuple) and item[0] in ("flush", "stop")]
+            flushes = [item[1] for item in controls if item[0] == "flush"]
+            stop = any(item[0] == "stop" for item in controls)
             try:
                 state.write(items)
             except Exception:
@@ -372,6 +373,10 @@ class Recorder:
                 done.set()
 
 
+_TASK_COLUMNS = ("run_id", "task_id", "parent_id", "name", "kind", "path", "thread", "status", "start", "end",
+                 "duration", "error_type", "error_message")
+
+
 class _WriterState:
     """Turns queued events into rows (runs only in the writer thread)."""
 
@@ -379,30 +384,34 @@ class _WriterState:
         self.recorder = recorder
         self.run_id = recorder.run_id
         self.written: set[int] = set()  # task ids inserted
-        self.threads: dict[int, str] = {}  # task id -> name of the thread that started it
+        self.thread_names: dict[int, str] = {}  # thread ident -> name (refreshed per batch)
         self.in_scope: dict[int, bool] = {}
         self.last_heartbeat = time.monotonic()
+        dialect = recorder._engine.dialect
+        mark = "?" if dialect.paramstyle == "qmark" else "%s"
+        q = dialect.identifier_preparer.quote
+        self.sql_insert = (f"INSERT INTO pycram_tasks ({', '.join(q(c) for c in _TASK_COLUMNS)}) "
+                           f"VALUES ({', '.join([mark] * len(_TASK_COLUMNS))})")
+        self.sql_update = (f"UPDATE pycram_tasks SET {', '.join(f'{q(c)} = {mark}' for c in _TASK_COLUMNS[7:])} "
+                           f"WHERE run_id = {mark} AND task_id = {mark}")
 
-    def _task_row(self, task: Task) -> dict[str, Any]:
+    def _task_row(self, task: Task) -> tuple:
+        """The row of `task` in `_TASK_COLUMNS` order (hot path: kept cheap)."""
         parent = task.parent
-        status = task.status.get_value()
-        error_type, error_message = _error_fields(task.exception) if status.value != "succeeded" else (None, None)
-        thread = self.threads.get(task.id)
-        return {
-            "run_id": self.run_id,
-            "task_id": task.id,
-            "parent_id": parent.id if parent is not None else None,
-            "name": _short(str(task.name), 512),
-            "kind": _short(str(task.kind), 64),
-            "path": _short(task.path),
-            "thread": _short(thread, 255) if thread else None,
-            "status": status.value,
-            "start": task.start_time,
-            "end": task.end_time,
-            "duration": task.duration,
-            "error_type": error_type,
-            "error_message": error_message,
-        }
+        status = task.status.get_value().value
+        exception = task.exception
+        if exception is not None and status != "succeeded":
+            error_type, error_message = _error_fields(exception)
+        else:
+            error_type = error_message = None
+        runner = task._runner
+        thread = self.thread_names.get(runner.ident) if runner is not None else None
+        name = task.name
+        start, end = task.start_time, task.end_time
+        return (self.run_id, task.id, parent.id if parent is not None else None,
+                name if len(name) <= 512 else name[:511] + "…", task.kind, task.path, thread, status,
+                start, end, end - start if start is not None and end is not None else None,
+                error_type, error_message)
 
     def _wanted(self, task: Task) -> bool:
         scope = self.recorder.scope
@@ -425,14 +434,13 @@ class _WriterState:
             self.in_scope[task_id] = answer
         return answer
 
-    def write(self, items: Iterable[tuple]) -> None:
-        import sqlalchemy as sa
-
+    def write(self, items: Iterable[Any]) -> None:
         from pycram.trace.db import (designators_table, executions_table, fluent_samples_table,
                                      runs_table, tasks_table)
 
-        inserts: dict[int, dict[str, Any]] = {}
-        updates: dict[int, dict[str, Any]] = {}
+        self.thread_names = {t.ident: t.name for t in threading.enumerate() if t.ident is not None}
+        inserts: dict[int, tuple] = {}
+        updates: dict[int, tuple] = {}
         designators: list[dict[str, Any]] = []
         executions: list[dict[str, Any]] = []
         samples: list[dict[str, Any]] = []
@@ -451,25 +459,20 @@ class _WriterState:
                 inserts[node.id] = self._task_row(node)
 
         for item in items:
-            tag = item[0]
-            if tag == "s" or tag == "e":
-                task = item[1]
+            if not isinstance(item, tuple):  # a task that started or ended: upsert its current state
+                task = item
                 if not self._wanted(task):
                     continue
-                if tag == "s":
-                    self.threads[task.id] = item[2]
-                if task.id in self.written:
-                    if tag == "e":
-                        row = self._task_row(task)
-                        updates[task.id] = {k: row[k] for k in ("status", "start", "end", "duration",
-                                                                 "error_type", "error_message")}
+                if task.id in inserts:
+                    if inserts[task.id][9] is None:  # no end yet; else it holds the final state
+                        inserts[task.id] = self._task_row(task)
+                elif task.id in self.written:
+                    updates[task.id] = self._task_row(task)
                 else:
                     ensure(task)
-                    if tag == "e":
-                        inserts[task.id] = self._task_row(task)
-                if tag == "e":
-                    self.threads.pop(task.id, None)
-            elif tag == "f":
+                continue
+            tag = item[0]
+            if tag == "f":
                 _, name, value, t = item
                 samples.append({"run_id": run_id, "name": name, "time": t, "value": _text(value),
                                 "number": _number(value)})
@@ -506,14 +509,10 @@ class _WriterState:
             run_update.setdefault("last_seen_at", _now_utc())
             self.last_heartbeat = now
         with self.recorder._engine.begin() as conn:
-            if inserts:
-                conn.execute(tasks_table.insert(), list(inserts.values()))
+            if inserts:  # plain DB-API executemany: no per-row SQLAlchemy processing
+                conn.exec_driver_sql(self.sql_insert, list(inserts.values()))
             if updates:
-                stmt = (tasks_table.update()
-                        .where(tasks_table.c.run_id == sa.bindparam("b_run"))
-                        .where(tasks_table.c.task_id == sa.bindparam("b_task")))
-                conn.execute(stmt, [{"b_run": run_id, "b_task": task_id, **values}
-                                    for task_id, values in updates.items()])
+                conn.exec_driver_sql(self.sql_update, [row[7:] + (run_id, row[1]) for row in updates.values()])
             if designators:
                 conn.execute(designators_table.insert(), designators)
             if executions:
