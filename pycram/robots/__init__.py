@@ -1,1 +1,28 @@
-"""Per-robot packages: descriptions (data), simulated hardware settings, resolvers and process modules."""
+"""Per-robot packages: descriptions (data), simulated hardware settings, resolvers and process modules.
+
+``load(name, world)`` builds the :class:`pycram.robot.Robot` of a simulated world; importing this
+package stays cheap (the robot modules, which need the simulation, are imported by ``load``).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__all__ = ["ROBOT_NAMES", "load"]
+
+#: Robots with a simulated implementation.
+ROBOT_NAMES = ("pr2", "tiago")
+
+
+def load(name: str, world: Any) -> Any:
+    """The robot ``name`` (``'pr2'`` or ``'tiago'``) of the simulated ``world``, as a
+    :class:`pycram.robots.sim_modules.SimRobot` with all process modules online and its motion,
+    process-module and location resolvers registered. Activate it with ``with robot:``; stop it
+    with ``robot.shutdown()``. Raises ``ValueError`` for an unknown name or a world built for
+    another robot.
+    """
+    if name not in ROBOT_NAMES:
+        raise ValueError(f"unknown robot {name!r}; available: {', '.join(ROBOT_NAMES)}")
+    module = importlib.import_module(f"pycram.robots.{name}.robot")
+    return module.make_robot(world)

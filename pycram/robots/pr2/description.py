@@ -114,3 +114,38 @@ KITCHEN_BASE_POSES = {
     "cooker #2": (0.29, -0.55, -1.5708),
     "cooker #1": (-0.12, 1.71, 3.1416),
 }
+
+# --- Plan interface: numbers read by the PR2's motion and location resolvers ------------------------
+# (pycram.robots.pr2.robot). Appended data; the entries above are used by the simulation.
+
+#: A named arm configuration for reaching at counter height: tool 0.5 m ahead of the base, in line
+#: with the shoulder, 0.95 m high (torso "up"), pointing forward.
+ARM_CONFIGURATIONS["right"]["pre_grasp"] = (-0.566, -0.147, -2.211, -2.272, 2.914, -1.721, -0.982)
+ARM_CONFIGURATIONS["left"]["pre_grasp"] = (0.566, -0.137, 2.215, -2.268, -2.905, -1.723, 0.984)
+
+#: Torso heights [m] of the symbolic positions of `setting_torso`.
+TORSO_POSITIONS = {"up": 0.28, "down": 0.0}
+
+#: Arm / gripper names accepted in designators -> the physical arm / gripper (thesis: '0' = left,
+#: '1' = right).
+ARM_ALIASES = {"left": "left", "right": "right", "0": "left", "1": "right", 0: "left", 1: "right"}
+GRIPPER_ALIASES = dict(ARM_ALIASES)
+
+#: Where a point to reach lies in the base frame (x ahead [m], y left [m]) when the base stands
+#: in front of it, per arm: in line with that arm's shoulder, 0.65 m ahead (verified in the
+#: simulated kitchen for the three item spots at cooker #2 and the place spot on cooker #1).
+REACH_POINT_IN_BASE = {"right": (0.65, -0.19), "left": (0.65, 0.19)}
+
+#: Tool offsets of each `reaching` phase relative to the target: (back along the approach
+#: direction [m], up [m]). The approach direction is the base's heading (the base faces the
+#: counter); the tool points along it with its fingers opening horizontally.
+APPROACH_OFFSETS = {
+    "pre_grasp": (0.10, 0.0),
+    "grasp": (0.0, 0.0),
+    "lift": (0.0, 0.10),
+    "pre_place": (0.0, 0.10),
+    "place": (0.0, 0.01),
+    "retreat": (0.10, 0.02),
+}
+#: Position tolerance [m] of the tool per phase (grasping pushes against the item a little).
+REACH_TOLERANCE = {"grasp": 0.02, "place": 0.02, "default": 0.01}

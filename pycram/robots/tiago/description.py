@@ -82,3 +82,36 @@ KITCHEN_BASE_POSES = {
     "cooker #2": (0.25, -0.45, -1.5708),
     "cooker #1": (-0.02, 1.75, 3.1416),
 }
+
+# --- Plan interface: numbers read by TIAGo's motion and location resolvers ---------------------------
+# (pycram.robots.tiago.robot). Appended data; the entries above are used by the simulation.
+
+#: A named arm configuration for reaching at counter height: tool 0.6 m ahead of the base,
+#: 0.15 m right, 0.95 m high (torso "up"), pointing forward.
+ARM_CONFIGURATIONS["right"]["pre_grasp"] = (0.277, -0.385, -1.499, 2.176, -1.794, -0.879, -0.208)
+
+#: Torso heights [m] of the symbolic positions of `setting_torso`.
+TORSO_POSITIONS = {"up": 0.32, "down": 0.0}
+
+#: TIAGo has one arm and one gripper: it serves requests for either arm (thesis: '0' = left,
+#: '1' = right) with them.
+ARM_ALIASES = {"left": "right", "right": "right", "0": "right", "1": "right", 0: "right", 1: "right"}
+GRIPPER_ALIASES = dict(ARM_ALIASES)
+
+#: Where a point to reach lies in the base frame (x ahead [m], y left [m]) when the base stands
+#: in front of it (verified in the simulated kitchen for the item spots at cooker #2 and the
+#: place spot on cooker #1).
+REACH_POINT_IN_BASE = {"right": (0.70, -0.15)}
+
+#: Tool offsets of each `reaching` phase relative to the target: (back along the approach
+#: direction [m], up [m]); see the PR2's description.
+APPROACH_OFFSETS = {
+    "pre_grasp": (0.10, 0.0),
+    "grasp": (0.0, 0.0),
+    "lift": (0.0, 0.10),
+    "pre_place": (0.0, 0.10),
+    "place": (0.0, 0.01),
+    "retreat": (0.10, 0.02),
+}
+#: Position tolerance [m] of the tool per phase.
+REACH_TOLERANCE = {"grasp": 0.02, "place": 0.02, "default": 0.01}

@@ -1,0 +1,298 @@
+"""Designator resolvers of the simulated robots, parametrised by a robot's description module.
+
+The robot packages (:mod:`pycram.robots.pr2`, :mod:`pycram.robots.tiago`) register these on
+their :class:`~pycram.robots.sim_modules.SimRobot`. All robot numbers (arm names, torso heights,
+named joint configurations, where the base stands to reach a point, approach offsets) are read
+from the description module; this file holds only the geometry that turns them into commands.
+
+Motion resolver (thesis ch. 4.2.1): :func:`make_motion_resolver` returns ``f(designator) ->
+list`` of solution dictionaries, each with a ``'cmd'`` key understood by the process modules of
+:mod:`pycram.robots.sim_modules`:
+
+=============================  ==================================================================
+designator type                solution
+=============================  ==================================================================
+``moving``                     ``{'cmd': 'navigate', 'pose': Pose2D (map), 'frame': 'map', 'wait'}``
+``cancelling_movement``        ``{'cmd': 'stop_base'}``
+``pointing_head``              ``{'cmd': 'point_head', 'point': (x, y, z) map, 'track': not wait}``
+``setting_torso``              ``{'cmd': 'set_torso', 'height': m}``
+``setting_gripper``            ``{'cmd': 'set_gripper', 'gripper', 'opening': m, 'effort': N|None}``
+``setting_arm_configuration``  ``{'cmd': 'move_arm', 'arm', 'positions', 'configuration'}``
+``setting_arm_joints``         ``{'cmd': 'move_arm', 'arm', 'positions'}``
+``reaching``                   ``{'cmd': 'reach', 'arm', 'position', 'orientation', 'tolerance',
+                               'phase', 'target'}``
+``subscribing_pose``           ``{'cmd': 'subscribe', 'source': 'base_pose', 'fl'}``
+``subscribing_gripper``        ``{'cmd': 'subscribe', 'source': 'gripper_opening', 'gripper', 'fl'}``
+``detecting``                  ``{'cmd': 'perceive', 'object': name/type or None}``
+=============================  ==================================================================
+
+``arm`` / ``gripper`` in a solution is always the *physical* name (``description.ARMS``); a
+designator may use any name of ``description.ARM_ALIASES`` (``'left'``, ``'right'``, ``'0'``,
+``'1'``). Invalid values raise ``ValueError`` naming the valid choices (reported by the
+designator as ``ResolverError``).
+
+``reaching`` and ``moving`` in the ``base_footprint`` frame depend on the base pose at the
+time the designator is first referenced -- the process module references it when it starts
+executing it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Iterator, Optional, Sequence
+
+from pycram.sim.kitchen import COUNTERS, FREE_FLOOR
+from pycram.sim.types import Pose2D, yaw_to_quat
+
+__all__ = [
+    "make_motion_resolver",
+    "make_to_reach_generator",
+    "physical_arm",
+    "physical_gripper",
+    "approach_target",
+    "base_pose_to_reach",
+]
+
+
+def _choices(mapping: Any) -> list[str]:
+    return sorted({str(k) for k in mapping})
+
+
+def physical_arm(description: Any, name: Any) -> str:
+    """The physical arm that serves a request for arm ``name`` (``ValueError`` if none)."""
+    try:
+        return description.ARM_ALIASES[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"{description.NAME} has no arm {name!r}; available: "
+                         f"{_choices(description.ARM_ALIASES)}") from None
+
+
+def physical_gripper(description: Any, name: Any) -> str:
+    """The physical gripper that serves a request for gripper ``name`` (``ValueError`` if none)."""
+    try:
+        return description.GRIPPER_ALIASES[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"{description.NAME} has no gripper {name!r}; available: "
+                         f"{_choices(description.GRIPPER_ALIASES)}") from None
+
+
+def _pose2d(value: Any) -> Pose2D:
+    if isinstance(value, Pose2D):
+        return value
+    if hasattr(value, "x") and hasattr(value, "y") and hasattr(value, "yaw"):
+        return Pose2D(float(value.x), float(value.y), float(value.yaw))
+    try:
+        x, y, yaw = value
+        return Pose2D(float(x), float(y), float(yaw))
+    except (TypeError, ValueError):
+        raise ValueError(f"a base pose is a Pose2D or (x [m], y [m], yaw [rad]), got {value!r}") from None
+
+
+def _point(value: Any) -> tuple[float, float, float]:
+    try:
+        x, y, z = value
+        return (float(x), float(y), float(z))
+    except (TypeError, ValueError):
+        raise ValueError(f"a point is [x, y, z] in [m], got {value!r}") from None
+
+
+def _relative_to(base: Pose2D, pose: Pose2D) -> Pose2D:
+    """``pose`` given in the frame of the base at ``base``, in the map frame."""
+    c, s = math.cos(base.yaw), math.sin(base.yaw)
+    return Pose2D(base.x + c * pose.x - s * pose.y, base.y + s * pose.x + c * pose.y,
+                  base.yaw + pose.yaw)
+
+
+def approach_target(description: Any, base: Pose2D, target: Sequence[float],
+                    phase: Optional[str]) -> tuple[tuple[float, float, float], tuple[float, ...]]:
+    """Tool position [m, map] and orientation (w, x, y, z) for ``phase`` of reaching ``target``.
+
+    The approach direction is the base's heading: the tool points along it (fingers opening
+    horizontally) and is moved ``back`` [m] against it and ``up`` [m] per
+    ``description.APPROACH_OFFSETS[phase]`` (no offset without a phase).
+    """
+    x, y, z = _point(target)
+    if phase is None:
+        back, up = 0.0, 0.0
+    else:
+        offsets = description.APPROACH_OFFSETS
+        if phase not in offsets:
+            raise ValueError(f"unknown reaching phase {phase!r}; available: {sorted(offsets)}")
+        back, up = offsets[phase]
+    c, s = math.cos(base.yaw), math.sin(base.yaw)
+    return (x - c * back, y - s * back, z + up), yaw_to_quat(base.yaw)
+
+
+def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
+    """The motion-designator resolver of the robot of ``description`` in ``world``."""
+    d = description
+
+    def arm_configuration(arm: str, name: Any) -> tuple[float, ...]:
+        configurations = d.ARM_CONFIGURATIONS[arm]
+        if name not in configurations:
+            raise ValueError(f"{d.NAME} {arm} arm has no configuration {name!r}; available: "
+                             f"{sorted(configurations)}")
+        return tuple(configurations[name])
+
+    def torso_height(position: Any) -> float:
+        if isinstance(position, str):
+            if position not in d.TORSO_POSITIONS:
+                raise ValueError(f"unknown torso position {position!r}; available: "
+                                 f"{sorted(d.TORSO_POSITIONS)} or a height in [m]")
+            return float(d.TORSO_POSITIONS[position])
+        low, high = d.TORSO["range"]
+        height = float(position)
+        if not low <= height <= high:
+            raise ValueError(f"torso height {height} m outside [{low}, {high}] m")
+        return height
+
+    def gripper_opening(position: Any) -> float:
+        fraction = float(position)
+        if not 0.0 <= fraction <= 1.0:
+            raise ValueError(f"gripper position is a fraction open in [0, 1], got {position!r}")
+        return fraction
+
+    def motion_resolver(desig: Any) -> list:
+        solutions = []
+        wait = desig.prop_value("wait") is not False
+        if desig.check_constraints([("type", "moving"), "pose"]):
+            pose = _pose2d(desig.prop_value("pose"))
+            frame = desig.prop_value("frame") or "map"
+            if frame == "base_footprint":
+                pose = _relative_to(world.base_pose.get_value(), pose)
+            elif frame != "map":
+                raise ValueError(f"unknown frame {frame!r}; available: map, base_footprint")
+            solutions.append(desig.make_dictionary(
+                [("cmd", "navigate"), ("pose", pose), ("frame", "map"), ("wait", wait)]))
+        if desig.check_constraints([("type", "cancelling_movement")]):
+            solutions.append(desig.make_dictionary([("cmd", "stop_base")]))
+        if desig.check_constraints([("type", "pointing_head"), "coordinates"]):
+            frame = desig.prop_value("frame") or "map"
+            if frame != "map":
+                raise ValueError(f"pointing_head supports the frame 'map', got {frame!r}")
+            solutions.append(desig.make_dictionary(
+                [("cmd", "point_head"), ("point", _point(desig.prop_value("coordinates"))),
+                 ("frame", "map"), ("track", not wait)]))
+        if desig.check_constraints([("type", "setting_torso"), "position"]):
+            solutions.append(desig.make_dictionary(
+                [("cmd", "set_torso"), ("height", torso_height(desig.prop_value("position")))]))
+        if desig.check_constraints([("type", "setting_gripper"), "gripper", "position"]):
+            gripper = physical_gripper(d, desig.prop_value("gripper"))
+            spec = d.GRIPPERS[gripper]
+            opening = gripper_opening(desig.prop_value("position")) * spec["max_opening"]
+            effort = desig.prop_value("max_effort")
+            solutions.append(desig.make_dictionary(
+                [("cmd", "set_gripper"), ("gripper", gripper), ("opening", opening),
+                 ("effort", None if effort is None else float(effort))]))
+        if desig.check_constraints([("type", "setting_arm_configuration"), "arm", "configuration"]):
+            arm = physical_arm(d, desig.prop_value("arm"))
+            name = desig.prop_value("configuration")
+            solutions.append(desig.make_dictionary(
+                [("cmd", "move_arm"), ("arm", arm), ("positions", arm_configuration(arm, name)),
+                 ("configuration", name)]))
+        if desig.check_constraints([("type", "setting_arm_joints"), "arm", "positions"]):
+            arm = physical_arm(d, desig.prop_value("arm"))
+            positions = tuple(float(v) for v in desig.prop_value("positions"))
+            joints = d.ARMS[arm]["joints"]
+            if len(positions) != len(joints):
+                raise ValueError(f"the {d.NAME} {arm} arm has {len(joints)} joints {joints}, "
+                                 f"got {len(positions)} positions")
+            solutions.append(desig.make_dictionary(
+                [("cmd", "move_arm"), ("arm", arm), ("positions", positions)]))
+        if desig.check_constraints([("type", "reaching"), "arm", "target"]):
+            arm = physical_arm(d, desig.prop_value("arm"))
+            phase = desig.prop_value("phase")
+            target = _point(desig.prop_value("target"))
+            position, orientation = approach_target(d, world.base_pose.get_value(), target, phase)
+            tolerance = d.REACH_TOLERANCE.get(phase, d.REACH_TOLERANCE["default"])
+            solutions.append(desig.make_dictionary(
+                [("cmd", "reach"), ("arm", arm), ("position", position),
+                 ("orientation", orientation), ("tolerance", tolerance), ("phase", phase),
+                 ("target", target)]))
+        if desig.check_constraints([("type", "subscribing_pose"), "fl"]):
+            solutions.append(desig.make_dictionary(
+                [("cmd", "subscribe"), ("source", "base_pose"), "fl"]))
+        if desig.check_constraints([("type", "subscribing_gripper"), "gripper", "fl"]):
+            solutions.append(desig.make_dictionary(
+                [("cmd", "subscribe"), ("source", "gripper_opening"),
+                 ("gripper", physical_gripper(d, desig.prop_value("gripper"))), "fl"]))
+        if desig.check_constraints([("type", "detecting")]):
+            solutions.append(desig.make_dictionary([("cmd", "perceive"), "object"]))
+        return solutions
+
+    motion_resolver.__qualname__ = f"{d.NAME}_motion_resolver"
+    return motion_resolver
+
+
+# --------------------------------------------------------------------------- locations
+
+
+def _counter_normal(x: float, y: float) -> Optional[tuple[float, float]]:
+    """Outward normal (towards the free floor) of the counter edge in front of (x, y), or None
+    when (x, y) is on no counter of the simulated kitchen."""
+    fx0, fy0, fx1, fy1 = FREE_FLOOR
+    best: Optional[tuple[float, tuple[float, float]]] = None
+    for box in COUNTERS:
+        (cx, cy, _), (hx, hy, _) = box.center, box.half
+        if not (abs(x - cx) <= hx + 1e-6 and abs(y - cy) <= hy + 1e-6):
+            continue
+        for n in ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
+            edge_x = cx + n[0] * hx if n[0] else x
+            edge_y = cy + n[1] * hy if n[1] else y
+            probe_x, probe_y = edge_x + 0.3 * n[0], edge_y + 0.3 * n[1]
+            if not (fx0 <= probe_x <= fx1 and fy0 <= probe_y <= fy1):
+                continue
+            distance = math.hypot(edge_x - x, edge_y - y)
+            if best is None or distance < best[0]:
+                best = (distance, n)
+    return None if best is None else best[1]
+
+
+def base_pose_to_reach(description: Any, point: Sequence[float], arm: str,
+                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0) -> Pose2D:
+    """The base pose from which ``arm`` reaches ``point`` [m, map].
+
+    The base faces the counter the point lies on (heading against the counter edge's outward
+    normal); off the counters it faces the point from the ``current`` base position. The point
+    is then at ``description.REACH_POINT_IN_BASE[arm]`` (+ ``extra_standoff`` [m] ahead) in the
+    base frame.
+    """
+    x, y, _ = _point(point)
+    normal = _counter_normal(x, y)
+    if normal is not None:
+        yaw = math.atan2(-normal[1], -normal[0])
+    elif current is not None:
+        yaw = math.atan2(y - current.y, x - current.x)
+    else:
+        raise ValueError(f"{_point(point)} is on no counter and no current base pose is known")
+    ahead, left = description.REACH_POINT_IN_BASE[arm]
+    ahead += extra_standoff
+    c, s = math.cos(yaw), math.sin(yaw)
+    return Pose2D(x - c * ahead + s * left, y - s * ahead - c * left, yaw)
+
+
+def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any]:
+    """Location generator for ``('to_reach', [x, y, z])`` (optionally ``('arm', a)``).
+
+    Yields base poses (``Pose2D``, map frame) from which the arm (default
+    ``description.DEFAULT_ARM``) reaches the point: the best one first, then the same with the
+    base 5 cm further back, 5 cm closer and 10 cm further back. Returns ``None`` for other
+    location designators.
+    """
+    d = description
+
+    def to_reach(desig: Any) -> Optional[Iterator[Pose2D]]:
+        if not desig.check_constraints(["to_reach"]):
+            return None
+        point = _point(desig.prop_value("to_reach"))
+        arm = physical_arm(d, desig.prop_value("arm") or d.DEFAULT_ARM)
+        current = world.base_pose.get_value()
+
+        def poses() -> Iterator[Pose2D]:
+            for extra in (0.0, 0.05, -0.05, 0.10):
+                yield base_pose_to_reach(d, point, arm, current, extra)
+
+        return poses()
+
+    to_reach.__qualname__ = f"{d.NAME}_to_reach"
+    return to_reach

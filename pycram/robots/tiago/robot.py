@@ -1,0 +1,74 @@
+"""The simulated TIAGo as a :class:`pycram.robot.Robot`: resolvers and process modules.
+
+One arm and one gripper (physically named ``'right'`` in the description). Like the one-armed
+robot of the thesis' ch. 4.2.2 discussion, its only arm module serves requests for either arm
+(``'left'``, ``'right'``, ``'0'``, ``'1'``) and its only gripper module requests for either
+gripper, so a plan written for the two-armed PR2 runs unchanged. All numbers come from
+:mod:`pycram.robots.tiago.description`.
+
+Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``, ``head``,
+``torso``, ``arm_right``, ``gripper_right``, ``sensors``, ``perception``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from pycram.process_module import ProcessModule
+from pycram.robots import sim_modules as sm
+from pycram.robots.sim_resolvers import (make_motion_resolver, make_to_reach_generator,
+                                         physical_arm, physical_gripper)
+from pycram.robots.tiago import description
+
+__all__ = ["make_robot"]
+
+
+def make_robot(world: Any) -> sm.SimRobot:
+    """The TIAGo of ``world`` (a :class:`pycram.sim.World` built for ``'tiago'``), modules online."""
+    if getattr(world, "robot", None) != description.NAME:
+        raise ValueError(f"make_robot for {description.NAME!r} needs a world with a "
+                         f"{description.NAME!r}, got {world!r}")
+    robot = sm.SimRobot(description.NAME, world, description)
+    navigation = robot.add_process_module("navigation", sm.NavigationModule(world))
+    base_stop = robot.add_process_module("base_stop", sm.BaseStopModule(world, navigation))
+    head = robot.add_process_module("head", sm.HeadModule(world))
+    torso = robot.add_process_module("torso", sm.TorsoModule(world))
+    (arm_name,) = description.ARMS
+    (gripper_name,) = description.GRIPPERS
+    arm = robot.add_process_module(f"arm_{arm_name}", sm.ArmModule(world, arm_name))
+    gripper = robot.add_process_module(f"gripper_{gripper_name}",
+                                       sm.GripperModule(world, gripper_name))
+    sensors = robot.add_process_module("sensors", sm.SensorModule(world))
+    perception = robot.add_process_module("perception", sm.PerceptionModule(world))
+
+    robot.motion_resolvers.append(make_motion_resolver(world, description))
+    robot.location_generators.append(make_to_reach_generator(world, description))
+
+    def available_process_modules(desig: Any) -> Optional[ProcessModule]:
+        """Thesis ch. 4.2.2: choose TIAGo's module by the designator's type; any arm or gripper
+        request goes to its only arm or gripper (unknown names still fail clearly)."""
+        if desig.check_constraints([("type", "moving")]):
+            return navigation
+        if desig.check_constraints([("type", "cancelling_movement")]):
+            return base_stop
+        if desig.check_constraints([("type", "pointing_head")]):
+            return head
+        if desig.check_constraints([("type", "setting_torso")]):
+            return torso
+        if desig.check_constraints([("type", "detecting")]):
+            return perception
+        if (desig.check_constraints([("type", "subscribing_pose")])
+                or desig.check_constraints([("type", "subscribing_gripper")])):
+            return sensors
+        if desig.check_constraints([("type", "setting_gripper"), "gripper"]):
+            physical_gripper(description, desig.prop_value("gripper"))  # validates the name
+            return gripper
+        if (desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
+                or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
+                or desig.check_constraints([("type", "reaching"), "arm"])):
+            physical_arm(description, desig.prop_value("arm"))  # validates the name
+            return arm
+        return None
+
+    robot.process_module_resolvers.append(available_process_modules)
+    return robot
