@@ -22,7 +22,12 @@ resolved to: a plan function for action designators, the motion/solution data ot
 
 `PROCESS_MODULE_EXECUTED` ("process_module.executed"), fields: ``module``, ``designator``,
 ``outcome`` (a string such as "succeeded", "failed", "cancelled"), ``start`` and ``end`` (active
-clock [s]), ``error`` (exception or None).
+clock [s]), ``error`` (exception or None; for a failure, the exception ``_execute`` raised).
+
+Publishers: :meth:`pycram.process_module.ProcessModule.perform` and
+:func:`pycram.designator.perform` publish ``DESIGNATOR_PERFORMED`` once per call (also when it
+raises); a process module publishes ``PROCESS_MODULE_EXECUTED`` once per started execution, in
+the executing task's thread.
 """
 
 from __future__ import annotations

@@ -34,6 +34,10 @@ Guarantees
   while the module's state is consistent (under its condition).
 - **No module.** :class:`NoProcessModuleError` names the designator's properties, the resolvers
   asked and the active robot.
+- **Events.** Every started execution is announced once on :mod:`pycram.events`
+  (``PROCESS_MODULE_EXECUTED``, in the executing task's thread, when its outcome is settled);
+  every :meth:`ProcessModule.perform` announces ``DESIGNATOR_PERFORMED``. Observers never change
+  what happens (see :mod:`pycram.events`).
 """
 
 from __future__ import annotations
@@ -45,10 +49,11 @@ from collections import deque
 from enum import Enum
 from typing import Any, Callable, ClassVar, Optional
 
-from pycram.designators.core import DesignatorError, callable_name
+from pycram import events
+from pycram.designators.core import DesignatorError, callable_name, known_solution
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
-from pycram.runtime import Evaporated, no_evaporation, wait_until
+from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
 
 __all__ = [
     "ProcessModule",
@@ -126,6 +131,10 @@ class Execution:
                              name=f"{module.name}.execution-{self.id}.status")
         self.result: Any = None
         self.exception: Optional[BaseException] = None
+        #: Active-clock times [s] when ``_execute`` started and when the outcome was settled
+        #: (``None`` if it never started).
+        self.start: Optional[float] = None
+        self.end: Optional[float] = None
         self._task: Any = None  # the child task of a nowait execution
         self._group: Any = None
         self._cancel_requested = False
@@ -199,12 +208,21 @@ class ProcessModule:
 
         Blocks until done, except for designators with the property ``('wait', False)``
         (thesis): then returns an :class:`Execution` handle at once. Raises
-        :class:`NoProcessModuleError` when no resolver returns a module.
+        :class:`NoProcessModuleError` when no resolver returns a module. Announces
+        ``DESIGNATOR_PERFORMED`` (with the designator's solution if it was resolved, and the
+        exception if one is raised) before returning or raising.
         """
-        module = ProcessModule.resolve(designator)
-        if designator.prop_value("wait") is False:
-            return module.execute_nowait(designator)
-        return module.execute(designator)
+        try:
+            module = ProcessModule.resolve(designator)
+            if designator.prop_value("wait") is False:
+                result = module.execute_nowait(designator)
+            else:
+                result = module.execute(designator)
+        except BaseException as e:
+            events.designator_performed(designator, known_solution(designator), e)
+            raise
+        events.designator_performed(designator, known_solution(designator), None)
+        return result
 
     @staticmethod
     def perform_nowait(designator: Any) -> Execution:
@@ -391,6 +409,7 @@ class ProcessModule:
             wait_until(self._cond, lambda: self._claim(execution))
             if self._current is execution:
                 started = True
+                execution.start = current_clock().now()
                 logger.debug("%s: executing %r", self.name, designator)
                 try:
                     result = self._execute(designator)
@@ -422,6 +441,8 @@ class ProcessModule:
                     logger.exception("%s: cancel hook failed for %r", self.name,
                                      execution.designator)
             with self._cond:
+                if started and execution.end is None:
+                    execution.end = current_clock().now()  # before waiters see the outcome
                 if execution in self._queue:
                     self._queue.remove(execution)
                     self.queued.set_value(len(self._queue))
@@ -434,6 +455,10 @@ class ProcessModule:
                 if not execution.done:
                     self._finish_locked(execution, outcome, error)
                 self._cond.notify_all()
+            if started:
+                cause = error.cause if isinstance(error, ProcessModuleFailure) else error
+                events.process_module_executed(self, execution.designator, outcome.value,
+                                               execution.start, execution.end, cause)
 
     def _finish_locked(self, execution: Execution, outcome: ProcessModuleStatus,
                        error: Optional[BaseException]) -> None:

@@ -7,7 +7,7 @@ import threading
 import pytest
 
 from pycram.designator import (Designator, DesignatorError, GeneratorList, MotionDesignator,
-                               NoSolutionError, PropertyError, ResolverError)
+                               NoSolutionError, PropertyError, ResolverError, UnknownKindError)
 from pycram.testing import CountingGenerator
 
 
@@ -28,6 +28,38 @@ location = object()
 def test_thesis_check_constraints_example():
     d = Designator([('shape', 'round'), ('color', 'yellow'), ('at', location)])
     assert d.check_constraints([('shape', 'round'), 'color']) is True
+
+
+def test_thesis_api_names_and_signatures():
+    """The thesis' Designator API (ch. 3.3) under its names, with its parameters and defaults."""
+    import inspect
+
+    def params(f):
+        return [(p.name, p.default) for p in inspect.signature(f).parameters.values()
+                if p.kind is not inspect.Parameter.VAR_KEYWORD]
+
+    empty = inspect.Parameter.empty
+    assert params(Designator.__init__) == [('self', empty), ('properties', None),
+                                           ('parent', None)]
+    assert params(Designator.copy) == [('self', empty), ('new_properties', None)]
+    assert params(Designator.make_effective) == [('self', empty), ('properties', None),
+                                                 ('data', None), ('timestamp', None)]
+    assert params(Designator.solutions) == [('self', empty), ('from_root', None)]
+    for name in ('equate', 'equal', 'first', 'current', 'newest_effective', 'prop_value',
+                 'check_constraints', 'make_dictionary', 'reference', '_reference',
+                 'next_solution'):
+        assert callable(getattr(Designator, name)), name
+    assert Designator([('a', 1)]).timestamp is None
+    assert issubclass(DesignatorError, Exception)
+    assert isinstance(MotionDesignator.resolvers, list)
+    assert MotionDesignator([('a', 1)]).next_solution() is None  # no resolvers: None, no error
+
+
+def test_thesis_check_constraints_false_for_the_same_designator():
+    d = Designator([('shape', 'round'), ('color', 'yellow'), ('at', location)])
+    assert d.check_constraints([('shape', 'square'), 'color']) is False
+    assert d.check_constraints([('shape', 'round'), 'size']) is False
+    assert d.check_constraints([]) is True
 
 
 def test_thesis_make_dictionary_example():
@@ -140,8 +172,14 @@ def test_prop_value_first_match_and_missing():
 
 def test_keyword_construction_equals_pair_list():
     p = (1.0, 2.0, 0.0)
-    assert MotionDesignator(type='moving', pose=p).properties == \
-        MotionDesignator([('type', 'moving'), ('pose', p)]).properties
+    keyword, pairs = MotionDesignator(type='moving', pose=p), \
+        MotionDesignator([('type', 'moving'), ('pose', p)])
+    assert keyword.properties == pairs.properties
+    assert repr(keyword) == repr(pairs)
+    MotionDesignator.resolvers.append(
+        lambda d: [d.make_dictionary([('cmd', 'move'), 'pose'])] if d.check_constraints(
+            [('type', 'moving'), 'pose']) else [])
+    assert keyword.reference() == pairs.reference() == {'cmd': 'move', 'pose': p}
     mixed = Designator([('type', 'moving')], pose=p, type='navigating')
     assert mixed.properties == [('type', 'navigating'), ('pose', p)]
     assert Designator({'a': 1}).properties == [('a', 1)]
@@ -209,7 +247,7 @@ def test_resolution_is_lazy():
     assert d3.reference() == 2 and counter.advanced == 3
     solutions = d.solutions()
     assert [next(solutions) for _ in range(4)] == [0, 1, 2, 3]
-    assert counter.advanced <= 5
+    assert counter.advanced == 4  # exactly as far as the solutions taken, no further
     assert len(calls) == 1  # the resolver ran once for the whole chain
 
 
@@ -281,13 +319,26 @@ def test_resolver_that_raises_is_named():
         list(d.solutions())
 
 
-def test_resolver_returning_non_iterable_is_named():
+@pytest.mark.parametrize('returned', [42, 'abc', object()])
+def test_resolver_returning_non_iterable_is_named(returned):
     def int_resolver(d):
-        return 42
+        return returned
 
     MotionDesignator.resolvers.append(int_resolver)
-    with pytest.raises(ResolverError, match='int_resolver.*non-iterable'):
-        MotionDesignator([('type', 'x')]).reference()
+    d = MotionDesignator([('type', 'x')])
+    with pytest.raises(ResolverError, match='int_resolver.*non-iterable') as info:
+        d.reference()
+    assert "MotionDesignator([('type', 'x')])" in str(info.value)
+    assert info.value.designator is d and info.value.resolver is int_resolver
+
+
+def test_unknown_kinds_as_parent_or_equate_target():
+    with pytest.raises(UnknownKindError, match="parent must be a Designator.*'cup'"):
+        MotionDesignator([('type', 'x')], parent='cup')
+    d = Designator([('type', 'x')])
+    with pytest.raises(UnknownKindError, match="Designator.*'type', 'x'.*non-designator"):
+        d.equate([('type', 'x')])
+    assert issubclass(UnknownKindError, DesignatorError)
 
 
 def test_failing_solution_generator_is_named():
@@ -318,16 +369,28 @@ def test_resolver_reentering_reference_does_not_hang():
 
 
 def test_concurrent_reference_resolves_once():
+    """16 threads call reference() while the first one is inside the resolver: one resolution."""
     calls = []
     gate = threading.Event()
+    entered = threading.Condition()
+    callers = [0]
+
+    class CountedDesignator(MotionDesignator):
+        def reference(self):
+            with entered:
+                callers[0] += 1
+                entered.notify_all()
+            return super().reference()
 
     def slow_resolver(d):
-        calls.append(threading.get_ident())
-        gate.wait(5)
+        with entered:
+            calls.append(threading.get_ident())
+            entered.notify_all()
+        assert gate.wait(5)
         return [object()]
 
     MotionDesignator.resolvers.append(slow_resolver)
-    d = MotionDesignator([('type', 'x')])
+    d = CountedDesignator([('type', 'x')])
     results = []
     lock = threading.Lock()
 
@@ -339,6 +402,8 @@ def test_concurrent_reference_resolves_once():
     threads = [threading.Thread(target=worker) for _ in range(16)]
     for t in threads:
         t.start()
+    with entered:  # all callers are in reference() and one is inside the (held) resolver
+        assert entered.wait_for(lambda: callers[0] == 16 and calls, 5)
     gate.set()
     for t in threads:
         t.join(5)

@@ -110,6 +110,10 @@ def test_object_designator_resolves_against_beliefs_in_stable_order():
         assert [o.name for o in cups.solutions()] == ['red_cup', 'blue_cup', 'green_cup']
         second = cups.next_solution()
         assert second.reference().name == 'blue_cup' and second.equal(cups)
+        third = second.next_solution()
+        assert third.reference().name == 'green_cup' and third.first() is cups
+        assert third.next_solution() is None  # walked them all
+        assert cups.current() is third
         assert ObjectDesignator(type='cup', color='green').reference().name == 'green_cup'
         assert [o.name for o in ObjectDesignator(type='cup').solutions()] == \
             ['red_cup', 'blue_cup', 'green_cup']  # same order on every resolution
@@ -124,6 +128,16 @@ def test_object_at_location_designator():
         assert [o.name for o in cups.solutions()] == ['red_cup', 'green_cup']
         on_table = LocationDesignator([('on', ObjectDesignator(name='table'))])
         assert ObjectDesignator([('type', 'cup'), ('at', on_table)]).reference().name == 'blue_cup'
+
+
+def test_object_at_location_without_applicable_validator_is_an_error_not_a_match():
+    world, _ = make_kitchen()
+    with world:
+        somewhere = LocationDesignator([('near', 'window')])  # no validator knows 'near'
+        cups = ObjectDesignator([('type', 'cup'), ('at', somewhere)])
+        with pytest.raises(DesignatorError, match="no location validator applies") as info:
+            cups.reference()
+        assert "('near', 'window')" in str(info.value)
 
 
 def test_object_designator_predicates_and_missing_properties():
@@ -189,6 +203,39 @@ def test_same_location_resolves_differently_on_two_robots():
                 name='red_cup'))]).solutions())
     assert len(left_poses) == 3 and len(right_poses) == 3
     assert all(p[1] > 0.1 for p in left_poses) and all(p[1] < 0.1 for p in right_poses)
+
+
+def to_see_generator(distance):
+    """Four base poses ``distance`` [m] around the object (a robot's camera decides how far)."""
+    def generator(desig):
+        if not desig.check_constraints(['to_see']):
+            return None
+        x, y, _ = desig.prop_value('to_see').reference().pose
+        return [(round(x + dx * distance, 3), round(y + dy * distance, 3), 0.0)
+                for dx, dy in ((-1, 0), (0, 1), (1, 0), (0, -1))]
+    return generator
+
+
+def test_to_see_location_per_robot_filtered_by_world_validator():
+    world, _ = make_kitchen()
+
+    def inside_walls(desig, pose):  # world knowledge: the kitchen ends at x = 2.0
+        return pose[0] < 2.0
+
+    world.location_validators.append(inside_walls)
+    short, tall = Robot('short'), Robot('tall')
+    short.location_generators.append(to_see_generator(1.0))
+    tall.location_generators.append(to_see_generator(2.0))
+    with world:
+        cup = ObjectDesignator(name='red_cup')  # at (1.1, 0.1)
+        with short:
+            short_poses = list(LocationDesignator([('to_see', cup)]).solutions())
+        with tall:
+            tall_poses = list(LocationDesignator([('to_see', cup)]).solutions())
+    # one generator per robot, one validator for the world: (2.1, 0.1) / (3.1, 0.1) lie
+    # outside the walls
+    assert short_poses == [(0.1, 0.1, 0.0), (1.1, 1.1, 0.0), (1.1, -0.9, 0.0)]
+    assert tall_poses == [(-0.9, 0.1, 0.0), (1.1, 2.1, 0.0), (1.1, -1.9, 0.0)]
 
 
 def test_location_without_generator_and_with_all_candidates_rejected():
@@ -291,6 +338,71 @@ def test_action_resolution_depends_on_active_robot_and_next_solution_gives_alter
         assert perform(d.next_solution()) == 'one-b'
     with r2:
         assert perform(ActionDesignator(type='waving')) == 'two'
+
+
+def _register(kind, resolver):
+    {'object': ObjectDesignator.resolvers, 'location': LocationDesignator.generators,
+     'action': ActionDesignator.resolvers, 'motion': MotionDesignator.resolvers}[kind].append(
+        resolver)
+
+
+def _resolve(kind):
+    designator = {'object': ObjectDesignator, 'location': LocationDesignator,
+                  'action': ActionDesignator, 'motion': MotionDesignator}[kind]([('type', 'x')])
+    return designator, (lambda: perform(designator)) if kind == 'action' else designator.reference
+
+
+@pytest.mark.parametrize('kind', ['object', 'location', 'action', 'motion'])
+def test_raising_resolver_of_every_kind_names_designator_and_resolver(kind):
+    def exploding_resolver(d):
+        raise RuntimeError('no map')
+
+    _register(kind, exploding_resolver)
+    designator, resolve = _resolve(kind)
+    with pytest.raises(ResolverError) as info:
+        resolve()
+    message = str(info.value)
+    assert 'exploding_resolver' in message and "('type', 'x')" in message
+    assert type(designator).__name__ in message and 'no map' in message
+    assert info.value.designator is designator and info.value.resolver is exploding_resolver
+    assert isinstance(info.value, DesignatorError)
+
+
+@pytest.mark.parametrize('kind', ['object', 'location', 'action', 'motion'])
+def test_non_iterable_from_resolver_of_every_kind_names_designator_and_resolver(kind):
+    def number_resolver(d):
+        return 42
+
+    _register(kind, number_resolver)
+    designator, resolve = _resolve(kind)
+    with pytest.raises(ResolverError, match='number_resolver.*non-iterable') as info:
+        resolve()
+    assert f"{type(designator).__name__}([('type', 'x')])" in str(info.value)
+
+
+def test_performed_actions_are_published_as_events():
+    from pycram import events
+
+    def wave(designator):
+        return 'waved'
+
+    def fall(designator):
+        raise RuntimeError('fell over')
+
+    ActionDesignator.resolvers.extend([plan_for('waving', wave), plan_for('falling', fall)])
+    performed = []
+    unsubscribe = events.subscribe(events.DESIGNATOR_PERFORMED, lambda **kw: performed.append(kw))
+    try:
+        perform(ActionDesignator(type='waving'))
+        with pytest.raises(RuntimeError):
+            perform(ActionDesignator(type='falling'))
+        with pytest.raises(NoSolutionError):
+            perform(ActionDesignator(type='flying'))
+    finally:
+        unsubscribe()
+    assert [(p['designator'].prop_value('type'), p['solution'], type(p['error']).__name__)
+            for p in performed] == [('waving', wave, 'NoneType'), ('falling', fall, 'RuntimeError'),
+                                    ('flying', None, 'NoSolutionError')]
 
 
 def test_action_resolver_returning_non_plan():

@@ -7,6 +7,7 @@ import threading
 import pytest
 
 from pycram.designator import MotionDesignator, perform
+from pycram.fluent import Fluent
 from pycram.language import State, par, pursue
 from pycram.process_module import (Execution, ExecutionCancelled, NoProcessModuleError,
                                    ProcessModule, ProcessModuleError, ProcessModuleFailure,
@@ -183,6 +184,51 @@ def test_status_transitions():
         perform(motion(3))
     module.start()
     assert module.status.get_value() is S.WAITING
+
+
+class RecordingFluent(Fluent):
+    """A fluent that remembers every value it was set to (to check exact transitions)."""
+
+    def __init__(self, value):
+        super().__init__(value)
+        self.history = [value]
+
+    def set_value(self, value):
+        self.history.append(value)
+        super().set_value(value)
+
+
+def test_status_fluent_exact_transitions_over_every_outcome():
+    module = ScriptedProcessModule('arm', hold=True, script=['ok', RuntimeError('stuck'), 'never'])
+    module.status = RecordingFluent(module.status.get_value())
+    route_all_to(module)
+    module.release(2)
+    assert perform(motion(1)) == 'ok'
+    with pytest.raises(ProcessModuleFailure):
+        perform(motion(2))
+    state = pursue(lambda: perform(motion(3)), lambda: module.wait_started(3, TIMEOUT))
+    assert state.get_value() is State.SUCCEEDED
+    module.shutdown()
+    module.start()
+    assert module.status.history == [S.WAITING, S.RUNNING, S.SUCCEEDED, S.RUNNING, S.FAILED,
+                                     S.RUNNING, S.CANCELLED, S.OFFLINE, S.WAITING]
+
+
+def test_plan_waits_on_the_status_fluent():
+    """A plan branch waits for the module to be RUNNING, then for its outcome."""
+    module = ScriptedProcessModule('head', hold=True)
+    route_all_to(module)
+    seen = []
+
+    def watcher():
+        wait_true(module.status == S.RUNNING)
+        seen.append(module.status.get_value())
+        module.release()
+        wait_true(module.status == S.SUCCEEDED)
+        seen.append(module.status.get_value())
+
+    state = par(lambda: perform(motion(1)), watcher)
+    assert state.get_value() is State.SUCCEEDED and seen == [S.RUNNING, S.SUCCEEDED]
 
 
 def test_shutdown_fails_queued_designators():
@@ -387,6 +433,37 @@ def test_cancel_while_running_plain_python_execute():
     assert state.get_value() is State.SUCCEEDED
     assert module.stopped == [1] and module.status.get_value() is S.CANCELLED
     assert module.current is None and module.queued.get_value() == 0
+
+
+def test_executions_and_performed_designators_are_published_as_events():
+    from pycram import events
+
+    executed, performed = [], []
+    unsubscribe = [events.subscribe(events.PROCESS_MODULE_EXECUTED,
+                                    lambda **kw: executed.append(kw)),
+                   events.subscribe(events.DESIGNATOR_PERFORMED,
+                                    lambda **kw: performed.append(kw))]
+    try:
+        module = ScriptedProcessModule('nav', hold=True,
+                                       script=[lambda d: d.reference(), KeyError('map')])
+        route_all_to(module)
+        MotionDesignator.resolvers.append(lambda d: [{'cmd': 'move', 'n': d.prop_value('n')}])
+        module.release(2)
+        perform(motion(1))
+        with pytest.raises(ProcessModuleFailure):
+            perform(motion(2))
+        pursue(lambda: perform(motion(3)), lambda: module.wait_started(3, TIMEOUT))
+    finally:
+        for u in unsubscribe:
+            u()
+    assert [(e['module'], e['designator'].prop_value('n'), e['outcome']) for e in executed] == [
+        (module, 1, 'succeeded'), (module, 2, 'failed'), (module, 3, 'cancelled')]
+    assert all(e['start'] is not None and e['start'] <= e['end'] for e in executed)
+    assert isinstance(executed[1]['error'], KeyError)  # the module's own error
+    assert executed[0]['error'] is None and executed[2]['error'] is None
+    assert [(p['designator'].prop_value('n'), type(p['error']).__name__) for p in performed] == [
+        (1, 'NoneType'), (2, 'ProcessModuleFailure'), (3, 'Evaporated')]
+    assert performed[0]['solution'] == {'cmd': 'move', 'n': 1}  # resolved by _execute
 
 
 def test_public_surface():

@@ -13,7 +13,8 @@ import pytest
 
 from pycram.designator import MotionDesignator, perform
 from pycram.language import State, par
-from pycram.process_module import NoProcessModuleError, ProcessModule
+from pycram.fluent import Fluent
+from pycram.process_module import NoProcessModuleError, ProcessModule, ProcessModuleStatus
 from pycram.robot import Robot, current_robot, use_robot, use_world
 
 
@@ -89,18 +90,34 @@ class FakeHead(ProcessModule):
             self.journal.add('head', 'point_head_to', solution['coordinates'])
 
 
-class FakeArm(ProcessModule):
-    """One physical arm (Pr2ArmL / Pr2ArmR of the thesis)."""
+class Control:
+    """Stand-in for the thesis' ``control.py`` (``c``): records every command in a journal.
 
-    def __init__(self, journal, side):
-        super().__init__(f'arm_{side}')
+    ``set_arm_joints`` waits (at most 5 s) until both arms are moving at the same time and
+    records whether they were -- two arm process modules must run concurrently.
+    """
+
+    def __init__(self, journal):
         self.journal = journal
-        self.side = side
+        self._lock = threading.Lock()
+        self._moving = 0
+        self.most_arms_moving = Fluent(0)  # never decreases: a waiter cannot miss the peak
 
-    def _execute(self, designator):
-        solution = designator.reference()
-        if solution['cmd'] == 'set_arm_joints':
-            self.journal.add(self.name, 'set_arm_joints', solution['positions'])
+    def move_to(self, pose, wait, frame):
+        self.journal.add('navigation', 'move_to', pose, frame)
+
+    def point_head_to(self, x, y, z, wait, frame):
+        self.journal.add('head', 'point_head_to', (x, y, z))
+
+    def set_arm_joints(self, arm, positions, wait):
+        with self._lock:
+            self._moving += 1
+            if self._moving > self.most_arms_moving.get_value():
+                self.most_arms_moving.set_value(self._moving)
+        together = (self.most_arms_moving >= 2).wait_for(5.0)
+        self.journal.add(f'arm_{arm}', 'set_arm_joints', positions, f'together={together}')
+        with self._lock:
+            self._moving -= 1
 
 
 class OnlyArm(ProcessModule):
@@ -109,8 +126,18 @@ class OnlyArm(ProcessModule):
     def __init__(self, journal):
         super().__init__('arm')
         self.journal = journal
+        self.inside = 0
+        self.max_inside = 0
 
     def _execute(self, designator):
+        self.inside += 1
+        self.max_inside = max(self.max_inside, self.inside)
+        try:
+            self._serve(designator)
+        finally:
+            self.inside -= 1
+
+    def _serve(self, designator):
         solution = designator.reference()
         if solution['cmd'] == 'set_arm_joints':
             requested = {'0': 'left', '1': 'right'}[solution['arm']]
@@ -119,27 +146,57 @@ class OnlyArm(ProcessModule):
 
 
 def make_two_armed_robot():
+    """The thesis' ch. 4.2.2 process modules, as written there, bundled into a test robot."""
     journal = Journal()
-    robot = Robot('two-armed-test-robot')
-    navigation = robot.add_process_module('navigation', FakeNavigation(journal))
-    head = robot.add_process_module('head', FakeHead(journal))
-    arm_l = robot.add_process_module('arm_left', FakeArm(journal, 'left'))
-    arm_r = robot.add_process_module('arm_right', FakeArm(journal, 'right'))
-    robot.motion_resolvers.append(motion_resolver(joint_count=7))
+    c = Control(journal)
 
-    def available_process_modules(design):  # thesis ch. 4.2.2: dispatch on type and arm
+    class Pr2Navigation(ProcessModule):
+        def _execute(self, designator):
+            solution = designator.reference()
+            if solution['cmd'] == 'move':
+                c.move_to(solution['pose'], solution['wait'], solution['frame'])
+
+    class Pr2Head(ProcessModule):
+        def _execute(self, designator):
+            solution = designator.reference()
+            if solution['cmd'] == 'point_head':
+                coordinates = solution['coordinates']
+                c.point_head_to(coordinates[0], coordinates[1], coordinates[2],
+                                solution['wait'], solution['frame'])
+
+    class Pr2ArmL(ProcessModule):
+        def _execute(self, designator):
+            solution = designator.reference()
+            if solution['cmd'] == 'set_arm_joints':
+                c.set_arm_joints('l', solution['positions'], solution['wait'])
+
+    class Pr2ArmR(ProcessModule):
+        def _execute(self, designator):
+            solution = designator.reference()
+            if solution['cmd'] == 'set_arm_joints':
+                c.set_arm_joints('r', solution['positions'], solution['wait'])
+
+    pr2_navigation = Pr2Navigation()
+    pr2_head = Pr2Head()
+    pr2_arm_l = Pr2ArmL()
+    pr2_arm_r = Pr2ArmR()
+
+    def available_pr2_process_modules(design):  # thesis ch. 4.2.2: dispatch on type and arm
         if design.check_constraints([('type', 'moving')]):
-            return navigation
+            return pr2_navigation
         if design.check_constraints([('type', 'pointing_head')]):
-            return head
+            return pr2_head
         if design.check_constraints([('type', 'setting_arm_joints')]):
             if design.check_constraints([('arm', '0')]):
-                return arm_l
+                return pr2_arm_l
             if design.check_constraints([('arm', '1')]):
-                return arm_r
+                return pr2_arm_r
         return None
 
-    robot.process_module_resolvers.append(available_process_modules)
+    robot = Robot('two-armed-test-robot', {'navigation': pr2_navigation, 'head': pr2_head,
+                                           'arm_left': pr2_arm_l, 'arm_right': pr2_arm_r})
+    robot.motion_resolvers.append(motion_resolver(joint_count=7))
+    robot.process_module_resolvers.append(available_pr2_process_modules)
     return robot, journal
 
 
@@ -192,9 +249,12 @@ def test_same_plan_on_two_armed_robot():
     entries = journal.entries
     assert entries[0] == ('navigation', 'move_to', 'p0', 'map')
     by_module = {e[0]: e for e in entries[1:]}
-    assert by_module['arm_left'][2] == JOINTS and by_module['arm_right'][2] == JOINTS
+    # one module per arm: both arms moved at the same time
+    assert by_module['arm_l'] == ('arm_l', 'set_arm_joints', JOINTS, 'together=True')
+    assert by_module['arm_r'] == ('arm_r', 'set_arm_joints', JOINTS, 'together=True')
     assert by_module['head'] == ('head', 'point_head_to', (1, 2, 3))
     assert len(entries) == 4
+    assert robot.process_module('arm_left').status.get_value() is ProcessModuleStatus.SUCCEEDED
 
 
 def test_same_plan_on_one_armed_robot():
@@ -207,6 +267,7 @@ def test_same_plan_on_one_armed_robot():
     assert arm_entries == [('arm', 'set_arm_joints', JOINTS[:6], 'requested left'),
                            ('arm', 'set_arm_joints', JOINTS[:6], 'requested right')]
     assert ('head', 'point_head_to', (1, 2, 3)) in entries and len(entries) == 4
+    assert robot.process_module('arm').max_inside == 1  # one arm: the requests took turns
 
 
 def test_active_robot_is_process_global_across_plan_branches():

@@ -145,6 +145,16 @@ def _merge(properties: list[Property], key: Any, value: Any) -> None:
         properties.append((key, value))
 
 
+def known_solution(designator: Any) -> Any:
+    """The solution of ``designator`` if it was already resolved (is effective), else ``None``.
+
+    Never resolves and never blocks (for reporting, e.g. :mod:`pycram.events`).
+    """
+    if isinstance(designator, Designator) and designator._effective:
+        return designator._data
+    return None
+
+
 def _short(value: Any, limit: int = 60) -> str:
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -10,7 +10,8 @@ candidate only if no *validator* (same three sources, ``location_validators`` /
   or ``None`` when it does not apply to this designator (check ``designator.check_constraints``).
   Generators may be infinite: they are advanced lazily.
 - validator: ``f(designator, pose) -> bool | None``; ``False`` rejects, ``True`` or ``None``
-  (does not apply) accept.
+  (does not apply) accept a generated candidate. :meth:`LocationDesignator.contains` (used for
+  an object's ``('at', location)``) is stricter: some validator must affirm the pose.
 
 Guarantees: a resolver that raises becomes a ``ResolverError`` naming it; an infinite generator
 whose candidates are all rejected does not hang: after ``max_rejected`` consecutive rejections
@@ -21,8 +22,8 @@ from __future__ import annotations
 
 from typing import Any, Callable, ClassVar, Iterator
 
-from pycram.designators.core import (LazyDesignator, NoSolutionError, call_resolver,
-                                     callable_name, expand_solutions)
+from pycram.designators.core import (DesignatorError, LazyDesignator, NoSolutionError,
+                                     call_resolver, callable_name, expand_solutions)
 
 __all__ = ["LocationDesignator"]
 
@@ -48,14 +49,37 @@ class LocationDesignator(LazyDesignator):
         return self._current_generators()
 
     def accepts(self, pose: Any, validators: Any = None) -> bool:
-        """``True`` iff no validator rejects ``pose`` for this designator.
-
-        Used by object designators for ``('at', location)``. A validator that raises is reported
-        as ``ResolverError``.
+        """``True`` iff no validator rejects ``pose`` for this designator (the filter applied to
+        generated candidates). A validator that raises is reported as ``ResolverError``.
         """
         for validator in self._current_validators() if validators is None else validators:
             if call_resolver(self, validator, pose) is False:
                 return False
+        return True
+
+    def contains(self, pose: Any) -> bool:
+        """``True`` iff ``pose`` lies in this location: no validator rejects it and at least one
+        validator affirms it (returns ``True``).
+
+        Used by object designators for ``('at', location)``. Unlike :meth:`accepts`, "no
+        validator applies" is not taken as a yes (that would make every object match): it raises
+        :class:`DesignatorError` naming this designator and the validators asked. A validator
+        that raises is reported as ``ResolverError``.
+        """
+        validators = self._current_validators()
+        affirmed = False
+        for validator in validators:
+            verdict = call_resolver(self, validator, pose)
+            if verdict is False:
+                return False
+            if verdict is not None:
+                affirmed = True
+        if not affirmed:
+            from pycram.robot import describe_active_robot
+            raise DesignatorError(
+                f"Cannot tell whether {pose!r} is in {self!r}: no location validator applies "
+                f"(validators asked: {[callable_name(v) for v in validators]}; "
+                f"{describe_active_robot()})")
         return True
 
     def _generate(self) -> Iterator[Any]:

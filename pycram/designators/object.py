@@ -93,8 +93,10 @@ class ObjectDesignator(LazyDesignator):
 
     A candidate object matches when, for every property ``(key, value)``:
 
-    - ``value`` is a :class:`LocationDesignator` (e.g. ``('at', loc)``): the object's pose is
-      accepted by ``value.accepts(pose)``;
+    - ``value`` is a :class:`LocationDesignator` (e.g. ``('at', loc)``): the object's pose lies
+      in it, ``value.contains(pose)`` (a validator affirms it and none rejects it; when no
+      validator applies to the location this raises :class:`DesignatorError` rather than
+      matching every object);
     - ``value`` is another designator: the object's property ``key`` is that designator's
       resolved solution (or the designator itself);
     - ``value`` is callable: ``value(object_value)`` is true (predicates, e.g. on size);
@@ -117,7 +119,7 @@ class ObjectDesignator(LazyDesignator):
         for key, value in self._properties:
             if isinstance(value, LocationDesignator):
                 pose = _object_value(obj, "pose")
-                if pose is _MISSING or not value.accepts(pose):
+                if pose is _MISSING or not value.contains(pose):
                     return False
                 continue
             actual = _object_value(obj, key)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
+from pycram import events
 from pycram.designators.action import ActionDesignator
 from pycram.designators.core import UnknownKindError
 from pycram.designators.motion import MotionDesignator
@@ -26,18 +27,28 @@ def perform(designator: Any) -> Any:
       unchanged (so failure handling in the caller sees the plan's own errors).
     - anything else: :class:`UnknownKindError`.
 
+    Every performed designator is announced on :mod:`pycram.events` (``DESIGNATOR_PERFORMED``,
+    with its solution -- the plan for an action -- and the exception, if any).
+
     Evaporable: evaporating the calling task stops the motion or plan (see process modules).
     """
     if isinstance(designator, MotionDesignator):
         from pycram.process_module import ProcessModule
         return ProcessModule.perform(designator)
     if isinstance(designator, ActionDesignator):
-        plan = designator.reference()
-        action_type = designator.prop_value("type")
-        name = f"perform {action_type}" if action_type is not None else "perform action"
-        logger.debug("performing %r with plan %r", designator, plan)
-        from pycram.runtime import run_subtask
-        return run_subtask(name, plan, designator, kind="action")
+        plan = None
+        try:
+            plan = designator.reference()
+            action_type = designator.prop_value("type")
+            name = f"perform {action_type}" if action_type is not None else "perform action"
+            logger.debug("performing %r with plan %r", designator, plan)
+            from pycram.runtime import run_subtask
+            result = run_subtask(name, plan, designator, kind="action")
+        except BaseException as e:
+            events.designator_performed(designator, plan, e)
+            raise
+        events.designator_performed(designator, plan, None)
+        return result
     raise UnknownKindError(
         f"perform() accepts motion and action designators, got {designator!r} "
         f"({type(designator).__name__})")
