@@ -45,6 +45,9 @@ _STYLE = {
     "interrupted": "yellow",
     "created": "grey50",
 }
+#: Runs of this many identical successful siblings are shown as one line / box / row (×N);
+#: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
+_COLLAPSE = 3
 _MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·"}
 
 DbOption = typer.Option(None, "--db", help="SQLAlchemy URL of the trace database (default: $PYCRAM_DB_URL or "
@@ -117,13 +120,20 @@ def runs_command(
                       f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {_duration(run.elapsed)}", soft_wrap=True)
 
 
-def _label(record: Any) -> str:
+def _label(node: Any) -> str:
+    """One tree line for a display node (`pycram.trace.collapse.DisplayNode`)."""
+    record = node.record
     if record.kind == "root":
         return f"[bold]{escape(record.name)}[/bold] [grey50](thread)[/grey50]"
     style = _STYLE.get(record.status, "white")
-    text = (f"[{style}]{_MARK.get(record.status, '?')}[/{style}] {escape(record.name)} "
-            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] "
-            f"{_duration(record.duration)}")
+    times = f" ×{node.count}" if node.count > 1 else ""
+    text = (f"[{style}]{_MARK.get(record.status, '?')}[/{style}] {escape(record.name)}{times} "
+            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] ")
+    if node.count > 1:
+        low, high = node.duration_range or (None, None)
+        text += f"{_duration(node.total_duration)} in all ({_duration(low)} – {_duration(high)} each)"
+    else:
+        text += _duration(record.duration)
     if record.error_type and record.status != "succeeded":
         text += f" [red]— {escape(record.error or '')}[/red]"
     return text
@@ -132,11 +142,18 @@ def _label(record: Any) -> str:
 @app.command("show")
 def show_command(
     run: Optional[int] = RunArgument,
-    max_nodes: int = typer.Option(2000, "--max-nodes", help="Stop printing after this many tasks."),
+    max_nodes: int = typer.Option(2000, "--max-nodes", help="Stop printing after this many tree lines."),
+    expand: bool = typer.Option(False, "--expand", help="One line per task: do not collapse runs of "
+                                                         "identical successful siblings into one line (×N)."),
     db: Optional[str] = DbOption,
 ) -> None:
-    """Print a run's task tree with statuses, durations and failures."""
+    """Print a run's task tree with statuses, durations and failures.
+
+    Runs of 3 or more consecutive identical successful sibling tasks (e.g. a motion repeated by
+    a `whenever` loop) are shown as one line with a count, unless --expand.
+    """
     from pycram.trace import query
+    from pycram.trace.collapse import collapse
 
     info = _trace_errors(query.get_run, run, db)
     records = _trace_errors(query.tasks, info.id, db)
@@ -146,23 +163,26 @@ def show_command(
     title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
              f"[{style}]{state}[/{style}] · {_duration(info.elapsed)} · started {_local(info.started_at)}")
     tree = Tree(title)
-    shown = 0
+    lines = tasks_shown = 0
     branches: dict[int, Tree] = {}
-    for root in query.build_tree(records):
+    for root in collapse(query.build_tree(records), min_run=0 if expand else _COLLAPSE):
         for node, _depth in root.walk():
-            if shown >= max_nodes:
+            if lines >= max_nodes:
                 break
-            r = node.record
-            parent = branches.get(r.parent_id) if r.parent_id is not None else None
-            branches[r.task_id] = (parent or tree).add(_label(r))
-            shown += 1
+            parent_id = node.record.parent_id
+            parent = branches.get(parent_id) if parent_id is not None else None
+            branch = (parent or tree).add(_label(node))
+            for member in node.records:
+                branches[member.task_id] = branch
+            lines += 1
+            tasks_shown += node.count
     console.print(tree)
     failed = sum(1 for r in records if r.status == "failed")
     summary = f"{len(records)} tasks, {failed} failed"
     if executions:
         summary += f", {len(executions)} process-module executions"
-    if shown < len(records):
-        summary += f" ({len(records) - shown} not shown; raise --max-nodes)"
+    if tasks_shown < len(records):
+        summary += f" ({len(records) - tasks_shown} not shown; raise --max-nodes)"
     console.print(summary)
     if info.error:
         console.print(f"[red]{escape(info.error)}[/red]")
@@ -172,12 +192,13 @@ def show_command(
 def graph_command(
     run: Optional[int] = RunArgument,
     output: Path = typer.Option(Path("task-tree.svg"), "--output", "-o", help="SVG file to write."),
+    expand: bool = typer.Option(False, "--expand", help="One box per task (do not collapse identical siblings)."),
     db: Optional[str] = DbOption,
 ) -> None:
-    """Draw a run's task tree as an SVG picture."""
+    """Draw a run's task tree as an SVG picture (identical successful siblings: one box ×N)."""
     from pycram.trace.pictures import write_tree_svg
 
-    path = _trace_errors(write_tree_svg, run, output, db)
+    path = _trace_errors(write_tree_svg, run, output, db, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 
@@ -186,12 +207,14 @@ def timeline_command(
     run: Optional[int] = RunArgument,
     output: Path = typer.Option(Path("timeline.png"), "--output", "-o", help="PNG file to write."),
     max_rows: int = typer.Option(200, "--max-rows", help="At most this many task rows (deeper tasks are left out)."),
+    expand: bool = typer.Option(False, "--expand", help="One row per task (do not share rows between identical siblings)."),
     db: Optional[str] = DbOption,
 ) -> None:
-    """Draw which branches ran when (a Gantt chart, one row per task) as a PNG picture."""
+    """Draw which branches ran when (a Gantt chart, one row per task; identical successful
+    siblings share a row) as a PNG picture."""
     from pycram.trace.pictures import write_timeline_png
 
-    path = _trace_errors(write_timeline_png, run, output, db, max_rows)
+    path = _trace_errors(write_timeline_png, run, output, db, max_rows, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 

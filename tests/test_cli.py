@@ -41,6 +41,31 @@ if "--fail" in sys.argv:
 """
 
 
+REPEATING_PLAN = """
+from pycram.fluent import STOP, Fluent, whenever
+from pycram.language import seq
+from pycram.runtime import run_subtask
+
+tick = Fluent(True)  # a whenever loop that points the head on every pass
+count = 0
+
+def point_head():
+    global count
+    count += 1
+    if count == 251:
+        raise RuntimeError("head stuck")
+
+def body():
+    try:
+        run_subtask("head: pointing_head", point_head, kind="process-module")
+    except RuntimeError:
+        pass
+    return STOP if count >= 254 else None
+
+seq(lambda: whenever(tick, body), name="watch head")
+"""
+
+
 @pytest.fixture
 def db(tmp_path, monkeypatch):
     url = f"sqlite:///{tmp_path / 'cli.sqlite3'}"
@@ -160,3 +185,61 @@ def test_console_script_subprocess(tmp_path, plan_file):
     assert "recorded as run 1" in out.stderr
     out = subprocess.run([*command, "runs"], capture_output=True, text=True, env=env, cwd=REPO, timeout=60)
     assert out.returncode == 0 and out.stdout.startswith("1 "), out.stderr
+
+
+def test_repeated_siblings_are_collapsed_in_displays_not_in_the_data(db, tmp_path, monkeypatch):
+    """250 identical successful head motions are one line / box / row "×250"; the failure
+    between them stays visible; the database keeps every task; --expand shows them all."""
+    import pycram.cli
+
+    monkeypatch.setattr(pycram.cli.console, "width", 200)  # one tree line per task line
+    plan = tmp_path / "head_loop.py"
+    plan.write_text(REPEATING_PLAN)
+    assert _invoke("run", str(plan)).exit_code == 0
+    from pycram.trace import query
+
+    assert sum(r.name == "head: pointing_head" for r in query.tasks(1, db)) == 254
+
+    result = _invoke("show")
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert any("head: pointing_head ×250" in line and "succeeded" in line for line in lines)
+    assert any("head: pointing_head [" in line and "RuntimeError: head stuck" in line for line in lines)
+    assert any("head: pointing_head ×3" in line for line in lines)
+    assert sum("head: pointing_head" in line for line in lines) == 3
+    assert "257 tasks, 1 failed" in result.output and "not shown" not in result.output
+
+    expanded = _invoke("show", "--expand")
+    assert sum("head: pointing_head" in line for line in expanded.output.splitlines()) == 254
+
+    svg = tmp_path / "tree.svg"
+    assert _invoke("graph", "-o", str(svg)).exit_code == 0
+    root = ET.parse(svg).getroot()
+    texts = [el.text for el in root.iter() if el.tag.endswith("text")]
+    assert "head: pointing_head ×250" in texts and "head: pointing_head ×3" in texts
+    boxes = [el for el in root.iter() if el.tag.endswith("g") and "task" in (el.get("class") or "")]
+    assert len(boxes) < 10
+    assert _invoke("graph", "--expand", "-o", str(svg)).exit_code == 0
+    texts = [el.text for el in ET.parse(svg).getroot().iter() if el.tag.endswith("text")]
+    assert texts.count("head: pointing_head") == 254
+
+    from pycram.trace.pictures import _rows_for_timeline
+
+    rows, left_out = _rows_for_timeline(query.tasks(1, db), max_rows=200)
+    assert left_out == 0 and [n.count for n, _ in rows if n.record.name == "head: pointing_head"] == [250, 1, 3]
+    png = tmp_path / "timeline.png"
+    assert _invoke("timeline", "-o", str(png)).exit_code == 0 and png.stat().st_size > 1000
+
+
+def test_db_option_names_the_database(tmp_path, plan_file, monkeypatch):
+    monkeypatch.delenv("PYCRAM_RECORD", raising=False)
+    monkeypatch.setenv("PYCRAM_DB_URL", f"sqlite:///{tmp_path / 'env.sqlite3'}")
+    other = tmp_path / "other.sqlite3"
+    assert _invoke("run", str(plan_file), "--db", f"sqlite:///{other}", "--plan", "by option",
+                   "--robot", "pr2").exit_code == 0
+    assert other.exists() and not (tmp_path / "env.sqlite3").exists()
+    line = _invoke("runs", "--db", str(other)).output.splitlines()[0]  # a bare path works too
+    fields = line.split("  ")
+    assert fields[0] == "1" and fields[2:5] == ["by option", "pr2", "succeeded"]
+    assert "no runs recorded" in _invoke("runs").output  # $PYCRAM_DB_URL: nothing there
+    assert not (tmp_path / "env.sqlite3").exists()  # reading created nothing

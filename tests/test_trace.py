@@ -170,26 +170,162 @@ def test_watch_holds_no_polling_thread_and_unwatch(tmp_path):
 
 
 def test_callbacks_never_wait_for_the_database(tmp_path):
-    """A locked database must not slow the plan: rows are queued and written later."""
-    path = tmp_path / "locked.sqlite3"
-    url = f"sqlite:///{path}"
-    recorder = start_recording(url, plan="locked")
-    import sqlite3
+    """A writer stuck in the database must not stop the plan: rows are queued, written later.
 
-    blocker = sqlite3.connect(path, timeout=0.1, isolation_level=None)
-    blocker.execute("BEGIN EXCLUSIVE")
+    The writer is blocked inside a statement (a SQLAlchemy hook waits on a gate) while a plan
+    runs 300 tasks, sets a watched fluent and publishes events. If any plan-thread callback
+    waited for the database, the plan could not end before the gate opens.
+    """
+    url = f"sqlite:///{tmp_path / 'blocked.sqlite3'}"
+    recorder = start_recording(url, plan="blocked")
+    entered, gate = threading.Event(), threading.Event()
+
+    def block_writer(*_args) -> None:
+        if threading.current_thread() is recorder._writer:
+            entered.set()
+            gate.wait()
+
+    sa.event.listen(recorder._engine, "before_cursor_execute", block_writer)
+    fluent = Fluent(0, name="level")
+    recorder.watch(fluent, "level", max_rate_hz=None)
     try:
-        started = time.monotonic()
-        seq(*[(lambda: None) for _ in range(300)], name="fast")
-        elapsed = time.monotonic() - started
+        seq(lambda: None, name="first")
+        assert entered.wait(30), "the writer never tried to write"
+
+        def plan() -> None:
+            seq(*[(lambda: None) for _ in range(300)], name="fast")
+            for i in range(50):
+                fluent.set_value(i)
+            events.process_module_executed("arm", "reach", "succeeded", 0.0, 1.0)
+            events.designator_performed("a designator", solution="a solution")
+
+        runner = threading.Thread(target=plan)
+        runner.start()
+        runner.join(60)
+        plan_ended_while_writer_blocked = not runner.is_alive() and not gate.is_set()
     finally:
-        time.sleep(0.4)
-        blocker.execute("COMMIT")
-        blocker.close()
-    assert elapsed < 1.0
+        gate.set()
+    assert plan_ended_while_writer_blocked
     run_id = recorder.finish("succeeded")
     names = [r.name for r in query.tasks(run_id, url)]
-    assert names.count("fast") == 1 and len(names) >= 302
+    assert names.count("fast") == 1 and len(names) >= 303
+    assert [s.number for s in query.fluent_samples(run_id, "level", url)] == [float(i) for i in [0, *range(50)]]
+    assert len(query.executions(run_id, url=url)) == 1 and len(query.designators(run_id, url=url)) == 1
+
+
+def test_idle_run_keeps_a_heartbeat(tmp_path):
+    """A plan that creates no task for a while still shows as alive (last_seen_at advances)."""
+    url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
+    recorder = start_recording(url, plan="idle", heartbeat_interval=0.05)
+    try:
+        first = query.get_run(recorder.run_id, url).last_seen_at
+        deadline = time.monotonic() + 30
+        seen = first
+        while seen == first and time.monotonic() < deadline:
+            time.sleep(0.05)  # polling the database from the test, not timing the recorder
+            seen = query.get_run(recorder.run_id, url).last_seen_at
+        assert seen > first
+        assert query.get_run(recorder.run_id, url).state == "running"
+    finally:
+        recorder.finish()
+
+
+def test_module_level_watch_and_default_rate(tmp_path):
+    import pycram.trace as trace
+
+    url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
+    f = Fluent(0, name="speed")
+    assert trace.watch(f) == 0  # nothing records: a no-op
+    recorder = trace.start_recording(url, plan="watch", fluent_rate_hz=None)  # default: every change
+    assert trace.active_recorders() == [recorder]
+    assert trace.watch(f) == 1  # named after the fluent
+    for i in range(1, 20):
+        f.set_value(i)
+    run_id = recorder.finish()
+    assert trace.active_recorders() == [] and trace.watch(Fluent(1)) == 0
+    assert [s.number for s in query.fluent_samples(run_id, "speed", url)] == [float(i) for i in range(20)]
+
+
+def test_designators_and_process_modules_of_a_real_plan(tmp_path):
+    """perform() of action and motion designators on a robot's process modules is recorded:
+    the designator with the solution it resolved to, and each execution with module,
+    designator, outcome and duration."""
+    from pycram.designator import ActionDesignator, MotionDesignator, perform, plan_for
+    from pycram.process_module import ProcessModuleFailure
+    from pycram.robot import Robot
+    from pycram.testing import ScriptedProcessModule
+
+    url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
+    head = ScriptedProcessModule("head")
+    gripper = ScriptedProcessModule("gripper", script=[RuntimeError("slipped")])
+    robot = Robot("test-robot")
+    robot.add_process_module("head", head)
+    robot.add_process_module("gripper", gripper)
+    robot.process_module_resolvers.append(lambda d: head if d.prop_value("type") == "looking" else gripper)
+    robot.motion_resolvers.append(lambda d: [{"command": d.prop_value("type")}])
+
+    def look_around(designator) -> None:
+        perform(MotionDesignator(type="looking", target="table"))
+
+    robot.action_resolvers.append(plan_for("looking-around", look_around))
+    recorder = start_recording(url, plan="designators", robot=robot.name)
+    with robot:
+        perform(ActionDesignator(type="looking-around"))
+        with pytest.raises(ProcessModuleFailure):
+            perform(MotionDesignator(type="gripping"))
+    run_id = recorder.finish("succeeded")
+
+    desigs = {d.designator_type: d for d in query.designators(run_id, url=url)}
+    assert set(desigs) == {"looking-around", "looking", "gripping"}
+    assert desigs["looking-around"].designator_class == "ActionDesignator"
+    assert "look_around" in desigs["looking-around"].solution  # the plan it resolved to
+    assert desigs["looking"].designator_class == "MotionDesignator"
+    assert desigs["looking"].solution == "{'command': 'looking'}" and desigs["looking"].error_type is None
+    assert "'target', 'table'" in desigs["looking"].designator
+    assert desigs["gripping"].error_type == "ProcessModuleFailure" and "slipped" in desigs["gripping"].error_message
+    execs = query.executions(run_id, url=url)
+    assert [(x.module, x.designator_type, x.outcome) for x in execs] == [("head", "looking", "succeeded"),
+                                                                         ("gripper", "gripping", "failed")]
+    assert all(x.duration is not None and x.duration >= 0 for x in execs)
+    assert "slipped" in execs[1].error_message
+    action = next(r for r in query.tasks(run_id, url) if r.name == "perform looking-around")
+    assert execs[0].task_id == action.task_id  # the execution belongs to the action's task
+    assert query.executions(outcome="failed", url=url)[0].module == "gripper"
+
+
+def test_query_across_runs(tmp_path):
+    """The query API over several runs: all failed grasps, the durations of one action."""
+    url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
+
+    def grasp(ok: bool) -> None:
+        if not ok:
+            raise Boom("nothing between the fingers")
+
+    run_ids = []
+    for outcomes in ([False, True], [False, False, True], [True]):
+        recorder = start_recording(url, plan="fetch")
+        for ok in outcomes:
+            seq(lambda ok=ok: run_subtask("perform grasping", grasp, ok, kind="action"), errors=[])
+        run_subtask("perform navigating", sleep, 0.001, kind="action")
+        run_ids.append(recorder.finish("succeeded"))
+    failed = query.failed_tasks(name="grasp", kind="action", url=url)
+    assert [r.run_id for r in failed] == [run_ids[1], run_ids[1], run_ids[0]]  # newest run first
+    assert {r.error for r in failed} == {"Boom: nothing between the fingers"}
+    assert query.failed_tasks(error_type="boom", run_id=run_ids[2], url=url) == []
+    assert len(query.durations("perform grasping", url=url)) == 6
+    assert len(query.durations("perform grasping", status="succeeded", url=url)) == 3
+    navigating = query.durations("perform navigating", kind="action", url=url)
+    assert len(navigating) == 3 and all(d >= 0.001 for d in navigating)
+    assert [r.id for r in query.runs(url, plan="FET")] == run_ids[::-1]
+
+
+def test_reading_a_missing_sqlite_file_creates_nothing(tmp_path):
+    path = tmp_path / "nothing-here.sqlite3"
+    assert query.runs(f"sqlite:///{path}") == []
+    with pytest.raises(query.RunNotFound, match="no run has been recorded"):
+        query.get_run(None, str(path))
+    assert query.failed_tasks(url=str(path)) == []
+    assert not path.exists()
 
 
 def test_scope_records_only_tasks_below(tmp_path):
@@ -263,6 +399,16 @@ def test_default_url_and_env(monkeypatch, tmp_path):
     assert default_url() == f"sqlite:///{tmp_path / 'home' / 'runs.sqlite3'}"
     monkeypatch.setenv("PYCRAM_DB_URL", "sqlite:///elsewhere.sqlite3")
     assert resolve_url(None) == "sqlite:///elsewhere.sqlite3"
+    monkeypatch.setenv("PYCRAM_DB_URL", str(tmp_path / "env.sqlite3"))  # a bare path: a SQLite file
+    assert resolve_url(None) == f"sqlite:///{tmp_path / 'env.sqlite3'}"
+    assert resolve_url("  ") == f"sqlite:///{tmp_path / 'env.sqlite3'}"
+    monkeypatch.delenv("PYCRAM_DB_URL")
+    monkeypatch.delenv("PYCRAM_HOME")
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "xdg"))
+    assert default_url() == f"sqlite:///{tmp_path / 'xdg' / 'pycram' / 'runs.sqlite3'}"
+    monkeypatch.delenv("XDG_DATA_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "user"))
+    assert default_url() == f"sqlite:///{tmp_path / 'user' / '.local' / 'share' / 'pycram' / 'runs.sqlite3'}"
     assert resolve_url("sqlite:///x.db") == "sqlite:///x.db"
     assert resolve_url(str(tmp_path / "a.sqlite3")) == f"sqlite:///{tmp_path / 'a.sqlite3'}"
 
@@ -321,7 +467,7 @@ def _child(url: str, plan: str, count: int) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def test_sigkilled_run_keeps_its_trace_up_to_the_last_second(db_url):
+def test_sigkilled_run_keeps_its_trace_up_to_the_last_second(db_url, tmp_path):
     proc = _child(db_url, "killed", 100_000)
     try:
         first = proc.stdout.readline().split()
@@ -347,6 +493,20 @@ def test_sigkilled_run_keeps_its_trace_up_to_the_last_second(db_url):
     done = {r.name for r in records if r.status == "succeeded"}
     assert all(f"killed step {i}" in done for i in range(safe + 1))
     assert run.last_seen_at is not None
+    # the partial trace is readable by the CLI and the pictures (the run shows as unfinished
+    # once its heartbeat is 10 s old; until then as running)
+    from typer.testing import CliRunner
+
+    from pycram.cli import app
+    from pycram.trace.pictures import write_run_pictures
+
+    shown = CliRunner().invoke(app, ["show", str(run_id), "--db", db_url, "--max-nodes", "50"])
+    assert shown.exit_code == 0, shown.output
+    assert f"run {run_id}: killed" in shown.output and "killed step 0" in shown.output
+    listed = CliRunner().invoke(app, ["runs", "--db", db_url])
+    assert listed.output.startswith(f"{run_id} ")
+    svg, png = write_run_pictures(run_id, tmp_path / "pictures", url=db_url)
+    assert "killed step 0" in svg.read_text() and png.stat().st_size > 1000
 
 
 def test_concurrent_runs_in_one_database_stay_separate(db_url):
@@ -377,3 +537,45 @@ def test_two_recorders_in_one_process(tmp_path):
     names_b = {r.name for r in query.tasks(b_id, url)}
     assert {"shared", "both"} <= names_a and "only b" not in names_a
     assert {"both", "only b"} <= names_b and "shared" not in names_b
+
+
+# -- collapsing repeated siblings in displays ----------------------------------------------------
+
+def _record(task_id: int, parent: int | None, name: str, status: str = "succeeded", start: float = 0.0,
+            kind: str = "task") -> query.TaskRecord:
+    return query.TaskRecord(1, task_id, parent, name, kind, None, None, status, start, start + 0.1, 0.1,
+                            "Boom" if status == "failed" else None, None)
+
+
+def test_collapse_merges_identical_successful_siblings_only():
+    from pycram.trace.collapse import collapse
+
+    records = [_record(1, None, "MainThread", kind="root"), _record(2, 1, "loop")]
+    next_id = 3
+
+    def add(parent: int, name: str, status: str = "succeeded", child: str | None = None) -> None:
+        nonlocal next_id
+        task_id = next_id
+        records.append(_record(task_id, parent, name, status, start=float(task_id)))
+        next_id += 1
+        if child is not None:
+            records.append(_record(next_id, task_id, child, start=float(task_id)))
+            next_id += 1
+
+    for _ in range(4):
+        add(2, "look", child="move head")  # identical subtrees: merged, children merged too
+    add(2, "look", child="move eyes")  # a different subtree: its own node
+    add(2, "look", "failed")
+    add(2, "look", "failed")  # failures are never merged
+    add(2, "grasp")
+    add(2, "grasp")  # a run shorter than 3 stays as it is
+    roots = collapse(query.build_tree(records))
+    shown = [(node.record.name, node.count, depth) for node, depth in roots[0].walk()]
+    assert shown == [("MainThread", 1, 0), ("loop", 1, 1), ("look", 4, 2), ("move head", 4, 3),
+                     ("look", 1, 2), ("move eyes", 1, 3), ("look", 1, 2), ("look", 1, 2),
+                     ("grasp", 1, 2), ("grasp", 1, 2)]
+    every = sorted(r.task_id for node, _ in roots[0].walk() for r in node.records)
+    assert every == sorted(r.task_id for r in records)  # nothing dropped, nothing twice
+    assert [n.count for n, _ in collapse(query.build_tree(records), min_run=0)[0].walk()] == [1] * len(records)
+    group = roots[0].children[0].children[0]
+    assert group.total_duration == pytest.approx(0.4) and group.duration_range == pytest.approx((0.1, 0.1))

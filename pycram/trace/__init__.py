@@ -5,7 +5,8 @@ starts, a query runs or a picture is drawn (the `db` extra).
 
 - `Recorder` / `start_recording(url=None, plan=None, robot=None)` (`pycram.trace.recorder`):
   record the task tree, performed designators, process-module executions and watched fluents
-  of a run; `recording_enabled(default)` reads `$PYCRAM_RECORD`.
+  of a run; `recording_enabled(default)` reads `$PYCRAM_RECORD`; `watch(fluent, name)` records a
+  fluent in every active recorder (no-op when nothing records).
 - `pycram.trace.query`: runs, tasks, failures and durations across runs.
 - `pycram.trace.pictures`: task-tree SVG, timeline (Gantt) PNG, `write_run_pictures`.
 - `pycram.trace.db`: URLs (`$PYCRAM_DB_URL`, default SQLite file), schema, `TraceDatabaseError`.
@@ -19,6 +20,8 @@ __all__ = [
     "Recorder",
     "start_recording",
     "recording_enabled",
+    "watch",
+    "active_recorders",
     "TraceDatabaseError",
     "default_url",
     "write_run_pictures",
@@ -28,6 +31,8 @@ _LAZY = {
     "Recorder": "pycram.trace.recorder",
     "start_recording": "pycram.trace.recorder",
     "recording_enabled": "pycram.trace.recorder",
+    "watch": "pycram.trace.recorder",
+    "active_recorders": "pycram.trace.recorder",
     "TraceDatabaseError": "pycram.trace.db",
     "default_url": "pycram.trace.db",
     "write_run_pictures": "pycram.trace.pictures",

@@ -7,7 +7,8 @@ Guarantees
 ----------
 - `resolve_url(None)` is `$PYCRAM_DB_URL` if set, else a SQLite file in the default folder
   (`$PYCRAM_HOME`, else `$XDG_DATA_HOME/pycram`, else `~/.local/share/pycram`), whose folder
-  is created on demand.
+  is created on demand (when recording; reading a missing SQLite file creates nothing).
+  A bare file path (given or in `$PYCRAM_DB_URL`) means that SQLite file.
 - `connect(url)` returns an engine whose connection was tested and whose schema exists. It
   raises `TraceDatabaseError` naming the URL (password hidden) and what is wrong for
   malformed URLs, unknown database kinds, missing drivers and unreachable servers.
@@ -34,7 +35,9 @@ __all__ = [
     "TraceDatabaseError",
     "default_url",
     "resolve_url",
+    "sqlite_file",
     "connect",
+    "empty_engine",
     "metadata",
     "runs_table",
     "tasks_table",
@@ -61,22 +64,44 @@ def default_folder() -> Path:
     return Path.home() / ".local" / "share" / "pycram"
 
 
+def _path_as_url(url: str) -> str:
+    """A bare filesystem path (no `://`, ending in .sqlite/.sqlite3/.db or containing a path
+    separator) as a SQLite URL; anything else unchanged."""
+    if "://" not in url and (url.endswith((".sqlite", ".sqlite3", ".db")) or os.sep in url):
+        return f"sqlite:///{Path(url).expanduser().resolve()}"
+    return url
+
+
 def default_url() -> str:
-    """`$PYCRAM_DB_URL`, or the default SQLite file `runs.sqlite3` in `default_folder()`."""
-    env = os.environ.get("PYCRAM_DB_URL")
+    """`$PYCRAM_DB_URL` (a URL or a SQLite file path), or the default SQLite file
+    `runs.sqlite3` in `default_folder()`."""
+    env = os.environ.get("PYCRAM_DB_URL", "").strip()
     if env:
-        return env
+        return _path_as_url(env)
     return f"sqlite:///{default_folder() / 'runs.sqlite3'}"
 
 
 def resolve_url(url: str | None) -> str:
     """The URL to use: `url` if given, else `default_url()`. A bare filesystem path (no
     `://`) is taken as a SQLite file."""
-    if url is None or url == "":
+    if url is None or url.strip() == "":
         return default_url()
-    if "://" not in url and (url.endswith((".sqlite", ".sqlite3", ".db")) or os.sep in url):
-        return f"sqlite:///{Path(url).expanduser().resolve()}"
-    return url
+    return _path_as_url(url.strip())
+
+
+def sqlite_file(url: str | None) -> Path | None:
+    """The file of a SQLite URL (see `resolve_url`); None for other databases, in-memory
+    SQLite and unparsable URLs."""
+    try:
+        parsed = sa.make_url(resolve_url(url))
+    except sa_exc.ArgumentError:
+        return None
+    if parsed.get_backend_name() != "sqlite":
+        return None
+    database = parsed.database
+    if not database or database == ":memory:" or database.startswith("file:"):
+        return None
+    return Path(database).expanduser()
 
 
 def display_url(url: str | URL) -> str:
@@ -259,6 +284,24 @@ def connect(url: str | None = None, *, create_schema: bool = True, cached: bool 
         with _engines_lock:
             engine = _engines.setdefault(text, engine)
     return engine
+
+
+_empty: Engine | None = None
+
+
+def empty_engine() -> Engine:
+    """A shared in-memory SQLite engine with the (empty) schema: what queries read when the
+    SQLite file they were pointed at does not exist yet -- so reading never creates it."""
+    global _empty
+    with _engines_lock:
+        if _empty is None:
+            from sqlalchemy.pool import StaticPool
+
+            engine = sa.create_engine("sqlite://", poolclass=StaticPool,
+                                      connect_args={"check_same_thread": False})
+            metadata.create_all(engine)
+            _empty = engine
+        return _empty
 
 
 def ensure_schema(engine: Engine) -> None:

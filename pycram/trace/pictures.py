@@ -6,6 +6,9 @@
 - `timeline_png(records, path)` / `write_timeline_png(run_id, path)`: one row per task, a bar
   from its start to its end colored by status (matplotlib, Agg backend, no display needed), so
   concurrent branches, retries and evaporations are visible at a glance.
+- Both draw a run of identical successful siblings (a `whenever` loop repeating a motion) as one
+  box / one row "name ×N" (`pycram.trace.collapse`; pass `min_run=0` for one per task). The
+  stored trace is never changed.
 - `write_run_pictures(run_id, folder, url=None)`: both into `folder` (`task-tree.svg`,
   `timeline.png`); `write_task_pictures(task, folder)` does the same from an in-memory task.
 
@@ -19,7 +22,8 @@ from pathlib import Path
 from typing import Any, Iterable, Sequence
 from xml.sax.saxutils import escape
 
-from pycram.trace.query import TaskNode, TaskRecord, build_tree
+from pycram.trace.collapse import MIN_RUN, DisplayNode, collapse
+from pycram.trace.query import TaskRecord, build_tree
 
 log = logging.getLogger(__name__)
 
@@ -81,33 +85,53 @@ _BOX_H = 30
 _GAP_X = 28
 
 
-def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label: int = 48) -> str:
-    """An SVG document (string) drawing the task tree of `records`, left to right."""
-    roots = build_tree(records)
+def _group_detail(node: DisplayNode) -> str:
+    r = node.record
+    if r.kind == "root":
+        return "thread"
+    if node.count > 1:
+        return f"{r.kind or 'task'} · {_status_of(r)} · {node.count} × ≈{_fmt_duration(_mean(node))}"
+    detail = f"{r.kind or 'task'} · {_status_of(r)} · {_fmt_duration(r.duration)}"
+    if r.error_type and r.status != "succeeded":
+        detail += f" · {r.error_type}"
+    return detail
+
+
+def _mean(node: DisplayNode) -> float | None:
+    total = node.total_duration
+    known = sum(1 for r in node.records if r.duration is not None)
+    return total / known if total is not None and known else None
+
+
+def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label: int = 48,
+             min_run: int = MIN_RUN) -> str:
+    """An SVG document (string) drawing the task tree of `records`, left to right.
+
+    Runs of at least `min_run` consecutive identical successful siblings are drawn as one
+    stacked box labelled "name ×N" (see `pycram.trace.collapse`; `min_run=0`: one box per task).
+    """
+    roots = collapse(build_tree(records), min_run=min_run)
     lines1: dict[int, str] = {}
     lines2: dict[int, str] = {}
     depth_of: dict[int, int] = {}
-    order: list[TaskNode] = []
+    order: list[DisplayNode] = []
     for root in roots:
         for node, depth in root.walk():
-            r = node.record
-            depth_of[r.task_id] = depth
+            key = id(node)
+            depth_of[key] = depth
             order.append(node)
-            lines1[r.task_id] = _clip(r.name, max_label)
-            detail = ("thread" if r.kind == "root" else
-                      f"{r.kind or 'task'} · {_status_of(r)} · {_fmt_duration(r.duration)}")
-            if r.error_type and r.status != "succeeded":
-                detail += f" · {r.error_type}"
-            lines2[r.task_id] = _clip(detail, max_label + 10)
+            suffix = f" ×{node.count}" if node.count > 1 else ""
+            lines1[key] = _clip(node.record.name, max_label - len(suffix)) + suffix
+            lines2[key] = _clip(_group_detail(node), max_label + 10)
     if not order:
         return ('<svg xmlns="http://www.w3.org/2000/svg" width="300" height="60">'
                 '<text x="10" y="35" font-family="sans-serif" font-size="13">no tasks recorded</text></svg>\n')
     # column widths per depth
     widths: dict[int, float] = {}
     for node in order:
-        tid = node.record.task_id
-        w = max(len(lines1[tid]) * (_CHAR_W + 0.6), len(lines2[tid]) * (_CHAR_W - 0.8)) + 16
-        widths[depth_of[tid]] = max(widths.get(depth_of[tid], 0.0), w)
+        key = id(node)
+        w = max(len(lines1[key]) * (_CHAR_W + 0.6), len(lines2[key]) * (_CHAR_W - 0.8)) + 16
+        widths[depth_of[key]] = max(widths.get(depth_of[key], 0.0), w)
     x_of_depth: dict[int, float] = {}
     x = 10.0
     for depth in range(max(widths) + 1):
@@ -115,68 +139,68 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
         x += widths.get(depth, 0) + _GAP_X
     total_w = x + 10
     top = 40.0 if title else 10.0
-    # y: leaves take consecutive rows, parents centre on their children
+    # y: leaves take consecutive rows, parents centre on their children (post-order, iterative)
     y_of: dict[int, float] = {}
-    next_row = [0]
-
-    def place(node: TaskNode) -> float:
+    row = 0
+    stack: list[tuple[DisplayNode, bool]] = [(root, False) for root in reversed(roots)]
+    while stack:
+        node, expanded = stack.pop()
         if not node.children:
-            y = top + next_row[0] * _ROW_H
-            next_row[0] += 1
+            y_of[id(node)] = top + row * _ROW_H
+            row += 1
+        elif not expanded:
+            stack.append((node, True))
+            stack.extend((child, False) for child in reversed(node.children))
         else:
-            ys = [place(child) for child in node.children]
-            y = (ys[0] + ys[-1]) / 2
-        y_of[node.record.task_id] = y
-        return y
-
-    import sys
-
-    limit = sys.getrecursionlimit()
-    sys.setrecursionlimit(max(limit, 10000))
-    try:
-        for root in roots:
-            place(root)
-    finally:
-        sys.setrecursionlimit(limit)
-    total_h = top + next_row[0] * _ROW_H + 10
+            y_of[id(node)] = (y_of[id(node.children[0])] + y_of[id(node.children[-1])]) / 2
+    total_h = top + row * _ROW_H + 10
     out: list[str] = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{total_w:.0f}" height="{total_h:.0f}" '
         f'viewBox="0 0 {total_w:.0f} {total_h:.0f}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif">',
-        f'<rect width="100%" height="100%" fill="white"/>',
+        '<rect width="100%" height="100%" fill="white"/>',
     ]
     if title:
         out.append(f'<text x="10" y="26" font-size="15" font-weight="bold">{escape(title)}</text>')
     out.append('<g fill="none" stroke="#90a4ae" stroke-width="1.2">')
     for node in order:
-        r = node.record
         if not node.children:
             continue
-        x0 = x_of_depth[depth_of[r.task_id]] + widths[depth_of[r.task_id]]
-        y0 = y_of[r.task_id] + _BOX_H / 2
+        depth = depth_of[id(node)]
+        x0 = x_of_depth[depth] + widths[depth]
+        y0 = y_of[id(node)] + _BOX_H / 2
         for child in node.children:
-            c = child.record
-            x1 = x_of_depth[depth_of[c.task_id]]
-            y1 = y_of[c.task_id] + _BOX_H / 2
+            x1 = x_of_depth[depth_of[id(child)]]
+            y1 = y_of[id(child)] + _BOX_H / 2
             xm = x0 + _GAP_X / 2
             out.append(f'<path d="M{x0:.1f},{y0:.1f} H{xm:.1f} V{y1:.1f} H{x1:.1f}"/>')
     out.append('</g>')
     for node in order:
         r = node.record
-        tid = r.task_id
+        key = id(node)
         status = _status_of(r)
-        depth = depth_of[tid]
-        bx, by = x_of_depth[depth], y_of[tid]
+        depth = depth_of[key]
+        bx, by = x_of_depth[depth], y_of[key]
         stroke = STATUS_COLORS.get(status, "#607d8b")
         fill = _LIGHT.get(status, "#ffffff")
-        tip = f"{r.path or r.name}\n{status}, {_fmt_duration(r.duration)}"
-        if r.error:
-            tip += f"\n{r.error}"
-        out.append(f'<g class="task {escape(status)}"><title>{escape(tip)}</title>')
+        if node.count > 1:
+            low, high = node.duration_range or (None, None)
+            tip = (f"{r.path or r.name} (and {node.count - 1} identical siblings)\n{status}, "
+                   f"{node.count} tasks, {_fmt_duration(node.total_duration)} in all, "
+                   f"{_fmt_duration(low)} – {_fmt_duration(high)} each")
+        else:
+            tip = f"{r.path or r.name}\n{status}, {_fmt_duration(r.duration)}"
+            if r.error:
+                tip += f"\n{r.error}"
+        css = f"task {status}" + (" group" if node.count > 1 else "")
+        out.append(f'<g class="{escape(css)}"><title>{escape(tip)}</title>')
+        if node.count > 1:  # a stack of cards
+            out.append(f'<rect x="{bx + 4:.1f}" y="{by + 4:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" '
+                       f'rx="4" fill="{fill}" stroke="{stroke}" stroke-width="1"/>')
         out.append(f'<rect x="{bx:.1f}" y="{by:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" rx="4" '
                    f'fill="{fill}" stroke="{stroke}" stroke-width="1.6"/>')
         out.append(f'<rect x="{bx:.1f}" y="{by:.1f}" width="5" height="{_BOX_H}" rx="2" fill="{stroke}"/>')
-        out.append(f'<text x="{bx + 10:.1f}" y="{by + 13:.1f}" font-size="11" fill="#212121">{escape(lines1[tid])}</text>')
-        out.append(f'<text x="{bx + 10:.1f}" y="{by + 25:.1f}" font-size="9" fill="#546e7a">{escape(lines2[tid])}</text>')
+        out.append(f'<text x="{bx + 10:.1f}" y="{by + 13:.1f}" font-size="11" fill="#212121">{escape(lines1[key])}</text>')
+        out.append(f'<text x="{bx + 10:.1f}" y="{by + 25:.1f}" font-size="9" fill="#546e7a">{escape(lines2[key])}</text>')
         out.append('</g>')
     out.append('</svg>')
     return "\n".join(out) + "\n"
@@ -184,42 +208,45 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
 
 # -- timeline (PNG) -------------------------------------------------------------------------------
 
-def _rows_for_timeline(records: Sequence[TaskRecord], max_rows: int) -> tuple[list[tuple[TaskRecord, int]], int]:
-    """Depth-first rows (without thread roots), cut at the deepest level that fits `max_rows`.
-    Returns the rows and the number of tasks left out."""
-    rows: list[tuple[TaskRecord, int]] = []
-    for root in build_tree(records):
+def _rows_for_timeline(records: Sequence[TaskRecord], max_rows: int,
+                       min_run: int = MIN_RUN) -> tuple[list[tuple[DisplayNode, int]], int]:
+    """Depth-first rows (without thread roots; identical successful siblings share a row), cut
+    at the deepest level that fits `max_rows`. Returns the rows and the number of tasks left out."""
+    rows: list[tuple[DisplayNode, int]] = []
+    for root in collapse(build_tree(records), min_run=min_run):
         for node, depth in root.walk():
-            r = node.record
-            if r.kind == "root":
+            if node.record.kind == "root":
                 continue
-            rows.append((r, depth))
+            rows.append((node, depth))
     if len(rows) <= max_rows:
         return rows, 0
     depths = sorted({d for _, d in rows})
-    chosen = [(r, d) for r, d in rows if d <= depths[0]][:max_rows]
+    chosen = [(n, d) for n, d in rows if d <= depths[0]][:max_rows]
     for limit in depths:
-        candidate = [(r, d) for r, d in rows if d <= limit]
+        candidate = [(n, d) for n, d in rows if d <= limit]
         if len(candidate) > max_rows:
             break
         chosen = candidate
-    return chosen, len(rows) - len(chosen)
+    total = sum(n.count for n, _ in rows)
+    return chosen, total - sum(n.count for n, _ in chosen)
 
 
 def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | None = None,
-                 max_rows: int = 200, end_time: float | None = None) -> Path:
+                 max_rows: int = 200, end_time: float | None = None, min_run: int = MIN_RUN) -> Path:
     """Draw the Gantt chart of `records` into the PNG file `path`; returns the path.
 
-    Times are shown relative to the first task's start. Tasks without an end (a killed run)
-    are drawn hatched up to `end_time` (default: the latest time recorded).
+    One row per task; a run of at least `min_run` identical successful siblings shares one row
+    labelled "name ×N" with one bar per task (`min_run=0`: one row per task). Times are shown
+    relative to the first task's start. Tasks without an end (a killed run) are drawn hatched up
+    to `end_time` (default: the latest time recorded).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg  # no pyplot, no display
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
     path = Path(path)
-    rows, left_out = _rows_for_timeline(list(records), max_rows)
-    times = [t for r, _ in rows for t in (r.start, r.end) if t is not None]
+    rows, left_out = _rows_for_timeline(list(records), max_rows, min_run)
+    times = [t for node, _ in rows for r in node.records for t in (r.start, r.end) if t is not None]
     origin = min(times) if times else 0.0
     last = max(times) if times else 1.0
     if end_time is not None:
@@ -230,18 +257,26 @@ def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | N
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
     labels = []
-    for i, (r, depth) in enumerate(rows):
-        start = (r.start if r.start is not None else origin) - origin
-        end = (r.end if r.end is not None else last) - origin
-        width = max(end - start, span * 0.002)  # very short tasks stay visible
-        status = r.status
-        color = STATUS_COLORS.get(status, "#607d8b")
-        ax.barh(i, width, left=start, height=0.7, color=color, edgecolor="#37474f" if r.end is None else color,
-                hatch="//" if r.end is None else None, linewidth=0.5)
-        if r.error_type and status == "failed":
-            ax.text(start + width, i, f" {r.error_type}", va="center", fontsize=7, color="#b71c1c")
-        label = r.name if r.name == r.kind or not r.kind else f"{r.name} [{r.kind}]"
-        labels.append(_clip("  " * depth + label, 48))
+    unfinished = False
+    for i, (node, depth) in enumerate(rows):
+        by_style: dict[tuple[str, bool], list[tuple[float, float]]] = {}
+        for r in node.records:
+            start = (r.start if r.start is not None else origin) - origin
+            end = (r.end if r.end is not None else last) - origin
+            width = max(end - start, span * 0.002)  # very short tasks stay visible
+            by_style.setdefault((r.status, r.end is None), []).append((start, width))
+            if r.error_type and r.status == "failed" and node.count == 1:
+                ax.text(start + width, i, f" {r.error_type}", va="center", fontsize=7, color="#b71c1c")
+        for (status, open_ended), bars in by_style.items():
+            color = STATUS_COLORS.get(status, "#607d8b")
+            unfinished = unfinished or open_ended
+            ax.broken_barh(bars, (i - 0.35, 0.7), facecolors=color,
+                           edgecolors="#37474f" if open_ended else color,
+                           hatch="//" if open_ended else None, linewidth=0.5)
+        r = node.record
+        label = "  " * depth + (r.name if r.name == r.kind or not r.kind else f"{r.name} [{r.kind}]")
+        suffix = f" ×{node.count}" if node.count > 1 else ""
+        labels.append(_clip(label, 48 - len(suffix)) + suffix)
     ax.set_yticks(range(len(rows)))
     ax.set_yticklabels(labels, fontsize=7, family="monospace")
     width_chars = max((len(label) for label in labels), default=0)
@@ -257,9 +292,9 @@ def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | N
     if left_out:
         heading += f"  ({left_out} deeper tasks not shown)"
     ax.set_title(heading, fontsize=10, loc="left")
-    present = sorted({r.status for r, _ in rows}) or ["succeeded"]
+    present = sorted({r.status for node, _ in rows for r in node.records}) or ["succeeded"]
     handles = [Patch(color=STATUS_COLORS.get(s, "#607d8b"), label=s) for s in present]
-    if any(r.end is None for r, _ in rows):
+    if unfinished:
         handles.append(Patch(facecolor="white", edgecolor="#37474f", hatch="//", label="no end recorded"))
     ax.legend(handles=handles, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=len(handles), fontsize=8,
               frameon=False, borderaxespad=0.2)
@@ -281,23 +316,24 @@ def _title(run: Any) -> str:
     return " · ".join(parts)
 
 
-def write_tree_svg(run_id: int | None, path: str | Path, url: str | None = None) -> Path:
-    """Write the task tree of run `run_id` (newest when None) as SVG to `path`."""
+def write_tree_svg(run_id: int | None, path: str | Path, url: str | None = None, min_run: int = MIN_RUN) -> Path:
+    """Write the task tree of run `run_id` (newest when None) as SVG to `path` (see `tree_svg`)."""
     from pycram.trace import query
 
     run = query.get_run(run_id, url)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(tree_svg(query.tasks(run.id, url), title=_title(run)), encoding="utf-8")
+    path.write_text(tree_svg(query.tasks(run.id, url), title=_title(run), min_run=min_run), encoding="utf-8")
     return path
 
 
-def write_timeline_png(run_id: int | None, path: str | Path, url: str | None = None, max_rows: int = 200) -> Path:
-    """Write the timeline of run `run_id` (newest when None) as PNG to `path`."""
+def write_timeline_png(run_id: int | None, path: str | Path, url: str | None = None, max_rows: int = 200,
+                       min_run: int = MIN_RUN) -> Path:
+    """Write the timeline of run `run_id` (newest when None) as PNG to `path` (see `timeline_png`)."""
     from pycram.trace import query
 
     run = query.get_run(run_id, url)
-    return timeline_png(query.tasks(run.id, url), path, title=_title(run), max_rows=max_rows)
+    return timeline_png(query.tasks(run.id, url), path, title=_title(run), max_rows=max_rows, min_run=min_run)
 
 
 def write_run_pictures(run_id: int | None, folder: str | Path, url: str | None = None) -> list[Path]:

@@ -8,6 +8,7 @@
 Every function takes `url=None` (`$PYCRAM_DB_URL` or the default SQLite file) and returns
 plain frozen dataclasses, newest run first where runs are listed. Functions that need one run
 raise `RunNotFound` (a `LookupError`) with the ids that exist. Engines are cached per URL.
+Reading never creates a database: a SQLite file that does not exist reads as an empty trace.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ from typing import Any, Iterable, Iterator
 
 import sqlalchemy as sa
 
-from pycram.trace.db import (TraceDatabaseError, connect, designators_table, executions_table,
-                             fluent_samples_table, runs_table, tasks_table)
+from pycram.trace.db import (TraceDatabaseError, connect, designators_table, empty_engine, executions_table,
+                             fluent_samples_table, runs_table, sqlite_file, tasks_table)
 
 __all__ = [
     "RunInfo",
@@ -179,6 +180,9 @@ class FluentSample:
 
 
 def _engine(url: str | None) -> Any:
+    path = sqlite_file(url)
+    if path is not None and not path.exists():  # nothing recorded there: read an empty trace
+        return empty_engine()
     return connect(url, cached=True)
 
 

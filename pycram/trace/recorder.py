@@ -21,6 +21,10 @@ Guarantees
   samples are rate limited per fluent to `max_rate_hz`; the last value of a burst is written
   once its window passed (so the final value is never lost).
 - Database errors in the writer are logged, never raised into the plan.
+- While the run lasts, `last_seen_at` is refreshed at least every `heartbeat_interval` (2 s),
+  also when the plan is idle: a run not seen for 10 s reads as "unfinished" (killed).
+- `pycram.trace.watch(fluent, name)` adds a fluent to every active recorder (for plan scripts
+  run by `pycram run`, which never see the recorder object).
 """
 
 from __future__ import annotations
@@ -38,7 +42,7 @@ import time
 import uuid
 import weakref
 from enum import Enum
-from typing import Any, Iterable
+from typing import Any, Iterable, Literal
 
 from pycram import events
 from pycram.fluent import Fluent
@@ -46,7 +50,7 @@ from pycram.runtime import Task, add_task_listener, current_clock, current_task,
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Recorder", "start_recording", "recording_enabled"]
+__all__ = ["Recorder", "start_recording", "recording_enabled", "watch", "active_recorders"]
 
 _TEXT_LIMIT = 4000
 _current_thread = threading.current_thread
@@ -170,12 +174,16 @@ class Recorder:
     `url`: any SQLAlchemy URL (None: `$PYCRAM_DB_URL` or the default SQLite file).
     `plan`, `robot`: run metadata (also settable later with `set_run_info`).
     `scope`: record only tasks below this task (default: every task of the process).
-    `flush_interval`: seconds between batched commits.
+    `flush_interval`: seconds between batched commits (bounds what a SIGKILL loses).
+    `fluent_rate_hz`: default sampling limit of `watch` (None or 0: every change).
+    `heartbeat_interval`: an idle run still updates `last_seen_at` this often [s], so readers
+    can tell a quiet running plan (state "running") from a killed one ("unfinished").
     """
 
     def __init__(self, url: str | None = None, *, plan: str | None = None, robot: str | None = None,
                  scope: Task | None = None, flush_interval: float = 0.5, command: str | None = None,
-                 info: dict[str, Any] | None = None) -> None:
+                 info: dict[str, Any] | None = None, fluent_rate_hz: float | None = 10.0,
+                 heartbeat_interval: float = 2.0) -> None:
         from pycram.trace.db import resolve_url
 
         self.url = resolve_url(url)
@@ -183,6 +191,8 @@ class Recorder:
         self.robot = robot
         self.scope = scope
         self.flush_interval = float(flush_interval)
+        self.fluent_rate_hz = fluent_rate_hz
+        self.heartbeat_interval = float(heartbeat_interval)
         self.command = command if command is not None else " ".join(sys.argv)
         self.info: dict[str, Any] = dict(info or {})
         self.run_id: int | None = None
@@ -247,12 +257,16 @@ class Recorder:
         self.info.update(info)
         self._put(("r", self.plan, self.robot, dict(self.info)))
 
-    def watch(self, fluent: Fluent, name: str | None = None, max_rate_hz: float | None = 10.0) -> None:
-        """Sample `fluent` whenever it is set, at most `max_rate_hz` times per second
-        (None or 0: every change). The current value is recorded at once.
+    def watch(self, fluent: Fluent, name: str | None = None,
+              max_rate_hz: float | None | Literal["default"] = "default") -> None:
+        """Sample `fluent` under `name` (default: the fluent's name) whenever it is set, at most
+        `max_rate_hz` times per second ("default": the recorder's `fluent_rate_hz`; None or 0:
+        every change). The current value is recorded at once. O(1) per change, no thread.
 
         Raises ValueError if a different fluent is already watched under `name`.
         """
+        if max_rate_hz == "default":
+            max_rate_hz = self.fluent_rate_hz
         name = name or fluent.name
         existing = self._watches.get(name)
         if existing is not None:
@@ -341,7 +355,7 @@ class Recorder:
         state = _WriterState(self)
         stop = False
         while not stop:
-            timeout = self.flush_interval if self._pending_watches else None
+            timeout = self.flush_interval if self._pending_watches else self.heartbeat_interval
             try:
                 first = self._queue.get(timeout=timeout)
                 items = [first]
@@ -503,9 +517,10 @@ class _WriterState:
                 run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc())
 
         now = time.monotonic()
-        if not (inserts or updates or designators or executions or samples or run_update):
+        heartbeat_due = now - self.last_heartbeat >= min(1.0, self.recorder.heartbeat_interval)
+        if not (inserts or updates or designators or executions or samples or run_update or heartbeat_due):
             return
-        if now - self.last_heartbeat > 1.0 or run_update:
+        if heartbeat_due or run_update:
             run_update.setdefault("last_seen_at", _now_utc())
             self.last_heartbeat = now
         with self.recorder._engine.begin() as conn:
@@ -552,3 +567,22 @@ def start_recording(url: str | None = None, plan: str | None = None, robot: str 
                     **kwargs: Any) -> Recorder:
     """Create and start a `Recorder` (see its docstring); raises `TraceDatabaseError`."""
     return Recorder(url, plan=plan, robot=robot, **kwargs).start()
+
+
+def active_recorders() -> list[Recorder]:
+    """The recorders of this process that are started and not finished."""
+    return [r for r in list(_live_recorders) if r._engine is not None and not r._finished]
+
+
+def watch(fluent: Fluent, name: str | None = None,
+          max_rate_hz: float | None | Literal["default"] = "default") -> int:
+    """Record `fluent` in every active recorder (see `Recorder.watch`); returns how many.
+
+    For plan scripts run by `pycram run` (recorded by default): `pycram.trace.watch(pose,
+    "robot pose", max_rate_hz=5)`. Does nothing (returns 0) when nothing records, so library
+    code may call it unconditionally. Raises ValueError like `Recorder.watch`.
+    """
+    recorders = active_recorders()
+    for recorder in recorders:
+        recorder.watch(fluent, name, max_rate_hz)
+    return len(recorders)
