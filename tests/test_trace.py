@@ -432,6 +432,21 @@ def test_library_import_does_not_load_sqlalchemy():
     assert out.returncode == 0 and "ok" in out.stdout, out.stderr
 
 
+def test_library_use_records_nothing_unless_asked(tmp_path):
+    """Recording is off for library use: running plans writes no database and loads no
+    recorder, whatever $PYCRAM_RECORD says (that switch is for `pycram run` / `pycram demo`)."""
+    code = ("import sys; from pycram.language import par, seq; "
+            "seq(lambda: None, lambda: par(lambda: None, lambda: None)); "
+            "assert 'pycram.trace.recorder' not in sys.modules; print('ok')")
+    for record in ("", "1"):
+        env = dict(os.environ, PYCRAM_HOME=str(tmp_path / "home"), PYCRAM_RECORD=record)
+        env.pop("PYCRAM_DB_URL", None)
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO,
+                             env=env, timeout=60)
+        assert out.returncode == 0 and "ok" in out.stdout, out.stderr
+    assert not (tmp_path / "home").exists()
+
+
 def test_events_bus_is_free_when_nobody_listens():
     assert not events.has_subscribers("nobody.listens")
     events.publish("nobody.listens", x=1)

@@ -472,18 +472,11 @@ class _WriterState:
             for node in reversed(chain):
                 inserts[node.id] = self._task_row(node)
 
+        touched: dict[int, Task] = {}  # tasks that started or ended in this batch, first seen first
         for item in items:
-            if not isinstance(item, tuple):  # a task that started or ended: upsert its current state
-                task = item
-                if not self._wanted(task):
-                    continue
-                if task.id in inserts:
-                    if inserts[task.id][9] is None:  # no end yet; else it holds the final state
-                        inserts[task.id] = self._task_row(task)
-                elif task.id in self.written:
-                    updates[task.id] = self._task_row(task)
-                else:
-                    ensure(task)
+            if not isinstance(item, tuple):
+                if item.id not in touched and self._wanted(item):
+                    touched[item.id] = item
                 continue
             tag = item[0]
             if tag == "f":
@@ -515,6 +508,16 @@ class _WriterState:
             elif tag == "end":
                 _, outcome, duration, error = item
                 run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc())
+
+        # One row per task per batch, read after the whole batch was taken from the queue: a
+        # task's event is queued after its state was set, so the row holds at least that state.
+        for task in touched.values():
+            if task.id in inserts:
+                continue  # inserted as an ancestor of an earlier task, from its current state
+            if task.id in self.written:
+                updates[task.id] = self._task_row(task)
+            else:
+                ensure(task)
 
         now = time.monotonic()
         heartbeat_due = now - self.last_heartbeat >= min(1.0, self.recorder.heartbeat_interval)
