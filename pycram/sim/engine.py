@@ -19,6 +19,9 @@ _log = logging.getLogger(__name__)
 
 #: Where items taken "aside" by fault injection are put (on the floor, out of the kitchen) [m].
 ASIDE_AREA = (4.5, 4.0)
+#: A closing gripper grasps an item only while its fingers are at least this far apart [m]:
+#: fully closed fingers have nothing between them, whatever touches their outsides.
+MIN_GRASP_OPENING = 0.003
 
 
 class Gripper:
@@ -170,8 +173,10 @@ class Engine:
                            {n: float(qv[d]) for n, a, d in self.robot_joints})
 
     def gripper_state(self, name: str) -> GripperState:
+        """Opening [m], held item and effort [N] at the finger tips of gripper `name`."""
         g = self.grippers[name]
-        return GripperState(g.opening(self.data), g.holding)
+        effort = abs(float(self.data.actuator_force[g.actuator])) / g.spec["effort_lever"]
+        return GripperState(g.opening(self.data), g.holding, effort)
 
     def item_pose(self, name: str) -> Pose:
         b = self.item_bodies[name]
@@ -216,10 +221,13 @@ class Engine:
         return (touched[0] | touched[1]) if either else (touched[0] & touched[1])
 
     def _update_grasps(self) -> None:
+        """Contact-triggered grasping: a gripper that is closing welds an item when both of its
+        fingers touch that item and the fingers are still apart (the item is between them).
+        Nothing else ever attaches an item (except `GiveItem`, a person's hand-over)."""
         for g in self.grippers.values():
             if g.holding is None and g.closing:
                 items = self._touching_items(g)
-                if items:
+                if items and g.opening(self.data) >= MIN_GRASP_OPENING:
                     self.weld(g, sorted(items)[0])
 
     def weld(self, g: Gripper, item: str) -> None:

@@ -71,8 +71,15 @@ def write_png(path: str | Path, image: np.ndarray) -> Path:
 
 
 def write_animation(path: str | Path, frames: Sequence[np.ndarray], fps: float) -> Path:
-    """Write frames to an animated GIF (or any format imageio knows by the suffix)."""
+    """Write frames (RGB arrays of one size) to an animation at `fps` [frames per s of the video].
+
+    ".gif" always works (Pillow, installed with imageio); ".mp4" and other video formats need a
+    video backend (`pip install imageio-ffmpeg` or `av`) and raise `SimulationError` saying so
+    when none is installed. Raises ValueError when there are no frames.
+    """
     import imageio.v3 as iio
+
+    from .errors import SimulationError
 
     if not frames:
         raise ValueError("no frames recorded")
@@ -80,6 +87,10 @@ def write_animation(path: str | Path, frames: Sequence[np.ndarray], fps: float) 
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".gif":
         iio.imwrite(path, np.stack(frames), duration=1000.0 / fps, loop=0)
-    else:
+        return path
+    try:
         iio.imwrite(path, np.stack(frames), fps=fps)
+    except Exception as exc:  # imageio raises several types when no plugin can write the format
+        raise SimulationError(f"cannot write {path.suffix!r} animations ({type(exc).__name__}: {exc}); "
+                              "use a .gif path, or install imageio-ffmpeg (or av) for video") from exc
     return path

@@ -69,10 +69,12 @@ class VisibleItem:
 
 @dataclass(frozen=True)
 class GripperState:
-    """A gripper's measured state: opening [m] and the item welded to it (or None)."""
+    """A gripper's measured state: opening [m], the item welded to it (or None) and the effort [N]
+    its actuator currently applies at the finger tips (never above the commanded effort limit)."""
 
     opening: float
     holding: str | None = None
+    effort: float = 0.0
 
 
 @dataclass(frozen=True)

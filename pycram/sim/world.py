@@ -304,9 +304,13 @@ class World:
         return self.submit(HeadPointing(point, track=True), "track_point")
 
     def set_gripper(self, gripper: str, opening: float, effort: float | None = None) -> CommandHandle:
-        """Open/close `gripper` to `opening` [m] with at most `effort` [N]; value: measured opening [m].
+        """Open/close `gripper` to `opening` [m] with at most `effort` [N] at the finger tips
+        (default: the description's `default_effort`); value: measured opening [m].
 
-        Closing on an item (both fingers touching) grasps it; opening wider releases it.
+        The fingers never push harder than `effort` (the applied effort is published in
+        `gripper_states[gripper].effort`). Closing on an item that is between the fingers (both
+        touching it) grasps it with a weld; closing on nothing grasps nothing; opening wider
+        releases a held item. A non-positive effort ends with reason "invalid".
         """
         return self.submit(GripperCommand(self._check_gripper(gripper), opening, effort), f"gripper:{gripper}")
 
