@@ -4,7 +4,8 @@ The simulation thread is the only thread that touches MuJoCo. Other threads
 
 - send commands (`drive_to`, `move_arm`, `reach`, `set_gripper`, `track_point`, ...), each of
   which returns a `CommandHandle` at once (its `result` fluent gets the `Outcome`), and
-- read sensor fluents, updated at `sensor_rate` [Hz] of simulated time: `base_pose`,
+- read sensor fluents, updated at `sensor_rate` [Hz] of simulated time (at most once per
+  control tick of `control_period` [s], and also right after a command ends): `base_pose`,
   `joint_states`, `gripper_openings[g]`, `gripper_states[g]`, `tool_poses`, `item_poses`,
   `sim_time`, and `camera_image` (on request).
 
@@ -117,7 +118,7 @@ class World:
     # ------------------------------------------------------------------ the thread
     def _run(self) -> None:
         eng = self._engine
-        next_sensor = 0.0
+        next_sensor = eng.time + self._sensor_period  # the constructor published at eng.time
         wall0, sim0 = time.monotonic(), eng.time
         try:
             while not self._stop.is_set():
@@ -129,8 +130,12 @@ class World:
                         self._end(channel, out, stop=not out.succeeded)
                 eng.step(self._steps_per_tick)
                 self.clock.advance_to(eng.time)
-                if eng.time >= next_sensor or self._finished:
-                    next_sensor = eng.time + self._sensor_period
+                due = eng.time >= next_sensor - 1e-9
+                if due or self._finished:
+                    if due:  # a fixed schedule: exactly `sensor_rate` publications per simulated second
+                        next_sensor += self._sensor_period
+                        if next_sensor <= eng.time:
+                            next_sensor = eng.time + self._sensor_period
                     self._publish()
                     # outcomes are delivered after the sensors show the state they ended in
                     finished, self._finished = self._finished, []
