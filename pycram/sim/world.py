@@ -10,7 +10,10 @@ The simulation thread is the only thread that touches MuJoCo. Other threads
   `sim_time`, and `camera_image` (on request).
 
 While it runs, the world's `ManualClock` is the active PyCRAM clock: `pycram.sleep` and fluent
-time-outs follow simulated time. Headless it runs as fast as it can; `realtime=True` paces it.
+time-outs follow simulated time. Headless it runs as fast as it can; `realtime=True` paces it to
+`realtime_factor` x wall time: over any interval, simulated time advances by at most
+`realtime_factor` x (wall time + `REALTIME_SLACK`); a machine that cannot keep up runs slower,
+and never races afterwards to catch up.
 """
 
 from __future__ import annotations
@@ -41,6 +44,9 @@ from .types import Outcome, Pose, Pose2D, VisibleItem
 _log = logging.getLogger(__name__)
 
 DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)  # [m, m, rad] on the free floor between the counters
+#: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
+#: trying to catch up (it then paces from where it is).
+REALTIME_SLACK = 0.05
 
 
 class World:
@@ -147,6 +153,8 @@ class World:
                     ahead = (eng.time - sim0) / self.realtime_factor - (time.monotonic() - wall0)
                     if ahead > 0:
                         self._stop.wait(ahead)
+                    elif ahead < -REALTIME_SLACK:  # fell behind: carry on from here, do not race to catch up
+                        wall0, sim0 = time.monotonic(), eng.time
         except BaseException as exc:  # noqa: BLE001 - reported through handles and `error`
             self.error = exc
             _log.exception("simulation thread failed")
@@ -499,4 +507,4 @@ def _wait_wall(handle: CommandHandle, timeout: float) -> None:
         handle.wait(0.05)  # wakes on completion or after 0.05 s of the active clock
 
 
-__all__ = ["World", "DEFAULT_BASE_POSE"]
+__all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK"]
