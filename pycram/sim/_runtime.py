@@ -40,9 +40,19 @@ except ImportError:  # pragma: no cover
                 return self._cond.wait_for(lambda: self._value is not None, timeout)
 
 try:  # pragma: no cover
-    from pycram.runtime.clock import ManualClock, use_clock  # type: ignore[attr-defined]
+    from pycram.runtime.clock import ManualClock, current_clock, set_clock, use_clock  # type: ignore[attr-defined]
 except ImportError:  # pragma: no cover
     _log.warning("pycram.runtime not available: pycram.sim uses a minimal stand-in clock")
+
+    _active: Any = None
+
+    def current_clock() -> Any:  # type: ignore[no-redef]
+        return _active
+
+    def set_clock(clock: Any) -> Any:  # type: ignore[no-redef]
+        global _active
+        previous, _active = _active, clock
+        return previous
 
     class ManualClock:  # type: ignore[no-redef]
         def __init__(self, start: float = 0.0) -> None:
@@ -59,4 +69,4 @@ except ImportError:  # pragma: no cover
         yield clock
 
 
-__all__ = ["Fluent", "ManualClock", "use_clock"]
+__all__ = ["Fluent", "ManualClock", "current_clock", "set_clock", "use_clock"]

@@ -18,17 +18,17 @@ and never races afterwards to catch up.
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import queue
 import threading
 import time
+import weakref
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ._runtime import Fluent, ManualClock, use_clock
+from ._runtime import Fluent, ManualClock, current_clock, set_clock
 from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
                           JointTrajectory, Reach)
 from .engine import Engine
@@ -44,6 +44,9 @@ from .types import Outcome, Pose, Pose2D, VisibleItem
 _log = logging.getLogger(__name__)
 
 DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)  # [m, m, rad] on the free floor between the counters
+#: Clocks of closed worlds -> the clock that was active before each (to skip them when restoring).
+_CLOSED_CLOCKS: "weakref.WeakKeyDictionary[ManualClock, Any]" = weakref.WeakKeyDictionary()
+_CLOCK_LOCK = threading.Lock()
 #: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
 #: trying to catch up (it then paces from where it is).
 REALTIME_SLACK = 0.05
@@ -91,9 +94,8 @@ class World:
         self._recording: dict[str, Any] | None = None
         self._renderers: Renderers | None = None
         self.error: BaseException | None = None
-        self._clock_ctx = contextlib.ExitStack()
-        if activate_clock:
-            self._clock_ctx.enter_context(use_clock(self.clock))
+        self._previous_clock = set_clock(self.clock) if activate_clock else None
+        self._clock_active = activate_clock
         self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
         self._thread.start()
 
@@ -112,14 +114,29 @@ class World:
     def close(self, timeout: float = 10.0) -> None:
         """Stop the simulation thread and wait for it [s of wall time]; idempotent.
 
-        Commands still running end with reason "closed"; the previous clock is re-activated.
+        Commands still running end with reason "closed"; the clock that was active before this
+        world is re-activated if this world's clock is still the active one.
         """
         self._stop.set()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
                 _log.error("simulation thread did not stop within %.1f s", timeout)
-        self._clock_ctx.close()
+        self._deactivate_clock()
+
+    def _deactivate_clock(self) -> None:
+        """Hand the active clock back (once). Worlds may be closed in any order: the clock of a
+        world closed earlier is never re-activated; a later world's active clock stays active."""
+        with _CLOCK_LOCK:
+            if not self._clock_active:
+                return
+            self._clock_active = False
+            previous = self._previous_clock
+            while previous in _CLOSED_CLOCKS:
+                previous = _CLOSED_CLOCKS[previous]
+            _CLOSED_CLOCKS[self.clock] = previous
+            if current_clock() is self.clock:
+                set_clock(previous)
 
     # ------------------------------------------------------------------ the thread
     def _run(self) -> None:

@@ -118,6 +118,16 @@ def test_worlds_can_be_built_again_and_again():
             assert abs(pose.x - (start.x + 0.2)) < 0.02
 
 
+def test_worlds_closed_in_any_order_restore_the_clock():
+    before = current_clock()
+    first, second = World("tiago"), World("tiago")
+    assert current_clock() is second.clock
+    first.close()
+    assert current_clock() is second.clock  # the running world keeps simulated time
+    second.close()
+    assert current_clock() is before  # not the first world's dead clock
+
+
 def test_clean_shutdown_leaves_no_thread(tmp_path):
     before = set(threading.enumerate())
     waiter_done = threading.Event()
