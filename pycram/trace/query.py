@@ -4,6 +4,9 @@
     for run in query.runs(limit=5): print(run.id, run.plan, run.outcome)
     grasps = query.failed_tasks(name="grasp")            # all failed grasps, every run
     seconds = query.durations("perform navigating")       # how long each navigation took
+    slips = query.executions(module="gripper", outcome="failed")   # failed gripper motions
+    plans = query.designators(designator_type="fetching")  # what each fetch resolved to
+    tree = query.task_tree()                              # the newest run's task tree
 
 Every function takes `url=None` (`$PYCRAM_DB_URL` or the default SQLite file) and returns
 plain frozen dataclasses, newest run first where runs are listed. Functions that need one run
@@ -199,9 +202,15 @@ def _run_info(row: Any) -> RunInfo:
         clock_origin=m["clock_origin"], error=m["error"], info=info)
 
 
-def _task(row: Any) -> TaskRecord:
-    m = row._mapping
-    return TaskRecord(**{name: m[name] for name in TaskRecord.__dataclass_fields__})
+def _columns(table: sa.Table, record: type) -> list[Any]:
+    """The columns of `table` in the field order of the dataclass `record`."""
+    return [table.c[name] for name in record.__dataclass_fields__]
+
+
+def _records(stmt: Any, record: type, url: str | None) -> list[Any]:
+    """Run `stmt` (selecting `_columns(..., record)`) and build one `record` per row."""
+    with _engine(url).connect() as conn:
+        return [record(*row) for row in conn.execute(stmt).all()]
 
 
 def runs(url: str | None = None, limit: int | None = None, plan: str | None = None) -> list[RunInfo]:
@@ -232,9 +241,9 @@ def get_run(run_id: int | None = None, url: str | None = None) -> RunInfo:
 
 def tasks(run_id: int, url: str | None = None) -> list[TaskRecord]:
     """The tasks of run `run_id` in creation order (empty if it has none)."""
-    stmt = sa.select(tasks_table).where(tasks_table.c.run_id == run_id).order_by(tasks_table.c.task_id)
-    with _engine(url).connect() as conn:
-        return [_task(row) for row in conn.execute(stmt)]
+    stmt = (sa.select(*_columns(tasks_table, TaskRecord)).where(tasks_table.c.run_id == run_id)
+            .order_by(tasks_table.c.task_id))
+    return _records(stmt, TaskRecord, url)
 
 
 def build_tree(records: Iterable[TaskRecord]) -> list[TaskNode]:
@@ -276,7 +285,7 @@ def failed_tasks(name: str | None = None, kind: str | None = None, error_type: s
     all failed grasps); `kind` matches exactly (e.g. "action", "step", "branch").
     """
     t = tasks_table.c
-    stmt = sa.select(tasks_table).where(t.status == "failed")
+    stmt = sa.select(*_columns(tasks_table, TaskRecord)).where(t.status == "failed")
     if name:
         stmt = stmt.where(t.name.ilike(f"%{name}%"))
     if kind:
@@ -286,8 +295,7 @@ def failed_tasks(name: str | None = None, kind: str | None = None, error_type: s
     if run_id is not None:
         stmt = stmt.where(t.run_id == run_id)
     stmt = stmt.order_by(t.run_id.desc(), t.task_id)
-    with _engine(url).connect() as conn:
-        return [_task(row) for row in conn.execute(stmt)]
+    return _records(stmt, TaskRecord, url)
 
 
 def durations(name: str, kind: str | None = None, status: str | None = None, exact: bool = True,
@@ -312,21 +320,19 @@ def designators(run_id: int | None = None, designator_type: str | None = None,
                 url: str | None = None) -> list[DesignatorRecord]:
     """Designators performed (in one run or all), with the solutions they resolved to."""
     d = designators_table.c
-    stmt = sa.select(designators_table).order_by(d.run_id, d.id)
+    stmt = sa.select(*_columns(designators_table, DesignatorRecord)).order_by(d.run_id, d.id)
     if run_id is not None:
         stmt = stmt.where(d.run_id == run_id)
     if designator_type:
         stmt = stmt.where(d.designator_type == designator_type)
-    with _engine(url).connect() as conn:
-        return [DesignatorRecord(**{k: row._mapping[k] for k in DesignatorRecord.__dataclass_fields__})
-                for row in conn.execute(stmt)]
+    return _records(stmt, DesignatorRecord, url)
 
 
 def executions(run_id: int | None = None, module: str | None = None, outcome: str | None = None,
                designator_type: str | None = None, url: str | None = None) -> list[ExecutionRecord]:
     """Process-module executions (in one run or all), optionally filtered."""
     x = executions_table.c
-    stmt = sa.select(executions_table).order_by(x.run_id, x.id)
+    stmt = sa.select(*_columns(executions_table, ExecutionRecord)).order_by(x.run_id, x.id)
     if run_id is not None:
         stmt = stmt.where(x.run_id == run_id)
     if module:
@@ -335,17 +341,13 @@ def executions(run_id: int | None = None, module: str | None = None, outcome: st
         stmt = stmt.where(x.outcome == outcome)
     if designator_type:
         stmt = stmt.where(x.designator_type == designator_type)
-    with _engine(url).connect() as conn:
-        return [ExecutionRecord(**{k: row._mapping[k] for k in ExecutionRecord.__dataclass_fields__})
-                for row in conn.execute(stmt)]
+    return _records(stmt, ExecutionRecord, url)
 
 
 def fluent_samples(run_id: int, name: str | None = None, url: str | None = None) -> list[FluentSample]:
     """Samples of the watched fluents of a run (one name or all), in time order."""
     f = fluent_samples_table.c
-    stmt = sa.select(fluent_samples_table).where(f.run_id == run_id).order_by(f.id)
+    stmt = sa.select(*_columns(fluent_samples_table, FluentSample)).where(f.run_id == run_id).order_by(f.id)
     if name:
         stmt = stmt.where(f.name == name)
-    with _engine(url).connect() as conn:
-        return [FluentSample(**{k: row._mapping[k] for k in FluentSample.__dataclass_fields__})
-                for row in conn.execute(stmt)]
+    return _records(stmt, FluentSample, url)
