@@ -335,15 +335,20 @@ class Reach(Controller):
 
 
 class GiveItem(Controller):
-    """Fault injection: a person hands `item` into an open `gripper` and holds it until it is welded.
+    """Fault injection: a person hands `item` into an open `gripper` and holds it until it is grasped.
 
-    Opens the gripper if needed, puts the item at the tool frame, holds it there and (with `close`)
-    closes the gripper with its default effort. Succeeds when the gripper holds the item.
+    Opens the gripper if needed and holds the item at the tool frame. With `close` the person
+    also closes the gripper on it (default effort); without, the person waits for the robot to
+    close its gripper -- this command then runs on a channel of its own (`hand:<gripper>`), so
+    the robot's gripper command does not preempt it. Either way the grasp is the gripper's own
+    contact-triggered one. Succeeds (value: the measured opening [m]) once the gripper holds the
+    item; fails with "timeout" when it has not after `timeout` [s], and the item drops.
     """
 
-    def __init__(self, item: str, gripper: str, arm: str, close: bool = True) -> None:
-        self.channel = f"gripper:{gripper}"
-        self.item, self.gripper, self.arm, self.close = item, gripper, arm, close
+    def __init__(self, item: str, gripper: str, arm: str, close: bool = True, timeout: float = 5.0) -> None:
+        self.channel = f"gripper:{gripper}" if close else f"hand:{gripper}"
+        self.item, self.gripper, self.arm, self.close, self.timeout = item, gripper, arm, close, timeout
+        self.closer: GripperCommand | None = None
 
     def start(self, eng: Engine) -> Outcome | None:
         g = eng.grippers[self.gripper]
@@ -373,14 +378,14 @@ class GiveItem(Controller):
                     self.closer.start(eng)
             return None
         if g.holding == self.item:
-            if self.closer.update(eng, t) is not None:
+            if self.closer is None or self.closer.update(eng, t) is not None:
                 return ok(g.opening(eng.data))
             return None
-        if self.close and self.item in eng._touching_items(g, either=True):
+        if self.closer is not None and self.item in eng._touching_items(g, either=True):
             # the person lets go as soon as a finger presses the item against the other one
             eng.weld(g, self.item)
             return None
         self._put(eng)
-        if t - self.t0 > 5.0:
+        if t - self.t0 > self.timeout:
             return fail("timeout", f"gripper {self.gripper} did not take {self.item}")
         return None

@@ -467,12 +467,17 @@ class World:
 
         return self._call("take_item", fn)
 
-    def give_item(self, item: str, gripper: str, close: bool = True) -> CommandHandle:
-        """Hand `item` into `gripper` (opened first if needed) and, with `close`, close the gripper on it."""
+    def give_item(self, item: str, gripper: str, close: bool = True, timeout: float = 5.0) -> CommandHandle:
+        """Hand `item` into `gripper` (opened first if needed) and hold it there until it is grasped.
+
+        With `close` the person closes the gripper on the item; without, the robot must close
+        its gripper (e.g. a `setting_gripper` motion) within `timeout` [s of simulated time].
+        The command succeeds once the gripper holds the item and fails with "timeout" otherwise.
+        """
         self.scene.item(item)
         self._check_gripper(gripper)
         arm = next(a for a, s in self.description.ARMS.items() if s["gripper"] == gripper)
-        return self.submit(GiveItem(item, gripper, arm, close), "give_item")
+        return self.submit(GiveItem(item, gripper, arm, close, timeout), "give_item")
 
     def move_item(self, item: str, position: Sequence[float],
                   orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)) -> CommandHandle:

@@ -102,3 +102,25 @@ def test_grasp_lift_drive_keeps_item_and_taking_it_closes_the_gripper(world):
     assert np.linalg.norm(np.subtract(world.item_poses.get_value()["mug"].position, spot)) < 0.01
     ok(world.set_gripper(gripper, 0.09))
     ok(world.move_arm_to(arm, "park"))
+
+
+def test_an_item_handed_into_the_open_gripper_is_grasped_when_the_robot_closes_it(world):
+    d = world.description
+    arm = d.DEFAULT_ARM
+    gripper = d.ARMS[arm]["gripper"]
+    ok(world.move_item("mug", (MUG_SPOT[0], MUG_SPOT[1], COUNTER_HEIGHT + world.scene.item("mug").half_height)))
+    ok(world.set_gripper(gripper, 0.09))
+    ok(world.move_arm_to(arm, "carry"))
+    # a person holds the mug between the open fingers, waiting for the robot to close them
+    handover = world.give_item("mug", gripper, close=False, timeout=3.0)
+    assert handover.wait(0.5) is None  # not grasped yet: the gripper is still open
+    assert world.gripper_states[gripper].get_value().holding is None
+    closed = ok(world.set_gripper(gripper, 0.0))  # the robot's own command, not preempted by the person
+    assert ok(handover) > 0.03 and closed > 0.03  # the fingers stalled on the mug
+    assert world.gripper_states[gripper].get_value().holding == "mug"
+    # nobody closes the gripper: the person gives up after the time-out and the mug drops
+    ok(world.set_gripper(gripper, 0.09))
+    assert world.gripper_states[gripper].get_value().holding is None
+    unattended = world.give_item("mug", gripper, close=False, timeout=1.0).wait(T)
+    assert unattended is not None and not unattended.succeeded and unattended.reason == "timeout"
+    assert world.gripper_states[gripper].get_value().holding is None
