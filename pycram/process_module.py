@@ -53,7 +53,7 @@ from pycram import events
 from pycram.designators.core import DesignatorError, callable_name, known_solution
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
-from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
+from pycram.runtime import current_clock, no_evaporation, wait_until
 
 __all__ = [
     "ProcessModule",
@@ -296,10 +296,10 @@ class ProcessModule:
         execution._group = group
 
         def body() -> None:
-            try:
-                self._run(execution)
-            except (ProcessModuleError, Evaporated):
-                pass  # the outcome is recorded in the execution
+            # The outcome is recorded in the execution; a failure or cancellation also ends the
+            # task FAILED or EVAPORATED, so the task tree tells what became of the designator.
+            # The group is detached: nothing propagates to the caller's task.
+            self._run(execution)
 
         execution._task = group.spawn(f"{self.name}: {_type_of(designator)}", body,
                                       kind="process-module")
