@@ -8,6 +8,7 @@ the timeline PNG to the output folder, and returns 0 only when the item rests on
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import random
@@ -19,8 +20,15 @@ from typing import Any
 
 log = logging.getLogger("pycram.demo")
 
-#: A run that has not ended after this much wall time is evaporated and reported as failed [s].
-WALL_TIME_LIMIT = 110.0
+#: A plan that has not ended after this much simulated time is evaporated and reported as
+#: failed [s]. The default run needs about 20 s, three failed grasps about 40 s.
+SIM_TIME_LIMIT = 300.0
+#: Backstop for a simulation that stops advancing (e.g. a crashed simulator thread) [s of wall
+#: time]. Neither limit applies with `--interactive`, where a person may take their time.
+WALL_TIME_LIMIT = 600.0
+#: The animation: frames per second of simulated time, and how much faster it plays.
+ANIMATION_FPS = 8.0
+ANIMATION_SPEED_UP = 2.0
 
 
 @dataclass
@@ -35,6 +43,7 @@ class DemoOptions:
     db: str | None = None
     record: bool = True
     quiet: bool = False
+    animation: bool = True  # record run.gif from the overview camera
 
 
 @dataclass
@@ -45,8 +54,9 @@ class DemoResult:
     message: str
     output: Path
     run_id: Any = None
-    sim_time: float = 0.0
-    wall_time: float = 0.0
+    sim_time: float = 0.0  # simulated time the plan ran [s]
+    wall_time: float = 0.0  # wall time of the whole run: world, plan, pictures [s]
+    plan_wall_time: float = 0.0  # wall time the plan ran [s]
     failed_grasps: int = 0
     recoveries: int = 0
     item_on_cooker_1: bool = False
@@ -55,11 +65,71 @@ class DemoResult:
 
     @property
     def speed_factor(self) -> float:
-        return self.sim_time / self.wall_time if self.wall_time > 0 else 0.0
+        """Simulated time per wall time while the plan ran (> 1: faster than real time)."""
+        return self.sim_time / self.plan_wall_time if self.plan_wall_time > 0 else 0.0
 
 
 def default_output(robot: str) -> Path:
     return Path("output") / f"demo-{robot}"
+
+
+class PlanRun:
+    """The plan, run as task `fetch_and_place` in a thread of its own, so the driver can watch it.
+
+    `task` is the plan's task (its whole tree, the reset included); `error` is what made the
+    plan fail (e.g. `NoItemGrasped`), its evaporation on a time limit or Ctrl-C, or a bug.
+    """
+
+    def __init__(self, plan: Any, robot: Any, facts: Any) -> None:
+        self.plan, self.robot, self.facts = plan, robot, facts
+        self.task: Any = None
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="pycram-demo-plan", daemon=True)
+        self._started_wall = self._ended_wall = 0.0
+        self._started_sim = 0.0
+
+    def start(self, sim_now: float) -> None:
+        self._started_sim = sim_now
+        self._started_wall = time.monotonic()
+        self._thread.start()
+
+    def _run(self) -> None:
+        from pycram.runtime import current_task, run_subtask
+
+        def whole_plan() -> Any:
+            self.task = current_task()
+            with self.robot, self.facts:
+                return self.plan.fetch_and_place()
+
+        try:
+            run_subtask("fetch_and_place", whole_plan, kind="plan")
+        except BaseException as error:  # the plan failed, or was evaporated
+            self.error = error
+        finally:
+            self._ended_wall = time.monotonic()
+
+    def join(self, timeout: float) -> bool:
+        """Wait at most `timeout` [s of wall time] for the plan's thread; True once it ended."""
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Evaporate the plan and wait (at most `timeout` [s]) for its thread to end."""
+        if self.task is not None:
+            self.task.evaporate()
+        self._thread.join(timeout)
+
+    @property
+    def wall_time(self) -> float:
+        """Wall time [s] from the start to the end of the plan (or to now while it runs)."""
+        end = self._ended_wall or time.monotonic()
+        return end - self._started_wall
+
+    def sim_time(self, sim_now: float) -> float:
+        """Simulated time [s] the plan ran; `sim_now` is the simulation's current time."""
+        if self.task is not None and self.task.end_time is not None and self.task.start_time is not None:
+            return self.task.end_time - self.task.start_time
+        return sim_now - self._started_sim
 
 
 def run_demo(options: DemoOptions) -> DemoResult:
@@ -71,6 +141,22 @@ def run_demo(options: DemoOptions) -> DemoResult:
     output = Path(options.output) if options.output else default_output(options.robot)
     output.mkdir(parents=True, exist_ok=True)
 
+    result = DemoResult(exit_code=1, message="", output=output)
+    started_wall = time.monotonic()
+    recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
+    try:
+        _run_in_world(options, result, recorder)
+    finally:
+        result.wall_time = time.monotonic() - started_wall
+        if recorder is not None:
+            result.run_id = recorder.finish("succeeded" if result.exit_code == 0 else "failed")
+    if recorder is not None:
+        result.files.extend(_write_run_pictures(result.run_id, output, recorder))
+    return result
+
+
+def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> None:
+    """Build the kitchen, run the plan in it, fill in `result`, write the pictures."""
     from pycram import robots as robot_packages
     from pycram.demos import kitchen_plan as plan
     from pycram.demos.kitchen_world import (
@@ -83,18 +169,18 @@ def run_demo(options: DemoOptions) -> DemoResult:
         Thief,
         operator_resolver,
     )
-    from pycram.runtime import current_task, format_task_tree
+    from pycram.runtime import format_task_tree
     from pycram.sim import COUNTER_HEIGHT, ItemSpec, Pose2D, World
+    from pycram.sim.render import write_animation
 
+    output = result.output
     rng = random.Random(options.seed)
     mug = ItemSpec(ITEM_NAME, "mug", "cylinder", (0.03, 0.05), 0.25,
                    (*SLOTS[options.item_at], None) if options.item_at else (5.0, 5.0, None), (0.85, 0.2, 0.15, 1))
     items = [mug] if options.item_at else []
-    started_wall = time.monotonic()
     world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
-    result = DemoResult(exit_code=1, message="", output=output)
-    recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
     thief = None
+    frames: list = []
     try:
         robot = robot_packages.load(options.robot, world)
         helper = Helper(world, interactive=options.interactive)
@@ -108,56 +194,35 @@ def run_demo(options: DemoOptions) -> DemoResult:
             recorder.set_run_info(robot=options.robot)
             for fluent in (plan.phase, world.base_pose):
                 recorder.watch(fluent, fluent.name, max_rate_hz=5.0)
-        world.start_recording("overview", fps=8.0, width=480, height=360)
         world.snapshot(output / "start.png")
         result.files.append(output / "start.png")
         plan.forget_state()
-        outcome: dict[str, Any] = {}
-
-        def run_plan() -> None:
-            outcome["root"] = current_task()
-            try:
-                with robot, facts:
-                    outcome["state"] = plan.fetch_and_place()
-            except BaseException as error:  # evaporated on the wall-time limit, or a bug
-                outcome["error"] = error
-
-        runner = threading.Thread(target=run_plan, name="pycram-demo-plan", daemon=True)
+        if options.animation:
+            world.start_recording("overview", fps=ANIMATION_FPS, width=480, height=360)
+        run = PlanRun(plan, robot, facts)
         thief.start()
-        runner.start()
-        _show_progress(runner, world, plan, thief, started_wall, options.quiet, outcome)
-        if runner.is_alive():
-            result.message = f"the demo did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
-            root = outcome.get("root")
-            if root is not None:
-                for task in list(root.children):
-                    task.evaporate()
-            runner.join(10.0)
+        run.start(world.sim_time.get_value())
+        result.message = _watch(run, world, plan, thief, options)
         thief.stop()
-        root = outcome.get("root")
-        plan_task = root.children[-1] if root is not None and root.children else None
-        result.tree_text = format_task_tree(plan_task) if plan_task is not None else ""
-        result.failed_grasps = _count(plan_task, lambda t: t.kind == "step" and _failed(t) and "GraspFailed" in _error(t))
-        result.recoveries = _count(plan_task, lambda t: t.kind == "attempt" and "RetryRequested" in _error(t))
-        result.sim_time = world.sim_time.get_value()
+        result.plan_wall_time = run.wall_time
+        result.sim_time = run.sim_time(world.sim_time.get_value())
+        result.tree_text = format_task_tree(run.task) if run.task is not None else ""
+        result.failed_grasps = failed_grasps(run.task)
+        result.recoveries = recoveries(run.task)
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, COUNTER_HEIGHT) if items else False
         world.snapshot(output / "end.png")
         result.files.append(output / "end.png")
-        world.stop_recording(output / "run.gif")
-        result.files.append(output / "run.gif")
+        frames = world.stop_recording() if options.animation else []
         if result.item_on_cooker_1:
             result.exit_code, result.message = 0, "the item rests on cooker #1"
         elif not result.message:
-            result.message = _failure_message(outcome)
+            result.message = _failure_message(run)
     finally:
         if thief is not None:
             thief.stop()
         world.close()
-        result.wall_time = time.monotonic() - started_wall
-        if recorder is not None:
-            result.run_id = recorder.finish("succeeded" if result.exit_code == 0 else "failed")
-            result.files.extend(_write_run_pictures(result.run_id, output, recorder))
-    return result
+    if frames:  # encoded after the simulation stopped, so the two do not compete for the CPU
+        result.files.append(write_animation(output / "run.gif", frames, ANIMATION_SPEED_UP * ANIMATION_FPS))
 
 
 def _gripper_mapper(world: Any):
@@ -197,21 +262,21 @@ def _count(task: Any, predicate) -> int:
     return 0 if task is None else sum(1 for t in task.walk() if predicate(t))
 
 
-def _failure_message(outcome: dict) -> str:
-    if "error" in outcome:
-        error = outcome["error"]
-        return f"the plan stopped: {type(error).__name__}: {error}"
-    root = outcome.get("root")
-    plan_task = root.children[-1] if root is not None and root.children else None
-    if plan_task is not None:
-        failures = [t for t in plan_task.walk() if _failed(t) and t.exception is not None and t.kind in ("branch", "step")]
-        if failures:
-            deepest = failures[0]
-            for task in failures:
-                if type(task.exception).__name__ in ("NoItemGrasped", "ResetFailed", "ItemLost"):
-                    deepest = task
-            return f"{type(deepest.exception).__name__}: {deepest.exception}"
-    return "the item is not on cooker #1"
+def failed_grasps(plan_task: Any) -> int:
+    """How many grasp attempts in the plan's task tree failed with `GraspFailed`."""
+    return _count(plan_task, lambda t: t.kind == "step" and _failed(t) and _error(t) == "GraspFailed")
+
+
+def recoveries(plan_task: Any) -> int:
+    """How many transport attempts ended in `retry()` (one per recovered theft)."""
+    return _count(plan_task, lambda t: t.kind == "attempt" and _error(t) == "RetryRequested")
+
+
+def _failure_message(run: PlanRun) -> str:
+    """Why the item is not on cooker #1: what stopped the plan, if anything did."""
+    if run.error is not None:
+        return f"{type(run.error).__name__}: {run.error}"
+    return "the plan ended, but the item is not on cooker #1"
 
 
 def _start_recorder(options: DemoOptions, plan_name: str) -> Any:
@@ -233,32 +298,90 @@ def _write_run_pictures(run_id: Any, output: Path, recorder: Any) -> list[Path]:
     return list(write_run_pictures(run_id, output, url=recorder.url))
 
 
-def _show_progress(runner: threading.Thread, world: Any, plan: Any, thief: Any, started_wall: float,
-                   quiet: bool, outcome: dict) -> None:
-    """Live terminal progress until the plan thread ends or the wall-time limit passes."""
-    deadline = started_wall + WALL_TIME_LIMIT
+def _watch(run: PlanRun, world: Any, plan: Any, thief: Any, options: DemoOptions) -> str:
+    """Show live progress until the plan ends; stop it on a time limit or Ctrl-C.
 
-    def status_line() -> str:
-        wall = time.monotonic() - started_wall
-        sim = world.sim_time.get_value()
-        root = outcome.get("root")
-        plan_task = root.children[-1] if root is not None and root.children else None
-        grasps = _count(plan_task, lambda t: t.kind == "step" and _failed(t))
-        retries = _count(plan_task, lambda t: t.kind == "attempt" and _failed(t))
-        return (f"step: {plan.phase.get_value():<13} failed grasps: {grasps}  recoveries: {retries}  "
-                f"thefts: {thief.stolen}  sim {sim:6.1f} s  wall {wall:5.1f} s")
+    Returns "" when the plan ended by itself, otherwise why it was stopped. Without
+    `--interactive` the plan is stopped after `SIM_TIME_LIMIT` of simulated time or
+    `WALL_TIME_LIMIT` of wall time, whichever comes first: the demo never hangs.
+    """
+    limited = not options.interactive
+    sim_deadline = world.sim_time.get_value() + SIM_TIME_LIMIT
+    wall_deadline = time.monotonic() + WALL_TIME_LIMIT
+    progress = None if options.quiet else _ProgressLine(run, world, plan, thief)
+    reason = ""
+    with progress or contextlib.nullcontext():
+        try:
+            # Wake on the end of the plan, and 4 times a second of wall time to refresh the
+            # progress line and check the limits (a display refresh, not the plan's logic).
+            while not run.join(0.25):
+                if progress is not None:
+                    progress.refresh()
+                if limited and world.sim_time.get_value() > sim_deadline:
+                    reason = f"the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
+                elif limited and time.monotonic() > wall_deadline:
+                    reason = f"the plan did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
+                if reason:
+                    break
+        except KeyboardInterrupt:
+            reason = "interrupted by the user (Ctrl-C)"
+        if reason:
+            log.warning("stopping the plan: %s", reason)
+            run.stop()
+    return reason
 
-    if quiet:
-        runner.join(max(0.0, deadline - time.monotonic()))
-        return
-    from rich.console import Console
-    from rich.live import Live
 
-    console = Console(stderr=True)
-    with Live(status_line(), console=console, refresh_per_second=4, transient=False) as live:
-        while runner.is_alive() and time.monotonic() < deadline:
-            runner.join(0.25)  # refresh the status line four times a second
-            live.update(status_line())
+class _ProgressLine:
+    """One live terminal line: step, failed grasps, recoveries, thefts, simulated and wall time."""
+
+    def __init__(self, run: PlanRun, world: Any, plan: Any, thief: Any) -> None:
+        from rich.live import Live
+
+        self.run, self.world, self.plan, self.thief = run, world, plan, thief
+        self._started = time.monotonic()
+        self._live = Live(self._text(), console=_stderr_console(), refresh_per_second=4, transient=False)
+
+    def _text(self) -> str:
+        task = self.run.task
+        return (f"step: {self.plan.phase.get_value():<13} failed grasps: {failed_grasps(task)}  "
+                f"recoveries: {recoveries(task)}  "
+                f"thefts: {self.thief.stolen}  sim {self.world.sim_time.get_value():6.1f} s  "
+                f"wall {time.monotonic() - self._started:5.1f} s")
+
+    def __enter__(self) -> _ProgressLine:
+        self._live.__enter__()
+        return self
+
+    def refresh(self) -> None:
+        self._live.update(self._text())
+
+    def __exit__(self, *exc: Any) -> None:
+        self.refresh()
+        self._live.__exit__(*exc)
+
+
+def _stderr_console() -> Any:
+    """The one rich console of the demo's terminal output (progress line and log records)."""
+    global _CONSOLE
+    if _CONSOLE is None:
+        from rich.console import Console
+
+        _CONSOLE = Console(stderr=True)
+    return _CONSOLE
+
+
+_CONSOLE: Any = None
+
+
+def _log_to_terminal() -> None:
+    """Show the demo's INFO records above the live progress line (rich keeps them apart)."""
+    from rich.logging import RichHandler
+
+    demo_log = logging.getLogger("pycram.demo")
+    if not any(isinstance(h, RichHandler) for h in demo_log.handlers):
+        demo_log.addHandler(RichHandler(console=_stderr_console(), show_path=False, markup=False))
+        demo_log.setLevel(logging.INFO)
+        demo_log.propagate = False
 
 
 def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal: int = 0, seed: int = 0,
@@ -267,16 +390,18 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     """Run the demo, print the task tree and a summary; return the process exit code."""
     from rich.console import Console
 
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    if not quiet:
+        _log_to_terminal()
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
-    options = DemoOptions(robot, Path(output) if output else None, item_at, steal, seed, realtime,
-                          interactive, db, record, quiet)
+    options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
+                          seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
+                          quiet=quiet)
     result = run_demo(options)
     console.print("\n[bold]Task tree[/bold]")
     console.print(result.tree_text, markup=False, highlight=False)
-    console.print(f"\nsimulated {result.sim_time:.1f} s in {result.wall_time:.1f} s of wall time "
-                  f"({result.speed_factor:.1f}x faster than real time)")
+    console.print(f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
+                  f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s")
     console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")
     console.print(f"pictures in {result.output.resolve()}: " + ", ".join(p.name for p in result.files))
     if result.run_id is not None:

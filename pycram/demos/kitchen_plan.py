@@ -174,8 +174,8 @@ def aim_at(place: tuple) -> None:
 
 
 @plan
-def fetch_and_place() -> State:
-    """The whole demo; returns the outcome of the top-level `par` (thesis ch. 4.2.3)."""
+def fetch_and_place() -> None:
+    """The whole demo (thesis ch. 4.2.3). Raises what stopped the task when it failed."""
     log.info("initialising the demo")
     motion(type="subscribing_pose", fl=pose)
     motion(type="subscribing_gripper", gripper=GRIPPER, fl=r_gripper_state)
@@ -183,43 +183,48 @@ def fetch_and_place() -> State:
     errors = []
     with par(errors) as s:
         with whenever(pose.pulsed()):
+            if phase.get_value() == "done":
+                return  # the task succeeded: leave the loop, so that the par can end
             if look_goal.get_value() is not None:
                 motion(type="pointing_head", coordinates=look_goal.get_value(), wait=False, frame="map")
             sleep(0.2)
-        with seq as task:
-            if True:
-                phase.set_value("fetching")
-                grasp_errors = []
-                with try_in_order(grasp_errors) as state:
-                    if True:
-                        log.info("trying to grasp at position 1 in front of cooker #2")
-                        aim_at(location(("on", "cooker #2"), ("slot", 1)))
-                        grab_item()
-                    if True:
-                        log.info("trying to grasp at position 2 in front of cooker #2")
-                        aim_at(location(("on", "cooker #2"), ("slot", 2)))
-                        grab_item()
-                    if True:
-                        log.info("trying to grasp at position 3 in front of cooker #2")
-                        aim_at(location(("on", "cooker #2"), ("slot", 3)))
-                        grab_item()
-                if state.get_value() is State.FAILED:
-                    raise NoItemGrasped(
-                        "could not grasp an item at any of the 3 positions in front of cooker #2: "
-                        + "; ".join(str(e) for e in grasp_errors)
-                    )
-            if True:
-                phase.set_value("transporting")
-                aim_at(location(("on", "cooker #1")))
-                transport()
-            if True:
-                phase.set_value("placing")
-                place_item()
-                phase.set_value("done")
+        if True:
+            task_errors = []
+            with seq(task_errors) as task:
+                if True:
+                    phase.set_value("fetching")
+                    grasp_errors = []
+                    with try_in_order(grasp_errors) as state:
+                        if True:
+                            log.info("trying to grasp at position 1 in front of cooker #2")
+                            aim_at(location(("on", "cooker #2"), ("slot", 1)))
+                            grab_item()
+                        if True:
+                            log.info("trying to grasp at position 2 in front of cooker #2")
+                            aim_at(location(("on", "cooker #2"), ("slot", 2)))
+                            grab_item()
+                        if True:
+                            log.info("trying to grasp at position 3 in front of cooker #2")
+                            aim_at(location(("on", "cooker #2"), ("slot", 3)))
+                            grab_item()
+                    if state.get_value() is State.FAILED:
+                        raise NoItemGrasped(
+                            "could not grasp an item at any of the 3 positions in front of cooker #2: "
+                            + "; ".join(str(e) for e in grasp_errors)
+                        )
+                if True:
+                    phase.set_value("transporting")
+                    aim_at(location(("on", "cooker #1")))
+                    transport()
+                if True:
+                    phase.set_value("placing")
+                    place_item()
+                    phase.set_value("done")
+            if task.get_value() is State.FAILED:
+                raise task_errors[0]  # fail the par, which evaporates the head tracking
     if s.get_value() is State.FAILED:
         phase.set_value("failed")
-        log.error("the demo failed: %s", "; ".join(f"{type(e).__name__}: {e}" for e in errors))
-    return s.get_value()
+        raise errors[0]  # what stopped the task, e.g. NoItemGrasped
 
 
 @plan

@@ -79,10 +79,18 @@ class Helper:
 class Operator(ProcessModule):
     """Serves `('type', 'waiting_for_help'), ('request', text), ('gripper', g)`.
 
-    Simulated: waits `delay` seconds of simulated time, then hands the last taken item back into
-    the gripper. Interactive: asks the user to do it and to press Enter (the thesis' `input`),
-    then hands the item back — the simulated world has no hands of its own.
+    A person puts the last taken item back between the open fingers of the gripper and holds it
+    there until the robot closes its gripper on it (thesis: "Put the item into the right gripper
+    and hit [Enter]", then the plan closes the gripper). Simulated: the person reacts after
+    `delay` seconds of simulated time. Interactive: the user is asked at the terminal and the
+    item is handed over once they press Enter -- the simulated world has no hands of its own.
+    Returns once the item is held out in the gripper; the robot has `HOLD_TIME` [s] to close.
     """
+
+    #: How long the person holds the item between the fingers, waiting for them to close [s].
+    HOLD_TIME = 5.0
+    #: The person's hand needs this long [s] to bring the item between the fingers.
+    REACH_TIME = 0.3
 
     def __init__(self, helper: Helper, gripper_name: Callable[[str], str]) -> None:
         super().__init__("operator")
@@ -105,11 +113,11 @@ class Operator(ProcessModule):
             log.info("a helper will put the item back in %.1f s", helper.delay)
             sleep(helper.delay)
         item = helper.taken[-1] if helper.taken else ITEM_NAME
-        handle = helper.world.give_item(item, gripper, close=False)
-        outcome = handle.wait(10.0)
-        if outcome is None or not outcome.succeeded:
-            raise RuntimeError(f"could not put {item} back into the {gripper} gripper: {outcome}")
-        log.info("the %s is back in the gripper", item)
+        handle = helper.world.give_item(item, gripper, close=False, timeout=self.HOLD_TIME)
+        outcome = handle.wait(self.REACH_TIME)
+        if outcome is not None and not outcome.succeeded:
+            raise RuntimeError(f"could not put the {item} back into the {gripper} gripper: {outcome.message}")
+        log.info("the %s is held out in the %s gripper", item, gripper)
 
 
 def operator_resolver(operator: Operator) -> Callable[[Any], ProcessModule | None]:
