@@ -202,7 +202,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         run = PlanRun(plan, robot, facts)
         thief.start()
         run.start(world.sim_time.get_value())
-        result.message = _watch(run, world, plan, thief, options)
+        result.message = _watch(run, world, plan, helper, thief, options)
         thief.stop()
         result.plan_wall_time = run.wall_time
         result.sim_time = run.sim_time(world.sim_time.get_value())
@@ -298,7 +298,7 @@ def _write_run_pictures(run_id: Any, output: Path, recorder: Any) -> list[Path]:
     return list(write_run_pictures(run_id, output, url=recorder.url))
 
 
-def _watch(run: PlanRun, world: Any, plan: Any, thief: Any, options: DemoOptions) -> str:
+def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions) -> str:
     """Show live progress until the plan ends; stop it on a time limit or Ctrl-C.
 
     Returns "" when the plan ended by itself, otherwise why it was stopped. Without
@@ -309,6 +309,8 @@ def _watch(run: PlanRun, world: Any, plan: Any, thief: Any, options: DemoOptions
     sim_deadline = world.sim_time.get_value() + SIM_TIME_LIMIT
     wall_deadline = time.monotonic() + WALL_TIME_LIMIT
     progress = None if options.quiet else _ProgressLine(run, world, plan, thief)
+    if progress is not None:
+        helper.prompt = progress.ask  # --interactive: pause the live line while asking
     reason = ""
     with progress or contextlib.nullcontext():
         try:
@@ -354,6 +356,14 @@ class _ProgressLine:
 
     def refresh(self) -> None:
         self._live.update(self._text())
+
+    def ask(self, question: str) -> str:
+        """Ask the user at the terminal, with the live line paused so it does not hide the question."""
+        self._live.stop()
+        try:
+            return input(question)
+        finally:
+            self._live.start()
 
     def __exit__(self, *exc: Any) -> None:
         self.refresh()
