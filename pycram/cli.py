@@ -279,7 +279,7 @@ def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
     item_at: int = typer.Option(1, "--item-at", help="Where the item starts: position 1, 2 or 3 (0: no item)."),
-    steal: int = typer.Option(0, "--steal", help="How many times the item is taken away while the robot fetches it."),
+    steal: int = typer.Option(0, "--steal", help="How many times the item is taken from the gripper while the robot carries it."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
     realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
     interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
@@ -295,13 +295,9 @@ def demo_command(
         if e.name and e.name.startswith("pycram.demos"):
             _fail("the kitchen demo (pycram.demos.kitchen) is not available in this installation")
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
-    kwargs = dict(robot=robot, output=output, item_at=item_at, steal=steal, seed=seed, realtime=realtime,
-                  interactive=interactive, db=db, record=_record_flag(record))
-    import inspect
-
-    if "quiet" in inspect.signature(demo_main).parameters:
-        kwargs["quiet"] = quiet
-    code = _trace_errors(demo_main, **kwargs)
+    code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
+                         realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
+                         quiet=quiet)
     raise typer.Exit(int(code or 0))
 
 

@@ -77,3 +77,14 @@ def test_no_item_ends_with_a_clear_failure(tmp_path):
     assert "NoItemGrasped" in result.message and "cooker #2" in result.message
     assert grasp_attempts(result.tree_text) == ["failed", "failed", "failed"]
     assert not result.item_on_cooker_1
+
+
+@pytest.mark.parametrize("option, value, expected", [
+    ("robot", "nao", "--robot must be 'pr2' or 'tiago'"),
+    ("item_at", 4, "--item-at must be 0 (no item) or a position 1, 2 or 3"),
+])
+def test_bad_options_get_a_clear_message_and_exit_code_2(tmp_path, capsys, option, value, expected):
+    from pycram.demos.kitchen import main
+
+    assert main(output=str(tmp_path), record=False, quiet=True, **{option: value}) == 2
+    assert expected in capsys.readouterr().out

@@ -407,7 +407,11 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
                           seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
                           quiet=quiet)
-    result = run_demo(options)
+    try:
+        result = run_demo(options)
+    except ValueError as error:  # an option out of range: say which, no traceback
+        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
+        return 2
     console.print("\n[bold]Task tree[/bold]")
     console.print(result.tree_text, markup=False, highlight=False)
     console.print(f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
