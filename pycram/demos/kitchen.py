@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import os
 import random
 import threading
@@ -239,6 +240,7 @@ def _gripper_mapper(world: Any):
 
 
 def _item_on_cooker_1(world: Any, item: str, counter_height: float) -> bool:
+    """True when `item` stands upright on cooker #1 and no gripper holds it."""
     from pycram.demos.kitchen_world import PLACE_XY
 
     pose = world.item_poses.get_value().get(item)
@@ -247,7 +249,17 @@ def _item_on_cooker_1(world: Any, item: str, counter_height: float) -> bool:
     x, y, z = pose.position
     held = any(state.get_value().holding == item for state in world.gripper_states.values())
     on_top = counter_height < z < counter_height + 0.15
-    return not held and on_top and ((x - PLACE_XY[0]) ** 2 + (y - PLACE_XY[1]) ** 2) ** 0.5 < 0.15
+    near = math.hypot(x - PLACE_XY[0], y - PLACE_XY[1]) < 0.15
+    log.info("the %s ends at (%.2f, %.2f, %.2f), tilted %.0f deg%s", item, x, y, z,
+             math.degrees(_tilt(pose.orientation)), ", held" if held else "")
+    return not held and on_top and near and _tilt(pose.orientation) < math.radians(20)
+
+
+def _tilt(quaternion: tuple[float, float, float, float]) -> float:
+    """Angle [rad] between an item's own z axis and the vertical, from its (w, x, y, z) orientation."""
+    w, x, y, z = quaternion
+    up_z = 1.0 - 2.0 * (x * x + y * y)  # z component of the item's z axis in the map frame
+    return math.acos(max(-1.0, min(1.0, up_z)))
 
 
 def _failed(task: Any) -> bool:
