@@ -1,7 +1,8 @@
-"""Rendering in the simulation thread: RGB and segmentation images, animation frames, files.
+"""Rendering in the simulation thread (RGB and segmentation images) and writing image files.
 
 Renderers are created lazily in the simulation thread (GL contexts belong to a thread) and
-closed by it. Writing files happens in the caller's thread from plain arrays.
+closed by it. Animation frames are rendered elsewhere, by a recorder thread of their own
+(`pycram.sim.recording`). Writing files happens in the caller's thread from plain arrays.
 """
 
 from __future__ import annotations
@@ -73,21 +74,31 @@ def write_png(path: str | Path, image: np.ndarray) -> Path:
 def write_animation(path: str | Path, frames: Sequence[np.ndarray], fps: float) -> Path:
     """Write frames (RGB arrays of one size) to an animation at `fps` [frames per s of the video].
 
-    ".gif" always works (Pillow, installed with imageio); ".mp4" and other video formats need a
-    video backend (`pip install imageio-ffmpeg` or `av`) and raise `SimulationError` saying so
-    when none is installed. Raises ValueError when there are no frames.
+    ".gif" always works (our own `GifEncoder` on Pillow): frames returned by
+    `World.stop_recording` (`RecordedFrames`) were encoded while they were recorded and are
+    written at once; other frames are encoded here (a few ms per frame, palette from up to 8
+    of them). ".mp4" and other video formats need a video backend (`pip install
+    imageio-ffmpeg` or `av`) and raise `SimulationError` saying so when none is installed.
+    Raises ValueError when there are no frames.
     """
-    import imageio.v3 as iio
-
     from .errors import SimulationError
+    from .gif import GifEncoder
+    from .recording import RecordedFrames
 
-    if not frames:
+    if not len(frames):
         raise ValueError("no frames recorded")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".gif":
-        iio.imwrite(path, np.stack(frames), duration=1000.0 / fps, loop=0)
-        return path
+        encoder = frames.encoded_gif() if isinstance(frames, RecordedFrames) else None
+        if encoder is None:
+            samples = [frames[i] for i in np.linspace(0, len(frames) - 1, min(8, len(frames))).round().astype(int)]
+            encoder = GifEncoder(palette_from=[s[::2, ::2] for s in samples])
+            for frame in frames:
+                encoder.add(frame)
+        return encoder.write(path, fps)
+    import imageio.v3 as iio
+
     try:
         iio.imwrite(path, np.stack(frames), fps=fps)
     except Exception as exc:  # imageio raises several types when no plugin can write the format

@@ -36,6 +36,7 @@ from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
 from .kitchen import OBSTACLE_PARKING
+from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
 from .scene import build_scene
@@ -91,7 +92,8 @@ class World:
         self._stop = threading.Event()
         self._active: dict[str, tuple[Controller, CommandHandle]] = {}
         self._finished: list[tuple[CommandHandle, Outcome]] = []
-        self._recording: dict[str, Any] | None = None
+        self._recorder: FrameRecorder | None = None  # the running recording (simulation thread's)
+        self._recorders: list[FrameRecorder] = []  # every recorder started, for close() to end
         self._renderers: Renderers | None = None
         self.error: BaseException | None = None
         self._previous_clock = set_clock(self.clock) if activate_clock else None
@@ -114,14 +116,19 @@ class World:
     def close(self, timeout: float = 10.0) -> None:
         """Stop the simulation thread and wait for it [s of wall time]; idempotent.
 
-        Commands still running end with reason "closed"; the clock that was active before this
-        world is re-activated if this world's clock is still the active one.
+        Commands still running end with reason "closed"; a recording still running is ended
+        without writing anything (its recorder thread is joined too); the clock that was active
+        before this world is re-activated if this world's clock is still the active one.
         """
         self._stop.set()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
                 _log.error("simulation thread did not stop within %.1f s", timeout)
+        with self._lock:
+            recorders, self._recorders = self._recorders, []
+        for recorder in recorders:
+            recorder.close(timeout)
         self._deactivate_clock()
 
     def _deactivate_clock(self) -> None:
@@ -164,8 +171,9 @@ class World:
                     finished, self._finished = self._finished, []
                     for handle, outcome in finished:
                         handle._finish(outcome)
-                if self._recording is not None and eng.time >= self._recording["next"]:
-                    self._record_frame()
+                recorder = self._recorder
+                if recorder is not None and recorder.due(eng.time):
+                    recorder.capture(eng.data)  # a copy of the state; rendered in the recorder's thread
                 if self.realtime:
                     ahead = (eng.time - sim0) / self.realtime_factor - (time.monotonic() - wall0)
                     if ahead > 0:
@@ -196,6 +204,8 @@ class World:
                 b._finish(Outcome(False, reason, "world closed"))
         if self._renderers is not None:
             self._renderers.close()
+        if self._recorder is not None:
+            self._recorder.abort()  # never blocks; close() joins the thread
         # wake anybody waiting on simulated time one last time
         self.clock.advance_to(self._engine.time + 1e9)
 
@@ -406,41 +416,74 @@ class World:
                           lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height))
 
     def start_recording(self, camera: str = "overview", fps: float = 10.0, width: int = 320,
-                        height: int = 240) -> CommandHandle:
-        """Start recording frames of `camera` every 1/`fps` s of simulated time."""
+                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING) -> CommandHandle:
+        """Start recording frames of `camera` (width x height [px]) every 1/`fps` s of simulated
+        time, from the simulated time at which the command runs; a recording already running is
+        discarded.
+
+        The simulation thread only copies the state at each frame time (microseconds); a
+        recorder thread of its own renders and GIF-encodes the frames (`FrameRecorder`), so the
+        simulation never waits for rendering. If `max_pending` frames wait to be rendered, a new
+        one is dropped (counted and logged when the recording stops). Frames are not limited by
+        the world's `offscreen_size`, and are rendered without multisampling.
+        """
         self.scene.camera(camera)
+        recorder = FrameRecorder(self.scene.model, camera, fps, width, height, max_pending,
+                                 name=f"pycram-recorder-{self.robot}")
+        with self._lock:
+            self._recorders.append(recorder)
 
         def fn(eng: Engine) -> None:
-            self._recording = {"camera": camera, "fps": fps, "size": (width, height), "frames": [],
-                               "next": eng.time}
+            previous, self._recorder = self._recorder, recorder
+            if previous is not None:
+                _log.warning("start_recording: discarding the recording that was running")
+                previous.abort()
+            recorder.start_at(eng.time)
 
-        return self._call("start_recording", fn)
+        try:
+            return self._call("start_recording", fn)
+        except WorldClosedError:
+            self._forget_recorder(recorder, abort=True)
+            raise
 
-    def _record_frame(self) -> None:
-        rec = self._recording
-        assert rec is not None
-        w, h = rec["size"]
-        rec["frames"].append(self._get_renderers().rgb(self._engine.data, rec["camera"], w, h))
-        rec["next"] += 1.0 / rec["fps"]
+    def _forget_recorder(self, recorder: FrameRecorder, abort: bool) -> None:
+        with self._lock:
+            if recorder in self._recorders:
+                self._recorders.remove(recorder)
+        if abort:
+            recorder.close()
 
     def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
         """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
 
-        Blocks up to `timeout` [s of wall time].
+        Waits for the recorder thread to render the frames still pending and ends it. Blocks up
+        to `timeout` [s of wall time]; frames not rendered by then are dropped (logged). Returns
+        a `RecordedFrames` (a list of RGB arrays, height x width x 3 uint8, which also carries
+        the GIF encoding, so `write_animation` of these frames to a GIF is fast). Raises
+        `WorldClosedError` if the world is closed and `SimulationError` if rendering failed;
+        `ValueError` from writing when `path` is given but nothing was recorded.
         """
+        deadline = time.monotonic() + timeout
 
-        def fn(eng: Engine) -> tuple[list[np.ndarray], float]:
-            rec, self._recording = self._recording, None
-            return (rec["frames"], rec["fps"]) if rec else ([], 1.0)
+        def fn(eng: Engine) -> FrameRecorder | None:
+            recorder, self._recorder = self._recorder, None
+            return recorder
 
         handle = self._call("stop_recording", fn)
         _wait_wall(handle, timeout)
         out = handle.outcome
         if out is None or not out.succeeded:
             raise WorldClosedError(f"stop_recording failed: {out}")
-        frames, fps = out.value
+        recorder: FrameRecorder | None = out.value
+        if recorder is None:
+            frames = RecordedFrames()
+        else:
+            try:
+                frames = recorder.finish(max(0.0, deadline - time.monotonic()))
+            finally:
+                self._forget_recorder(recorder, abort=False)
         if path is not None:
-            write_animation(path, frames, fps)
+            write_animation(path, frames, frames.fps)
         return frames
 
     # ------------------------------------------------------------------ fault injection

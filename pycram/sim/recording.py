@@ -1,0 +1,255 @@
+"""Animation recording off the simulation thread: state snapshots in, rendered frames out.
+
+The simulation thread only copies the state that drawing needs (`StateSnapshot`, ~0.5 kB: joint
+positions, mocap poses, time) at each frame time and offers it to a `FrameRecorder`, which never
+blocks it. The recorder's own thread owns a copy of the model, its own `MjData` and its own
+`mujoco.Renderer` (GL contexts belong to the thread that created them): it computes the
+kinematics of each snapshot, renders it, and GIF-encodes it right away (`GifEncoder`), so that
+writing the animation at the end only joins bytes. The simulation's `MjData` is never touched by
+the recorder.
+
+Rendering and encoding hardly hold the GIL (measured on 2 cores: a busy Python thread kept
+~80% of its pace beside a thread rendering continuously, ~96% beside continuous GIF encoding;
+the rest is CPU contention). The recorder thread runs at a lower scheduling priority (Linux:
+nice +`RECORDER_NICE` for that thread only; the GL driver's rasterizer threads are shared by the
+process and keep theirs), so the simulation thread is preferred when the CPU is short, and the
+recorder catches up afterwards (`finish` waits for it).
+"""
+
+from __future__ import annotations
+
+import collections
+import copy
+import logging
+import os
+import threading
+import time
+from dataclasses import dataclass
+from typing import Iterable
+
+import mujoco
+import numpy as np
+
+from .errors import SimulationError
+from .gif import GifEncoder
+
+_log = logging.getLogger(__name__)
+
+#: Nice increment of the recorder thread (and the GL threads it starts): background work.
+RECORDER_NICE = 5
+#: Default bound of snapshots waiting to be rendered; more are dropped (counted, logged).
+DEFAULT_MAX_PENDING = 512
+
+
+@dataclass(frozen=True)
+class StateSnapshot:
+    """What drawing a frame needs of the simulation state, copied at simulated `time` [s].
+
+    Items held in a gripper (welds) and coupled joints are part of `qpos` (free and coupled
+    joints); obstacles are mocap bodies.
+    """
+
+    time: float
+    qpos: np.ndarray
+    mocap_pos: np.ndarray
+    mocap_quat: np.ndarray
+
+    @classmethod
+    def of(cls, data: mujoco.MjData) -> "StateSnapshot":
+        """Copy the state of `data` (call from the thread that owns `data`; a few microseconds)."""
+        return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+
+    def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        """Set `data` to this state and compute what rendering reads (body, geom, camera and
+        light poses: `mj_kinematics` + `mj_camlight`); velocities and contacts are not computed."""
+        data.time = self.time
+        data.qpos[:] = self.qpos
+        data.mocap_pos[:] = self.mocap_pos
+        data.mocap_quat[:] = self.mocap_quat
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_camlight(model, data)
+
+
+class RecordedFrames(list):
+    """RGB frames (height x width x 3, uint8), oldest first, as recorded by a `FrameRecorder`.
+
+    A plain list of arrays to its users; it also carries the recording's `fps` [frames per s of
+    simulated time], how many frames were `dropped`, and their GIF encoding (`gif`), which
+    `pycram.sim.render.write_animation` uses to write a GIF at once.
+    """
+
+    def __init__(self, frames: Iterable[np.ndarray] = (), fps: float = 1.0, dropped: int = 0,
+                 gif: GifEncoder | None = None) -> None:
+        super().__init__(frames)
+        self.fps = fps
+        self.dropped = dropped
+        self.gif = gif
+
+    def encoded_gif(self) -> GifEncoder | None:
+        """The GIF encoding of exactly these frames, or None (e.g. after the list was changed)."""
+        gif = self.gif
+        return gif if gif is not None and gif.frame_count == len(self) else None
+
+
+class FrameRecorder:
+    """Renders frames of `camera` at `fps` [frames per s of simulated time] in its own thread.
+
+    The owner of the simulation calls `due(t)` and `capture(data)` from its thread; neither ever
+    blocks for rendering. At most `max_pending` snapshots wait for rendering: a snapshot offered
+    while that many wait is dropped (counted in `dropped`). `finish` renders the rest and ends
+    the thread; `abort` ends it without rendering the rest. The thread exists from construction
+    until `finish`/`abort`/`close`; none of them may be called from the simulation thread if it
+    must not block (`abort` never blocks).
+    """
+
+    def __init__(self, model: mujoco.MjModel, camera: str, fps: float, width: int, height: int,
+                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder") -> None:
+        if fps <= 0:
+            raise ValueError(f"fps must be positive, got {fps}")
+        if width <= 0 or height <= 0:
+            raise ValueError(f"frame size must be positive, got {width}x{height}")
+        if max_pending < 1:
+            raise ValueError(f"max_pending must be at least 1, got {max_pending}")
+        self.camera, self.fps, self.size = camera, float(fps), (int(width), int(height))
+        self.max_pending = max_pending
+        self._model = model
+        self._period = 1.0 / self.fps
+        self._next: float | None = None  # simulated time of the next frame [s]; None: not started
+        self._pending: collections.deque[StateSnapshot] = collections.deque()
+        self._cond = threading.Condition()
+        self._finishing = False  # render what is pending, then end
+        self._aborted = False  # end now
+        self._frames: list[np.ndarray] = []
+        self._gif = GifEncoder()
+        self.dropped = 0  #: snapshots dropped because `max_pending` were waiting, or not rendered
+        self.error: BaseException | None = None  #: why the recorder thread failed, if it did
+        self.render_time = 0.0  #: wall time the thread spent on rendering and encoding [s]
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+        self._thread.start()
+
+    # ------------------------------------------------------------------ simulation side
+    def start_at(self, sim_time: float) -> None:
+        """Record the first frame at `sim_time` [s] and then every 1/fps s (simulation thread)."""
+        self._next = sim_time
+
+    def due(self, sim_time: float) -> bool:
+        """True when a frame is due at `sim_time` [s] (exactly `fps` frames per simulated second)."""
+        return self._next is not None and sim_time >= self._next - 1e-9
+
+    def capture(self, data: mujoco.MjData) -> bool:
+        """Snapshot `data` for the frame that is due and hand it to the recorder thread.
+
+        Call from the thread that owns `data`. Never blocks on rendering (only on a lock held for
+        microseconds). Returns False when the snapshot was dropped.
+        """
+        assert self._next is not None, "start_at() first"
+        self._next += self._period
+        if self._next <= data.time:  # far behind (e.g. stepped in big chunks): no burst of frames
+            self._next = float(data.time) + self._period
+        snapshot = StateSnapshot.of(data)
+        with self._cond:
+            if self._finishing or self._aborted:
+                return False
+            if len(self._pending) >= self.max_pending:
+                self.dropped += 1
+                return False
+            self._pending.append(snapshot)
+            self._cond.notify_all()
+        return True
+
+    # ------------------------------------------------------------------ ending
+    @property
+    def running(self) -> bool:
+        """True while the recorder thread runs."""
+        return self._thread.is_alive()
+
+    def abort(self) -> None:
+        """Ask the thread to end without rendering what is pending (never blocks)."""
+        with self._cond:
+            self._aborted = True
+            self._cond.notify_all()
+
+    def finish(self, timeout: float | None = None) -> RecordedFrames:
+        """Render what is pending, end the thread and return the frames.
+
+        Waits up to `timeout` [s of wall time] (None: until done) for the pending frames; what is
+        still pending then is dropped (logged). Raises `SimulationError` if rendering failed.
+        On return the thread has ended (or, if a single render hangs, is abandoned: logged).
+        """
+        with self._cond:
+            self._finishing = True
+            self._cond.notify_all()
+        self._thread.join(timeout)
+        if self._thread.is_alive():
+            with self._cond:
+                left = len(self._pending)
+            _log.warning("recording: %d frames still to render after %.1f s; dropping them", left, timeout)
+            self.close()
+        if self.error is not None:
+            raise SimulationError(f"recording failed: {type(self.error).__name__}: {self.error}") from self.error
+        level = logging.WARNING if self.dropped else logging.INFO
+        _log.log(level, "recorded %d frames of %r at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
+                 len(self._frames), self.camera, self.fps, *self.size, self.dropped, self.render_time)
+        return RecordedFrames(self._frames, self.fps, self.dropped, self._gif)
+
+    def close(self, timeout: float = 10.0) -> None:
+        """`abort` and wait up to `timeout` [s of wall time] for the thread to end; idempotent."""
+        self.abort()
+        if threading.current_thread() is not self._thread:
+            self._thread.join(timeout)
+            if self._thread.is_alive():  # pragma: no cover - a render that hangs in the GL driver
+                _log.error("recorder thread did not stop within %.1f s", timeout)
+
+    # ------------------------------------------------------------------ recorder thread
+    def _take(self) -> StateSnapshot | None:
+        """The next snapshot to render, or None when the thread must end."""
+        with self._cond:
+            self._cond.wait_for(lambda: self._pending or self._finishing or self._aborted)
+            if self._aborted or not self._pending:
+                self.dropped += len(self._pending)
+                self._pending.clear()
+                return None
+            return self._pending.popleft()
+
+    def _run(self) -> None:
+        _lower_priority()
+        renderer = None
+        try:
+            # A deep copy (mj_copyModel), so nothing is shared with the simulation thread afterwards.
+            # The simulation only writes weld parameters and force ranges into its model while it
+            # runs, which drawing never reads, so copying from here while it steps is harmless.
+            model = copy.copy(self._model)
+            model.vis.quality.offsamples = 0  # no multisampling: ~3x cheaper with a software renderer
+            model.vis.global_.offwidth, model.vis.global_.offheight = self.size
+            data = mujoco.MjData(model)
+            renderer = mujoco.Renderer(model, height=self.size[1], width=self.size[0])
+            while (snapshot := self._take()) is not None:
+                t0 = time.perf_counter()
+                snapshot.apply(model, data)
+                renderer.update_scene(data, camera=self.camera)
+                rgb = renderer.render()
+                self._frames.append(rgb)
+                self._gif.add(rgb)
+                self.render_time += time.perf_counter() - t0
+        except BaseException as exc:  # noqa: BLE001 - reported by finish()
+            self.error = exc
+            _log.exception("recorder thread failed")
+            with self._cond:
+                self._aborted = True
+                self.dropped += len(self._pending)
+                self._pending.clear()
+        finally:
+            if renderer is not None:
+                renderer.close()
+
+
+def _lower_priority() -> None:
+    """Lower this thread's scheduling priority by `RECORDER_NICE` (Linux: nice is per thread)."""
+    try:
+        tid = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + RECORDER_NICE)
+    except (AttributeError, OSError):  # pragma: no cover - other systems, or not permitted
+        _log.debug("could not lower the recorder's priority", exc_info=True)
+
+
+__all__ = ["FrameRecorder", "RecordedFrames", "StateSnapshot", "RECORDER_NICE", "DEFAULT_MAX_PENDING"]
