@@ -27,7 +27,6 @@ import threading
 import weakref
 from enum import Enum
 from typing import Any, Callable, Iterator
-from uuid import uuid4
 
 from pycram.block_forms import BlockForm
 from pycram.runtime.evaporation import wait_until
@@ -64,7 +63,7 @@ class Fluent:
         self._value = value
         self._name = name
         self._cv: threading.Condition | None = None
-        self._children: tuple[weakref.ref, ...] = ()
+        self._children: list[weakref.ref] = []  # replaced, never shrunk in place (see add_child)
         self._live = 0  # number of children after the last pruning of dead references
         self._pulses = 0
         self._handle_missed = Behavior.NEVER
@@ -75,6 +74,8 @@ class Fluent:
     def name(self) -> str:
         """The fluent's name (a random UUID string unless one was given)."""
         if self._name is None:
+            from uuid import uuid4  # lazily: uuid costs a few ms at import time
+
             self._name = str(uuid4())
         return self._name
 
@@ -121,13 +122,19 @@ class Fluent:
                 cv.notify_all()
 
     def add_child(self, fluent: Fluent) -> None:
-        """Make `fluent` be pulsed whenever this fluent is. Held weakly: it dies with its users."""
+        """Make `fluent` be pulsed whenever this fluent is. Held weakly: it dies with its users.
+
+        Amortised O(1): the list is appended to; dead references are pruned (into a new list,
+        so that a concurrent `pulse` iterating the old one is unaffected) whenever it has grown
+        to twice its live size since the last pruning.
+        """
+        ref = weakref.ref(fluent)
         with _create_lock:
             children = self._children
-            if len(children) >= 2 * self._live + 8:  # amortised pruning of dead references
-                children = tuple(ref for ref in children if ref() is not None)
+            if len(children) >= 2 * self._live + 8:
+                children = self._children = [r for r in children if r() is not None]
                 self._live = len(children)
-            self._children = children + (weakref.ref(fluent),)
+            children.append(ref)
 
     def _condition(self) -> threading.Condition:
         cv = self._cv

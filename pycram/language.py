@@ -320,17 +320,7 @@ def _failure_handling_block(max_retries: int | None) -> _BlockUse:
     return _BlockUse(form)
 
 
-def failure_handling(body: Branch | int | None = None, max_retries: int = -1, name: str | None = None) -> Any:
-    """Run `body`; each `retry()` inside it restarts it (thesis 3.2.3).
-
-    `max_retries` limits the restarts (the body then runs at most `max_retries + 1` times);
-    once it is reached, `retry()` does nothing and returns. Negative means unlimited. Each run
-    is a task "attempt N" under a "failure_handling" task (`task.info["attempts"]`).
-    Returns the body's result; other exceptions of the body propagate. Implemented as a loop:
-    10,000 retries do not grow the stack. An evaporating body is never restarted.
-    """
-    if body is None or not callable(body):
-        return _failure_handling_block(body if isinstance(body, int) else None)
+def _run_failure_handling(body: Branch, max_retries: int, name: str | None) -> Any:
     handler = _FailureHandler(max_retries)
 
     def attempt() -> Any:
@@ -347,6 +337,38 @@ def failure_handling(body: Branch | int | None = None, max_retries: int = -1, na
             except RetryRequested as request:
                 if request.handler is not handler:
                     raise
+
+
+class _FailureHandling(BlockForm):
+    """The `failure_handling` expression object (callable; refuses a bare `with` without the
+    block syntax, as the thesis' `with failure_handling:` would otherwise fail obscurely)."""
+
+    _block_form_name = "failure_handling"
+    __name__ = __qualname__ = "failure_handling"
+
+    def __call__(self, body: Branch | int | None = None, max_retries: int = -1, name: str | None = None) -> Any:
+        """Run `body`; each `retry()` inside it restarts it (thesis 3.2.3).
+
+        `max_retries` limits the restarts (the body then runs at most `max_retries + 1` times);
+        once it is reached, `retry()` does nothing and returns. Negative means unlimited. Each
+        run is a task "attempt N" under a "failure_handling" task (`task.info["attempts"]`;
+        inside the body `current_attempt()`). Returns the body's result; other exceptions of
+        the body propagate. Implemented as a loop: 10,000 retries do not grow the stack. An
+        evaporating body is never restarted.
+
+        `failure_handling(5)` / `failure_handling()` without a callable are the heads of the
+        block form `with failure_handling(5):`, which needs the block syntax.
+        """
+        if body is None or not callable(body):
+            return _failure_handling_block(body if isinstance(body, int) else None)
+        return _run_failure_handling(body, max_retries, name)
+
+    def __repr__(self) -> str:
+        return "<pycram expression failure_handling>"
+
+
+failure_handling = _FailureHandling()
+failure_handling.__doc__ = _FailureHandling.__call__.__doc__
 
 
 def _innermost_handler() -> tuple[Task, _FailureHandler] | None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import sys
 import threading
 import time
 
@@ -66,24 +67,41 @@ def test_wait_for_wakes_when_value_is_set_from_another_thread():
     thread.join(WAIT)
 
 
+def _wait_until_blocked(fluent: Fluent, count: int) -> None:
+    """Until `count` threads are blocked in `fluent.wait_for()` (CPython's Condition keeps its
+    waiters in `_waiters`): only then does a single `set_value` have to wake all of them."""
+    cv = fluent._condition()
+    deadline = time.monotonic() + WAIT
+    while len(cv._waiters) < count:
+        assert time.monotonic() < deadline, f"only {len(cv._waiters)} of {count} waiters blocked"
+        time.sleep(0.001)
+
+
 def test_every_waiter_wakes_not_just_one():
     f = Fluent()
+    network = f > 3  # waiters on a network wake too
     woke = []
     lock = threading.Lock()
-    ready = threading.Barrier(21)
 
-    def waiter(i):
-        ready.wait()
-        if f.wait_for(timeout=WAIT):
+    def waiter(i, fluent):
+        if fluent.wait_for(timeout=WAIT):
             with lock:
                 woke.append(i)
 
-    threads = [start_thread(lambda i=i: waiter(i)) for i in range(20)]
-    ready.wait()
-    f.set_value("go")
+    threads = [start_thread(lambda i=i: waiter(i, f if i < 10 else network)) for i in range(20)]
+    _wait_until_blocked(f, 10)
+    _wait_until_blocked(network, 10)
+    f.set_value(5)  # one change: with notify() instead of notify_all() only one would wake
     for thread in threads:
         thread.join(WAIT)
     assert sorted(woke) == list(range(20))
+
+
+def test_set_value_always_pulses_even_with_the_same_value():
+    f = Fluent(1)
+    p = f.pulsed()
+    f.set_value(1)
+    assert p.get_value() is True
 
 
 def test_fluent_is_hashable_by_identity_despite_overloaded_eq():
@@ -201,14 +219,32 @@ def test_thesis_user_defined_network_with_add_child():
     thread.join(WAIT)
 
 
-def test_temporary_networks_do_not_accumulate_in_their_parent():
+def test_a_million_temporary_networks_keep_memory_flat():
+    """The thesis' parents kept every child alive: `while ...: (f < 3).wait_for()` leaked."""
     f = Fluent(1)
-    for _ in range(200_000):
+    for _ in range(10_000):  # warm-up: caches, free lists
         (f < 3).get_value()
     gc.collect()
-    live = [ref for ref in f._children if ref() is not None]
-    assert live == []
-    assert len(f._children) < 64  # dead references are pruned, memory stays flat
+    blocks = sys.getallocatedblocks()
+    longest = 0
+    for i in range(1_000_000):
+        (f < 3).get_value()
+        if i % 100_000 == 0:
+            f.set_value(1)  # pulses walk the (pruned) children
+            longest = max(longest, len(f._children))
+    gc.collect()
+    assert len(f._children) < 64 and longest < 64  # dead references are pruned
+    assert [ref for ref in f._children if ref() is not None] == []
+    # a leak would hold >= 1,000,000 fluents (several blocks each); allow for unrelated noise
+    assert sys.getallocatedblocks() - blocks < 10_000
+
+
+def test_adding_many_live_children_is_not_quadratic():
+    f = Fluent(0)
+    kept = [f.pulsed() for _ in range(20_000)]  # amortised O(1) each: a copy-on-add tuple was O(n)
+    f.pulse()
+    assert all(p.get_value() is True for p in kept)
+    assert len(f._children) == 20_000
 
 
 def test_networks_stay_alive_while_used_and_die_afterwards():

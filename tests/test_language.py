@@ -20,7 +20,7 @@ from pycram.language import (
     try_in_order,
     with_timeout,
 )
-from pycram.runtime import Evaporated, TaskStatus, current_task, no_evaporation, sleep
+from pycram.runtime import Evaporated, TaskStatus, check_evaporation, current_task, no_evaporation, sleep
 
 WAIT = 5.0
 
@@ -248,7 +248,7 @@ def test_evaporation_is_sticky_and_finally_blocks_run():
                 Fluent().wait_for()
             except BaseException:  # a bare except cannot save the task ...
                 events.append("caught")
-            sleep(1)  # ... every later pycram call raises again
+            sleep(0.5)  # ... every later pycram call raises again
             events.append("resurrected")
         finally:
             events.append("finally")
@@ -256,6 +256,100 @@ def test_evaporation_is_sticky_and_finally_blocks_run():
     s = pursue(stubborn, lambda: started.wait_for(timeout=WAIT))
     assert s.get_value() is State.SUCCEEDED
     assert events == ["caught", "finally"]
+
+
+def test_evaporation_is_sticky_for_every_later_pycram_call():
+    started = Fluent()
+    raised = []
+    calls = {
+        "check_evaporation": check_evaporation,
+        "wait_for": lambda: Fluent(1).wait_for(),  # even a wait that would not block
+        "sleep": lambda: sleep(0),
+        "whenever": lambda: whenever(Fluent(1), lambda: None),
+        "seq": lambda: seq(lambda: None),
+        "par": lambda: par(lambda: None),
+        "with_timeout": lambda: with_timeout(1, lambda: None),
+        "failure_handling": lambda: failure_handling(lambda: None),
+        "retry": retry,
+    }
+
+    def stubborn():
+        started.set_value(True)
+        try:
+            Fluent().wait_for()
+        except BaseException:
+            pass  # a bare except ...
+        for name, call in calls.items():
+            try:
+                call()
+            except Evaporated:
+                raised.append(name)  # ... cannot save the task: every pycram call raises again
+
+    pursue(stubborn, lambda: started.wait_for(timeout=WAIT))
+    assert raised == list(calls)
+
+
+class Resource:
+    """A context manager that records that its clean-up ran, and why."""
+
+    def __init__(self, log: list) -> None:
+        self.log = log
+
+    def __enter__(self) -> "Resource":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        self.log.append(exc_type.__name__ if exc_type else None)
+        return False
+
+
+def test_evaporation_runs_context_managers_and_finally_in_waits_and_busy_loops():
+    log = []
+    started = [Fluent(), Fluent()]
+
+    def waiting():
+        with Resource(log):
+            try:
+                started[0].set_value(True)
+                Fluent().wait_for()
+            finally:
+                log.append("finally waiting")
+
+    def busy():
+        with Resource(log):
+            started[1].set_value(True)
+            _spin()
+
+    s = pursue(waiting, busy, lambda: started[0].AND(started[1]).wait_for(timeout=WAIT))
+    assert s.get_value() is State.SUCCEEDED
+    assert sorted(map(str, log)) == ["Evaporated", "Evaporated", "finally waiting"]
+    assert statuses(last_expression_task())[:2] == [TaskStatus.EVAPORATED, TaskStatus.EVAPORATED]
+
+
+def _spin() -> None:
+    x = 0
+    while True:
+        x += 1
+
+
+def test_no_evaporation_holds_back_the_interrupt_of_a_busy_loop():
+    events = []
+    inside = Fluent()
+
+    def critical():
+        me = current_task()
+        with no_evaporation():
+            inside.set_value(True)
+            while not me.evaporating:  # plain Python: would be interrupted without the shield
+                pass
+            for _ in range(200_000):
+                pass
+            events.append("critical done")
+        events.append("after")
+
+    pursue(critical, lambda: inside.wait_for(timeout=WAIT))
+    assert events == ["critical done"]
+    assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
 
 
 def test_no_evaporation_delays_delivery_to_the_end_of_the_block():
@@ -303,7 +397,7 @@ def test_retry_does_not_restart_an_evaporating_body():
 
 
 def test_evaporation_is_delivered_in_waits_sleep_and_whenever():
-    for blocked in (lambda: Fluent().wait_for(), lambda: sleep(60), lambda: whenever(Fluent(), lambda: None)):
+    for blocked in (lambda: Fluent().wait_for(), lambda: sleep(0.5), lambda: whenever(Fluent(), lambda: None)):
         s = pursue(blocked, lambda: None)
         assert s.get_value() is State.SUCCEEDED
         assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
@@ -326,6 +420,25 @@ def test_thesis_failure_handling_with_limit_runs_body_limit_plus_one_times():
     assert runs == [1, 2, 3, 4, 5, 6]
     task = last_expression_task()
     assert task.info["attempts"] == 6 and len(task.children) == 6
+
+
+def test_attempt_count_is_observable_inside_and_after():
+    seen = []
+
+    def body():
+        seen.append((current_attempt(), current_task().parent.info["attempts"]))
+        if len(seen) < 3:
+            retry()
+        return "ok"
+
+    assert failure_handling(body, name="observed") == "ok"
+    assert seen == [(1, 1), (2, 2), (3, 3)]
+    task = last_expression_task()
+    assert task.name == "observed" and task.info["attempts"] == 3
+    assert [c.name for c in task.children] == ["attempt 1", "attempt 2", "attempt 3"]
+    assert statuses(task) == [TaskStatus.FAILED, TaskStatus.FAILED, TaskStatus.SUCCEEDED]
+    with pytest.raises(RuntimeError, match="outside any failure_handling"):
+        current_attempt()
 
 
 def test_failure_handling_unlimited_until_success():
@@ -421,6 +534,7 @@ def test_with_timeout_in_time_succeeds():
         lambda: seq,
         lambda: par([]),
         lambda: try_all([]),
+        lambda: failure_handling,  # the thesis' bare `with failure_handling:`
         lambda: failure_handling(5),
         lambda: failure_handling(),
         lambda: whenever(Fluent()),

@@ -78,11 +78,11 @@ class Runner:
 
     def _enter_runtime(self, condition: threading.Condition | None = None) -> None:
         with self._lock:
+            if self._injected:  # first, so that a late delivery leaves the state untouched
+                self._injected = False
+                _take_back_async_exception(self.ident)
             self._mode = _RUNTIME
             self._waiting_on = condition
-            if self._injected:
-                self._injected = False
-                _clear_async_exception(self.ident)
 
     def _leave_runtime(self) -> None:
         with self._lock:
@@ -93,11 +93,11 @@ class Runner:
     def seal(self) -> None:
         """Mark the thread as finishing: no asynchronous exception can reach it after this."""
         with self._lock:
-            self._mode = _SEALED
-            self._waiting_on = None
             if self._injected:
                 self._injected = False
-                _clear_async_exception(self.ident)
+                _take_back_async_exception(self.ident)
+            self._mode = _SEALED
+            self._waiting_on = None
 
     # -- interrupting ---------------------------------------------------------------------------
 
@@ -177,10 +177,10 @@ def shielded() -> Iterator[Runner]:
     """
     runner = current_runner()
     with runner._lock:
-        runner._protected += 1
         if runner._injected:  # an interrupt raced with entering: take it back
             runner._injected = False
-            _clear_async_exception(runner.ident)
+            _take_back_async_exception(runner.ident)
+        runner._protected += 1
     try:
         yield runner
     finally:
@@ -283,5 +283,31 @@ def _inject_async_exception(ident: int) -> None:
     _api()[0](ident, Evaporated)
 
 
-def _clear_async_exception(ident: int) -> None:
-    _api()[1](ident, None)  # NULL clears a pending asynchronous exception
+class _TakenBack(BaseException):
+    """Stand-in asynchronous exception that replaces a pending `Evaporated`; never escapes."""
+
+
+def _delivery_point() -> None:
+    """An empty Python function: entering it is an eval-breaker check, where CPython raises a
+    pending asynchronous exception."""
+
+
+def _take_back_async_exception(ident: int) -> None:
+    """Cancel an asynchronous `Evaporated` that may still be pending for the calling thread.
+
+    `ident` must be the calling thread's id. Setting the pending exception to NULL, the
+    documented way, leaves CPython 3.11/3.12's interpreter-wide "asynchronous exception
+    pending" flag set for good: every thread then takes the slow path of the eval loop at
+    every call and loop iteration, and a thread traced by a debugger (pdb, bdb) or coverage
+    spins forever. Instead the pending exception is replaced by `_TakenBack` and delivered,
+    and caught, right here — delivery is what clears the flag. If nothing was pending, this
+    delivers and catches only the stand-in.
+    """
+    setter = _api()[0]
+    for _ in range(100):
+        try:
+            setter(ident, _TakenBack)  # CPython may raise it as this call returns ...
+            _delivery_point()  # ... and will at the latest here
+        except _TakenBack:
+            return
+    _api()[1](ident, None)  # pragma: no cover - never seen: fall back to the documented way
