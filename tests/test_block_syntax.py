@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import ast
 import functools
+import importlib
+import json
 import os
 import subprocess
 import sys
@@ -29,7 +31,7 @@ from pycram.macros import (
     transform_source,
     uninstall_import_hook,
 )
-from pycram.runtime import add_task_listener, remove_task_listener
+from pycram.runtime import add_task_listener, current_task, remove_task_listener
 
 ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.timeout(60)
@@ -110,6 +112,24 @@ def f(n):
         tmp_path,
     )
     assert ns["f"](3) == (4, 6, 10, State.SUCCEEDED, [])
+
+
+def test_as_name_is_bound_before_the_branches_start(tmp_path: Path) -> None:
+    ns = run(
+        HEADER
+        + """
+def f():
+    seen = []
+    with par as s:
+        seen.append(s.get_value())  # NameError if `s` were bound only after the branches
+        seen.append(s.get_value())
+    with try_all as t:
+        seen.append(t.get_value())
+    return seen, s.get_value(), t.get_value()
+""",
+        tmp_path,
+    )
+    assert ns["f"]() == ([None, None, None], State.SUCCEEDED, State.SUCCEEDED)
 
 
 def test_name_assigned_only_in_a_branch_that_did_not_run_stays_unbound(tmp_path: Path) -> None:
@@ -508,3 +528,114 @@ def test_debugger_breakpoint_inside_a_branch_stops_at_the_user_line(tmp_path: Pa
     threading.settrace(None)
     assert ns["hits"] == [1, 2]
     assert stops == [(str(path), 6, "seq@dbg.py:4#2")]
+
+
+# -- every mode reports misuse at the user's line; debuggers and coverage see branch lines -------------
+
+
+def test_import_hook_reports_misuse_with_file_and_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    pkg = tmp_path / "bad_hooked_pkg"
+    pkg.mkdir()
+    _write(pkg / "__init__.py", "")
+    _write(pkg / "returns.py", HEADER + "def f():\n    with par as s:\n        return 1\n")
+    _write(pkg / "empty.py", HEADER + "with par(errors) as s:\n    pass\n")
+    _write(pkg / "broken.py", HEADER + "with par as s:\n    x = (\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    installed = install_import_hook()
+    try:
+        for name, line, match in (("returns", 5, "`return` is not allowed"), ("empty", 3, "has no statements"), ("broken", 4, "never closed")):
+            with pytest.raises(SyntaxError, match=match) as info:
+                importlib.import_module(f"bad_hooked_pkg.{name}")
+            assert (info.value.filename, info.value.lineno) == (str(pkg / f"{name}.py"), line)
+    finally:
+        if installed:
+            uninstall_import_hook()
+        for name in [m for m in sys.modules if m.startswith("bad_hooked_pkg")]:
+            sys.modules.pop(name, None)
+
+
+def test_plan_reports_an_empty_block_and_a_non_fluent_whenever_at_the_user_line() -> None:
+    with pytest.raises(SyntaxError, match="has no statements") as info:
+
+        @plan
+        def empty() -> None:
+            with par as s:
+                pass
+
+    assert info.value.filename == __file__ and "with par as s:" in (info.value.text or "")
+
+    @plan
+    def not_a_fluent() -> None:
+        with whenever(42):  # marker: non-fluent whenever
+            x = 1
+
+    line = _line_of("# marker: non-fluent whenever")
+    with pytest.raises(TypeError, match=rf"test_block_syntax.py:{line} needs a Fluent, got int"):
+        not_a_fluent()
+
+
+def test_plan_tracebacks_and_task_names_point_at_the_user_lines() -> None:
+    @plan
+    def failing() -> list:
+        errors = []
+        with par(errors) as s:  # marker: traceback par
+            x = 1
+            {}["missing"]  # marker: traceback failure
+        return errors
+
+    (error,) = failing()
+    frame = traceback.extract_tb(error.__traceback__)[-1]
+    par_line = _line_of("# marker: traceback par")
+    assert (frame.filename, frame.lineno, frame.name) == (
+        __file__, _line_of("# marker: traceback failure"), f"par@test_block_syntax.py:{par_line}#2"
+    )
+    assert frame.line.startswith('{}["missing"]')
+    task = current_task().children[-1]
+    assert task.name == f"par@test_block_syntax.py:{par_line}" and task.children[1].name.endswith("#2")
+
+
+def _line_of(marker: str) -> int:
+    """The line of this file that holds `marker` (once, besides this lookup's own argument)."""
+    lines = [i for i, text in enumerate(Path(__file__).read_text().splitlines(), 1) if marker in text and "_line_of(" not in text]
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+def test_pdb_breakpoint_inside_a_par_branch_in_a_worker_thread(tmp_path: Path) -> None:
+    path = _write(
+        tmp_path / "pdb_plan.py",
+        HEADER + "with par as s:\n    if True:\n        answer = 41 + 1\n        breakpoint()\n        after = answer\n    other = 1\n",
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONBREAKPOINT": "pdb.set_trace"}
+    proc = subprocess.run(
+        [sys.executable, "-m", "pycram", str(path)], input="p answer\nwhere\nnext\np after\ncontinue\n",
+        capture_output=True, text=True, timeout=60, env=env,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    out = proc.stdout
+    assert f"> {path}(7)par@pdb_plan.py:3#1()" in out  # stopped at the user's next line, in the branch
+    assert "42" in out.split("(Pdb)")[1]  # `p answer` reads the branch's variable
+    assert f"{path}(7)par@pdb_plan.py:3#1()" in out.split("(Pdb)")[2]  # `where` shows the user's frame
+    assert "*** NameError" not in out.split("(Pdb)")[4] and "42" in out.split("(Pdb)")[4]  # `next` ran line 7
+
+
+def test_coverage_style_line_tracing_sees_branch_lines_in_every_thread(tmp_path: Path) -> None:
+    """coverage.py (like the standard `trace` module used here) records lines through
+    sys.settrace/threading.settrace: branch bodies must be attributed to the user's lines."""
+    path = _write(
+        tmp_path / "covered.py",
+        HEADER + "out = []\nwith par as s:\n    out.append(1)\n    if True:\n        out.append(2)\n        out.append(3)\nwith seq as t:\n    out.append(4)\n",
+    )
+    code = (
+        "import json, sys, trace\n"
+        "from pycram.macros import run_script\n"
+        "tracer = trace.Trace(count=1, trace=0)\n"
+        f"tracer.runctx({f'run_script({str(path)!r})'!r}, globals(), locals())\n"
+        f"lines = sorted(line for (name, line) in tracer.results().counts if name == {str(path)!r})\n"
+        "print(json.dumps(lines))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 0, proc.stderr
+    lines = set(json.loads(proc.stdout.strip().splitlines()[-1]))
+    assert set(range(3, 11)) <= lines  # every statement, in the main thread and in the branch threads

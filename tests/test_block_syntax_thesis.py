@@ -25,6 +25,7 @@ ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.timeout(60)
 
 EXPECTED_LISTINGS: dict[str, Any] = {
+    "fluents": (1, 2, "SUCCEEDED", "SUCCEEDED", "SUCCEEDED"),
     "seq_ok": ("SUCCEEDED", ["s1", "s2"], 0),
     "seq_fail": ("FAILED", [], ["s1"]),
     "try_in_order": ("SUCCEEDED", ["s2"], ["s1"]),
@@ -82,6 +83,7 @@ def check_demo(results: dict[str, Any]) -> None:
 def check_module_results(results: dict[str, Any]) -> None:
     assert normalise(results["whenever"]) == TARGETS
     assert normalise(results["whenever_pulsed"]) == TARGETS
+    assert normalise(results["whenever_return"]) == TARGETS  # `return` inside `with whenever` in a function
     check_listings(results)
     check_demo(results)
 
@@ -104,7 +106,7 @@ def test_decorator_whenever(decorated: Any) -> None:
 
 
 def test_decorator_expressions(decorated: Any) -> None:
-    results = {**decorated.sequential(), **decorated.parallel(), **decorated.error_handling()}
+    results = {**decorated.fluents(), **decorated.sequential(), **decorated.parallel(), **decorated.error_handling()}
     check_listings(results)
 
 
@@ -127,6 +129,17 @@ def _python(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[
 
 def test_python_dash_m_pycram_script() -> None:
     proc = _python("-m", "pycram", str(MODULE_LISTINGS))
+    assert proc.returncode == 0, proc.stderr
+    check_module_results(json.loads(proc.stdout.strip().splitlines()[-1]))
+
+
+def test_pycram_run_console_script(tmp_path: Path) -> None:
+    pycram = Path(sys.executable).parent / "pycram"
+    if not pycram.exists():
+        pytest.skip(f"the `pycram` console script is not installed next to {sys.executable}")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYCRAM_RECORD": "0"}
+    proc = subprocess.run([str(pycram), "run", "--no-record", str(MODULE_LISTINGS)], capture_output=True,
+                          text=True, timeout=60, cwd=tmp_path, env=env)
     assert proc.returncode == 0, proc.stderr
     check_module_results(json.loads(proc.stdout.strip().splitlines()[-1]))
 

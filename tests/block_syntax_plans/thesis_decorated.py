@@ -25,6 +25,35 @@ def fail(label):
 
 
 @plan
+def fluents():
+    """3.2.2: the fluent listings; each wait is a branch of a `par`, the change another."""
+    f = Fluent(1)
+    first_value = f.get_value()  # returns 1
+    f.set_value(2)  # sets the value to 2
+    second_value = f.get_value()  # returns 2
+
+    goal_reached = Fluent()
+    with par as s:
+        goal_reached.wait_for()  # blocks if the value is None, no effect otherwise
+        goal_reached.set_value(True)
+    goal_state = s.get_value().name
+
+    f = Fluent(9)
+    with par as s:
+        (f / 3 < 1).wait_for()
+        f.set_value(2)
+    division_state = s.get_value().name
+
+    f = Fluent(9)
+    fluent_net = Fluent(lambda: f.get_value() / 3)
+    f.add_child(fluent_net)
+    with par as s:
+        (fluent_net < 1).wait_for()
+        f.set_value(1.5)
+    return {"fluents": (first_value, second_value, goal_state, division_state, s.get_value().name)}
+
+
+@plan
 def follow(loc, targets):
     """3.2.2: `return` inside `whenever` leaves the loop and the function."""
     moves = []

@@ -28,6 +28,34 @@ def fail(label):
     raise Boom(label)
 
 
+# -- 3.2.2 fluents and fluent networks (the waits are branches of a `par`, the change another) --
+
+f = Fluent(1)
+first_value = f.get_value()  # returns 1
+f.set_value(2)  # sets the value to 2
+second_value = f.get_value()  # returns 2
+
+goal_reached = Fluent()
+with par as s:
+    goal_reached.wait_for()  # blocks if the value is None, no effect otherwise
+    goal_reached.set_value(True)
+goal_state = s.get_value().name
+
+f = Fluent(9)
+with par as s:
+    (f / 3 < 1).wait_for()
+    f.set_value(2)
+division_state = s.get_value().name
+
+f = Fluent(9)
+fluent_net = Fluent(lambda: f.get_value() / 3)
+f.add_child(fluent_net)
+with par as s:
+    (fluent_net < 1).wait_for()
+    f.set_value(1.5)
+RESULTS["fluents"] = (first_value, second_value, goal_state, division_state, s.get_value().name)
+
+
 # -- 3.2.2 whenever ------------------------------------------------------------------------------
 
 loc = Fluent()
@@ -76,6 +104,22 @@ with whenever(loc.pulsed(Behavior.ONCE)):
     if len(moves) == len(targets):
         break
 RESULTS["whenever_pulsed"] = list(moves)
+
+
+
+def follow(loc, targets):
+    """`with whenever` inside a function: `return` leaves the loop (and the function), as the
+    thesis says ("it will not stop unless it is canceled by a return statement")."""
+    moves = []
+    loc.set_value(targets[0])
+    with whenever(loc):
+        moves.append(loc.get_value())
+        if len(moves) == len(targets):
+            return moves
+        loc.set_value(targets[len(moves)])
+
+
+RESULTS["whenever_return"] = follow(Fluent(), targets)
 
 # -- 3.2.3 sequential execution ------------------------------------------------------------------
 
