@@ -24,7 +24,6 @@ from typing import Any, Optional
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.tree import Tree
 
 app = typer.Typer(
     name="pycram",
@@ -36,19 +35,9 @@ app = typer.Typer(
 console = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
-_STYLE = {
-    "succeeded": "green",
-    "failed": "bold red",
-    "evaporated": "grey62",
-    "running": "blue",
-    "unfinished": "yellow",
-    "interrupted": "yellow",
-    "created": "grey50",
-}
 #: Runs of this many identical successful siblings are shown as one line / box / row (×N);
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
 _COLLAPSE = 3
-_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·"}
 
 DbOption = typer.Option(None, "--db", help="SQLAlchemy URL of the trace database (default: $PYCRAM_DB_URL or "
                                            "~/.local/share/pycram/runs.sqlite3).", metavar="URL")
@@ -74,18 +63,6 @@ def _trace_errors(fn: Any, *args: Any, **kwargs: Any) -> Any:
         _fail(str(e))
 
 
-def _duration(seconds: float | None) -> str:
-    if seconds is None:
-        return "–"
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.0f} µs"
-    if seconds < 1:
-        return f"{seconds * 1000:.1f} ms"
-    if seconds < 120:
-        return f"{seconds:.2f} s"
-    return f"{seconds / 60:.1f} min"
-
-
 def _local(when: _dt.datetime | None) -> str:
     return when.astimezone().strftime("%Y-%m-%d %H:%M:%S") if when is not None else "–"
 
@@ -108,6 +85,7 @@ def runs_command(
 ) -> None:
     """List recorded runs, newest first: id, start, plan, robot, outcome, duration."""
     from pycram.trace import query
+    from pycram.trace.display import STATUS_STYLE, format_duration
 
     found = _trace_errors(query.runs, db, limit or None, plan)
     if not found:
@@ -115,28 +93,10 @@ def runs_command(
         return
     for run in found:
         state = run.state
-        style = _STYLE.get(state, "white")
+        style = STATUS_STYLE.get(state, "white")
         console.print(f"{run.id}  {_local(run.started_at)}  {escape(run.plan or '–')}  "
-                      f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {_duration(run.elapsed)}", soft_wrap=True)
-
-
-def _label(node: Any) -> str:
-    """One tree line for a display node (`pycram.trace.collapse.DisplayNode`)."""
-    record = node.record
-    if record.kind == "root":
-        return f"[bold]{escape(record.name)}[/bold] [grey50](thread)[/grey50]"
-    style = _STYLE.get(record.status, "white")
-    times = f" ×{node.count}" if node.count > 1 else ""
-    text = (f"[{style}]{_MARK.get(record.status, '?')}[/{style}] {escape(record.name)}{times} "
-            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] ")
-    if node.count > 1:
-        low, high = node.duration_range or (None, None)
-        text += f"{_duration(node.total_duration)} in all ({_duration(low)} – {_duration(high)} each)"
-    else:
-        text += _duration(record.duration)
-    if record.error_type and record.status != "succeeded":
-        text += f" [red]— {escape(record.error or '')}[/red]"
-    return text
+                      f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {format_duration(run.elapsed)}",
+                      soft_wrap=True)
 
 
 @app.command("show")
@@ -153,29 +113,16 @@ def show_command(
     a `whenever` loop) are shown as one line with a count, unless --expand.
     """
     from pycram.trace import query
-    from pycram.trace.collapse import collapse
+    from pycram.trace.display import STATUS_STYLE, format_duration, task_tree
 
     info = _trace_errors(query.get_run, run, db)
     records = _trace_errors(query.tasks, info.id, db)
     executions = _trace_errors(query.executions, info.id, url=db)
     state = info.state
-    style = _STYLE.get(state, "white")
+    style = STATUS_STYLE.get(state, "white")
     title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
-             f"[{style}]{state}[/{style}] · {_duration(info.elapsed)} · started {_local(info.started_at)}")
-    tree = Tree(title)
-    lines = tasks_shown = 0
-    branches: dict[int, Tree] = {}
-    for root in collapse(query.build_tree(records), min_run=0 if expand else _COLLAPSE):
-        for node, _depth in root.walk():
-            if lines >= max_nodes:
-                break
-            parent_id = node.record.parent_id
-            parent = branches.get(parent_id) if parent_id is not None else None
-            branch = (parent or tree).add(_label(node))
-            for member in node.records:
-                branches[member.task_id] = branch
-            lines += 1
-            tasks_shown += node.count
+             f"[{style}]{state}[/{style}] · {format_duration(info.elapsed)} · started {_local(info.started_at)}")
+    tree, tasks_shown = task_tree(title, records, expand=expand, max_nodes=max_nodes)
     console.print(tree)
     failed = sum(1 for r in records if r.status == "failed")
     summary = f"{len(records)} tasks, {failed} failed"

@@ -88,3 +88,15 @@ def test_bad_options_get_a_clear_message_and_exit_code_2(tmp_path, capsys, optio
 
     assert main(output=str(tmp_path), record=False, quiet=True, **{option: value}) == 2
     assert expected in capsys.readouterr().out
+
+
+def test_the_command_prints_the_collapsed_task_tree_and_a_verdict(tmp_path, capsys):
+    from pycram.demos.kitchen import main
+
+    code = main(output=str(tmp_path / "out"), db=f"sqlite:///{tmp_path / 'runs.sqlite3'}", quiet=True)
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert re.search(r"head: pointing_head ×\d+ \[process-module\] succeeded", out)  # one line, not ~100
+    assert "fetch_and_place [plan] succeeded" in out
+    assert "x real time" in out and "SUCCESS: the item rests on cooker #1" in out
+    assert "recorded as run 1" in out

@@ -62,7 +62,8 @@ class DemoResult:
     recoveries: int = 0
     item_on_cooker_1: bool = False
     files: list[Path] = field(default_factory=list)
-    tree_text: str = ""
+    tree_text: str = ""  # the plan's task tree as plain text, one line per task
+    plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
 
     @property
     def speed_factor(self) -> float:
@@ -207,6 +208,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         thief.stop()
         result.plan_wall_time = run.wall_time
         result.sim_time = run.sim_time(world.sim_time.get_value())
+        result.plan_task = run.task
         result.tree_text = format_task_tree(run.task) if run.task is not None else ""
         result.failed_grasps = failed_grasps(run.task)
         result.recoveries = recoveries(run.task)
@@ -382,6 +384,20 @@ class _ProgressLine:
         self._live.__exit__(*exc)
 
 
+def _task_tree_display(result: DemoResult) -> Any:
+    """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
+    on one line), or as plain text when the trace extra is not installed."""
+    if result.plan_task is None:
+        return "(the plan did not start)"
+    try:
+        from pycram.trace.display import task_tree
+        from pycram.trace.query import records_from_task
+    except ImportError:
+        return result.tree_text
+    tree, _ = task_tree("[bold]Task tree[/bold]", records_from_task(result.plan_task))
+    return tree
+
+
 def _stderr_console() -> Any:
     """The one rich console of the demo's terminal output (progress line and log records)."""
     global _CONSOLE
@@ -424,8 +440,8 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     except ValueError as error:  # an option out of range: say which, no traceback
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
         return 2
-    console.print("\n[bold]Task tree[/bold]")
-    console.print(result.tree_text, markup=False, highlight=False)
+    console.print()
+    console.print(_task_tree_display(result))
     console.print(f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
                   f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s")
     console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")

@@ -1,0 +1,86 @@
+"""The task tree in the terminal: a rich `Tree` with statuses, durations and failures.
+
+Used by `pycram show` (a recorded run) and `pycram demo` (the run that just ended). Runs of
+identical successful siblings -- a `whenever` loop moving the head every 0.2 s -- are one line
+"✔ head: pointing_head ×83" unless `expand` (see `pycram.trace.collapse`).
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+from rich.markup import escape
+from rich.tree import Tree
+
+__all__ = ["STATUS_STYLE", "STATUS_MARK", "format_duration", "task_tree"]
+
+#: rich style per task or run status.
+STATUS_STYLE = {
+    "succeeded": "green",
+    "failed": "bold red",
+    "evaporated": "grey62",
+    "running": "blue",
+    "unfinished": "yellow",
+    "interrupted": "yellow",
+    "created": "grey50",
+}
+#: One-character mark per task status.
+STATUS_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·"}
+
+
+def format_duration(seconds: float | None) -> str:
+    """`seconds` [s] in a unit that suits it (µs, ms, s, min); "–" when unknown."""
+    if seconds is None:
+        return "–"
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.0f} µs"
+    if seconds < 1:
+        return f"{seconds * 1000:.1f} ms"
+    if seconds < 120:
+        return f"{seconds:.2f} s"
+    return f"{seconds / 60:.1f} min"
+
+
+def _label(node) -> str:
+    """One tree line for a display node (`pycram.trace.collapse.DisplayNode`)."""
+    record = node.record
+    if record.kind == "root":
+        return f"[bold]{escape(record.name)}[/bold] [grey50](thread)[/grey50]"
+    style = STATUS_STYLE.get(record.status, "white")
+    times = f" ×{node.count}" if node.count > 1 else ""
+    text = (f"[{style}]{STATUS_MARK.get(record.status, '?')}[/{style}] {escape(record.name)}{times} "
+            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] ")
+    if node.count > 1:
+        low, high = node.duration_range or (None, None)
+        text += f"{format_duration(node.total_duration)} in all ({format_duration(low)} – {format_duration(high)} each)"
+    else:
+        text += format_duration(record.duration)
+    if record.error_type and record.status != "succeeded":
+        text += f" [red]— {escape(record.error or '')}[/red]"
+    return text
+
+
+def task_tree(title: str, records: Sequence, expand: bool = False, max_nodes: int = 2000) -> tuple[Tree, int]:
+    """A rich tree of the task `records` (`pycram.trace.query.TaskRecord`) under `title`.
+
+    Returns the tree and how many tasks it shows (fewer than `len(records)` once `max_nodes`
+    lines were added). `title` is rich markup.
+    """
+    from pycram.trace.collapse import MIN_RUN, collapse
+    from pycram.trace.query import build_tree
+
+    tree = Tree(title)
+    lines = tasks_shown = 0
+    branches: dict[int, Tree] = {}
+    for root in collapse(build_tree(records), min_run=0 if expand else MIN_RUN):
+        for node, _depth in root.walk():
+            if lines >= max_nodes:
+                break
+            parent_id = node.record.parent_id
+            parent = branches.get(parent_id) if parent_id is not None else None
+            branch = (parent or tree).add(_label(node))
+            for member in node.records:
+                branches[member.task_id] = branch
+            lines += 1
+            tasks_shown += node.count
+    return tree, tasks_shown
