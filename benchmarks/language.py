@@ -14,6 +14,8 @@ Figures (each is the median over several repetitions, after a warm-up):
   synchronously inside `Task._end`, in the loser's thread).
 * CPU of 1,000 idle `whenever` monitors: `time.process_time()` of the whole process over a 2 s
   window while nobody pulses their fluents, in % of one core.
+* `python -c "import pycram.language"`: wall time of the whole command (interpreter start-up
+  included; the floor column is `python -c pass`), and the import alone (`-X importtime`).
 
 py_trees has no threads and no blocking waits: its trees are *ticked*. Its columns say what was
 measured: reaction latency of a tree ticked at 1 kHz by `tick_tock`, cost of one tick of a
@@ -67,6 +69,7 @@ TARGETS = {
     "evap_blocked": 1e-3,
     "evap_busy": 20e-3,
     "idle_cpu": 1.0,  # % of one core
+    "import": 0.3,  # python -c "import pycram.language" [s]
 }
 
 
@@ -653,6 +656,38 @@ def pytrees_idle(n: int, window: float, period_ms: int) -> float:
 # -- running it all ---------------------------------------------------------------------------------
 
 
+def python_c_seconds(statement: str, repeat: int) -> float:
+    """Median wall time [s] of `python -c statement` in a fresh interpreter (startup included)."""
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+
+    def once() -> float:
+        t0 = perf()
+        subprocess.run([sys.executable, "-c", statement], check=True, env=env)
+        return perf() - t0
+
+    return median_of(once, repeat, warmup=1)[0]
+
+
+def import_self_seconds(module: str, repeat: int) -> float:
+    """Median cumulative `-X importtime` of `module` [s]: the import alone, without startup."""
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+
+    def once() -> float:
+        err = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"], check=True,
+                             env=env, capture_output=True, text=True).stderr
+        for line in err.splitlines():
+            parts = [x.strip() for x in line.split("|")]
+            if len(parts) == 3 and parts[2] == module:
+                return int(parts[1]) * 1e-6
+        return float("nan")
+
+    return median_of(once, repeat, warmup=1)[0]
+
+
 def measure_pycram(cfg: argparse.Namespace) -> dict[str, Any]:
     r: dict[str, Any] = {}
     pycram_wake(200, network=False)  # warm up
@@ -667,6 +702,8 @@ def measure_pycram(cfg: argparse.Namespace) -> dict[str, Any]:
     r["evap_busy"] = statistics.median(x[0] for x in busy)
     r["evap_busy_all"] = [x[0] for x in busy]
     r["evap_call_busy"], _ = median_of(pycram_evaporate_call_busy, cfg.busy_repeat, warmup=1)
+    r["import_cli"] = python_c_seconds("import pycram.language", cfg.import_repeat)
+    r["import_self"] = import_self_seconds("pycram.language", cfg.import_repeat)
     idle = [pycram_idle_monitors(1000, cfg.window) for _ in range(cfg.idle_repeat)]
     r["idle_cpu"] = statistics.median(x[0] for x in idle)
     r["idle_start"] = statistics.median(x[1] for x in idle)
@@ -686,6 +723,7 @@ def measure_floor(cfg: argparse.Namespace) -> dict[str, Any]:
     r["evap_blocked"], _ = median_of(floor_evaporation_blocked, cfg.evap_repeat, warmup=3)
     r["evap_busy"], _ = median_of(floor_evaporation_busy, cfg.busy_repeat, warmup=1)
     r["idle_cpu"] = floor_idle(1000, cfg.window)
+    r["import_cli"] = python_c_seconds("pass", cfg.import_repeat)
     return r
 
 
@@ -697,6 +735,7 @@ def measure_pytrees(cfg: argparse.Namespace) -> dict[str, Any]:
     r["preempt"], _ = median_of(pytrees_preempt(), cfg.evap_repeat, warmup=3)
     r["idle_10"] = pytrees_idle(1000, cfg.window, 100)
     r["idle_100"] = pytrees_idle(1000, cfg.window, 10)
+    r["import_cli"] = python_c_seconds("import py_trees", cfg.import_repeat)
     return r
 
 
@@ -776,6 +815,14 @@ def build_table(title: str, pc: dict[str, Any], floor: dict[str, Any], pt: dict[
         f"{pt['idle_10']:.1f} % at 10 Hz, {pt['idle_100']:.1f} % at 100 Hz\nticking a Parallel of "
         f"1,000 WaitForBlackboardVariableValue (polling; reaction latency = tick period)",
     )
+    table.add_row(
+        "python -c \"import pycram.language\"\n(wall time, startup included)",
+        "< 0.3 s",
+        f"{fmt_time(pc['import_cli'])}\n(the import alone: {fmt_time(pc['import_self'])})",
+        verdict(pc["import_cli"], TARGETS["import"]),
+        f"{fmt_time(floor['import_cli'])}\npython -c pass",
+        f"{fmt_time(pt['import_cli'])}\npython -c \"import py_trees\"",
+    )
     return table
 
 
@@ -792,6 +839,7 @@ def main(argv: list[str] | None = None) -> int:
     cfg.busy_repeat = 5 if cfg.quick else 15
     cfg.idle_repeat = 1 if cfg.quick else 3
     cfg.window = 0.5 if cfg.quick else 2.0
+    cfg.import_repeat = 3 if cfg.quick else 9
 
     console = Console(width=max(160, Console().width))
     console.print(
@@ -824,14 +872,15 @@ def main(argv: list[str] | None = None) -> int:
                     pc["evap_blocked"] > TARGETS["evap_blocked"],
                     pc["evap_busy"] > TARGETS["evap_busy"],
                     pc["idle_cpu"] > TARGETS["idle_cpu"],
+                    pc["import_cli"] > TARGETS["import"],
                 )
             )
     console.print(
         "Evaporation is timed from the winner's last statement to the loser's status becoming "
-        "EVAPORATED (probe fluent pulsed inside Task._end). For the busy loser nearly all of it is "
-        "the GIL: the pursue thread, woken by the winner, waits one (sometimes two) 5 ms switch "
-        "intervals for the GIL held by the spinning loser before it can call evaporate(); the "
-        "runtime's own share is the 'direct evaporate() call' figure. CPython 3.11 quirk: an asynchronous "
+        "EVAPORATED (probe fluent pulsed inside Task._end). For the busy loser the pursue thread, "
+        "woken by the winner, may have to wait up to one 5 ms switch interval for the GIL held by "
+        "the spinning loser before it can call evaporate(); the runtime's own share is the "
+        "'direct evaporate() call' figure. CPython 3.11 quirk: an asynchronous "
         "Evaporated at the back-jump of a `while True:` that is the first statement of a `try:` "
         "skips that try's handlers — the busy loser's loop lives in a helper function."
     )
