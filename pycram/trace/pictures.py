@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Iterable, Sequence
 from xml.sax.saxutils import escape
 
+from pycram.trace.display import format_duration
 from pycram.trace.collapse import MIN_RUN, DisplayNode, collapse
 from pycram.trace.query import TaskRecord, build_tree
 
@@ -56,18 +57,6 @@ _LIGHT = {
 }
 
 
-def _fmt_duration(seconds: float | None) -> str:
-    if seconds is None:
-        return "–"
-    if seconds < 1e-3:
-        return f"{seconds * 1e6:.0f} µs"
-    if seconds < 1:
-        return f"{seconds * 1e3:.1f} ms"
-    if seconds < 120:
-        return f"{seconds:.2f} s"
-    return f"{seconds / 60:.1f} min"
-
-
 def _clip(text: str, limit: int) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
@@ -90,8 +79,8 @@ def _group_detail(node: DisplayNode) -> str:
     if r.kind == "root":
         return "thread"
     if node.count > 1:
-        return f"{r.kind or 'task'} · {_status_of(r)} · {node.count} × ≈{_fmt_duration(_mean(node))}"
-    detail = f"{r.kind or 'task'} · {_status_of(r)} · {_fmt_duration(r.duration)}"
+        return f"{r.kind or 'task'} · {_status_of(r)} · {node.count} × ≈{format_duration(_mean(node))}"
+    detail = f"{r.kind or 'task'} · {_status_of(r)} · {format_duration(r.duration)}"
     if r.error_type and r.status != "succeeded":
         detail += f" · {r.error_type}"
     return detail
@@ -185,10 +174,10 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
         if node.count > 1:
             low, high = node.duration_range or (None, None)
             tip = (f"{r.path or r.name} (and {node.count - 1} identical siblings)\n{status}, "
-                   f"{node.count} tasks, {_fmt_duration(node.total_duration)} in all, "
-                   f"{_fmt_duration(low)} – {_fmt_duration(high)} each")
+                   f"{node.count} tasks, {format_duration(node.total_duration)} in all, "
+                   f"{format_duration(low)} – {format_duration(high)} each")
         else:
-            tip = f"{r.path or r.name}\n{status}, {_fmt_duration(r.duration)}"
+            tip = f"{r.path or r.name}\n{status}, {format_duration(r.duration)}"
             if r.error:
                 tip += f"\n{r.error}"
         css = f"task {status}" + (" group" if node.count > 1 else "")

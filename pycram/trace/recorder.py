@@ -449,8 +449,7 @@ class _WriterState:
         return answer
 
     def write(self, items: Iterable[Any]) -> None:
-        from pycram.trace.db import (designators_table, executions_table, fluent_samples_table,
-                                     runs_table, tasks_table)
+        from pycram.trace.db import designators_table, executions_table, fluent_samples_table, runs_table
 
         self.thread_names = {t.ident: t.name for t in threading.enumerate() if t.ident is not None}
         inserts: dict[int, tuple] = {}
