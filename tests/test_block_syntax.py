@@ -639,3 +639,32 @@ def test_coverage_style_line_tracing_sees_branch_lines_in_every_thread(tmp_path:
     assert proc.returncode == 0, proc.stderr
     lines = set(json.loads(proc.stdout.strip().splitlines()[-1]))
     assert set(range(3, 11)) <= lines  # every statement, in the main thread and in the branch threads
+
+
+def test_debugger_breakpoint_on_a_line_of_a_concurrent_branch(tmp_path: Path) -> None:
+    """A breakpoint set in the debugger (not `breakpoint()`) on a line of a `par` branch stops
+    there although the branch runs in a worker thread: branches inherit the debugger's tracer."""
+    import bdb
+
+    path = _write(tmp_path / "dbg_par.py", HEADER + "hits = []\nwith par as s:\n    hits.append(1)\n    hits.append(2)\nafter = 3\n")
+    stops: list[tuple[int, str, bool]] = []
+
+    class Recorder(bdb.Bdb):
+        def user_line(self, frame: types.FrameType) -> None:
+            if self.break_here(frame):
+                stops.append((frame.f_lineno, frame.f_code.co_name, threading.current_thread() is threading.main_thread()))
+            self.set_continue()
+
+    debugger = Recorder()
+    assert debugger.set_break(str(path), 6) is None and debugger.set_break(str(path), 7) is None
+    code = compile_source(path.read_text(), str(path))
+    ns: dict[str, Any] = {"__name__": "dbg_par"}
+    try:
+        debugger.runctx(code, ns, ns)
+    finally:
+        sys.settrace(None)
+    assert sorted(ns["hits"]) == [1, 2] and ns["after"] == 3
+    assert (6, "par@dbg_par.py:4#2", False) in stops  # in the branch's worker thread
+    assert (7, "<module>", True) in stops  # and the main thread still stops after the block
+    par(lambda: None, lambda: None)  # workers are reused: they must not carry the tracer on
+    assert sys.gettrace() is None

@@ -14,6 +14,7 @@ them outlives it.
 from __future__ import annotations
 
 import itertools
+import sys
 import threading
 from enum import Enum
 from typing import Any, Callable, Iterator, Protocol
@@ -338,11 +339,14 @@ class TaskGroup:
         with self._cv:
             self._running += 1
         self.tasks.append(task)
-        submit(lambda: self._thread_main(task, runner, fn))
+        trace = _debugger_trace()
+        submit(lambda: self._thread_main(task, runner, fn, trace))
         return task
 
-    def _thread_main(self, task: Task, runner: Runner, fn: Callable[[], Any]) -> None:
+    def _thread_main(self, task: Task, runner: Runner, fn: Callable[[], Any], trace: Any = None) -> None:
         install_runner(runner)
+        if trace is not None:
+            sys.settrace(trace)  # a debugger's breakpoints work in the branch (see _debugger_trace)
         status, error, result = TaskStatus.FAILED, None, None
         try:
             try:
@@ -359,6 +363,8 @@ class TaskGroup:
             status, error = TaskStatus.EVAPORATED, late
         while True:  # at most one asynchronous exception can still be pending
             try:
+                if trace is not None:
+                    sys.settrace(None)  # the worker thread is reused: do not trace the next branch
                 runner.seal()
                 break
             except BaseException:
@@ -393,6 +399,21 @@ class TaskGroup:
 
     def _all_ended(self) -> bool:
         return self._running == 0
+
+
+def _debugger_trace() -> Any:
+    """The calling thread's trace function, if branch threads should inherit it.
+
+    A debugger (pdb, bdb; also `breakpoint()` followed by `continue`) traces only the thread it
+    runs in, through `sys.settrace`, so breakpoints on lines of concurrent branches — which run
+    in worker threads — would never be hit. The spawning thread's trace function is therefore
+    installed in the branch's thread for the branch's duration. Tools that trace every thread
+    themselves (coverage.py, the `trace` module: `threading.settrace`) are left alone.
+    """
+    trace = sys.gettrace()
+    if trace is None or threading.gettrace() is not None:
+        return None
+    return trace
 
 
 def _settle_detached(runner: Runner, stop: bool) -> None:
