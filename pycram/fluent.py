@@ -29,7 +29,7 @@ from enum import Enum
 from typing import Any, Callable, Iterator
 
 from pycram.block_forms import BlockForm
-from pycram.runtime.evaporation import wait_until
+from pycram.runtime.evaporation import notify_waiters, wait_until
 
 __all__ = ["Fluent", "Behavior", "whenever", "Whenever", "STOP"]
 
@@ -118,8 +118,7 @@ class Fluent:
                 child.pulse()
         cv = self._cv
         if cv is not None:
-            with cv:
-                cv.notify_all()
+            notify_waiters(cv)
 
     def add_child(self, fluent: Fluent) -> None:
         """Make `fluent` be pulsed whenever this fluent is. Held weakly: it dies with its users.

@@ -261,3 +261,27 @@ def test_taking_back_an_interrupt_leaves_debuggers_and_the_eval_loop_working(tmp
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "stops 1"
+
+
+@pytest.mark.timeout(60)  # the defect hangs the pursue: fail fast
+def test_asynchronous_evaporation_never_leaves_a_condition_lock_held():
+    """A busy branch that pulses a watched fluent is evaporated hundreds of times: the
+    asynchronous `Evaporated` must never land while a condition lock is held (it would be
+    held for good, and every later waiter would hang)."""
+    watched = Fluent(0, name="watched")
+    never = watched < 0  # a network: pulsing `watched` takes its condition lock too
+    for round_ in range(300):
+        def busy() -> None:
+            n = 0
+            while True:
+                n += 1
+                watched.set_value(n)
+
+        def waiter() -> None:
+            never.wait_for()
+
+        pursue(busy, waiter, lambda: watched.wait_for(), lambda: (watched > 50).wait_for())
+        for fluent in (watched, never):
+            lock = fluent._condition()._lock
+            assert lock.acquire(timeout=2.0), f"round {round_}: {fluent.name}'s condition lock was left held"
+            lock.release()

@@ -54,7 +54,8 @@ class Evaporated(BaseException):
 class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
-    __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_protected", "_lock", "_sleep")
+    __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_missed", "_protected", "_lock",
+                 "_sleep")
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
@@ -63,6 +64,7 @@ class Runner:
         self._mode = _USER
         self._waiting_on: threading.Condition | None = None
         self._injected = False
+        self._missed = False  # an interrupt found the thread in runtime code, not waiting
         self._protected = 0
         self._lock = threading.Lock()
         self._sleep: threading.Condition | None = None
@@ -76,19 +78,45 @@ class Runner:
 
     # -- entering and leaving the runtime -----------------------------------------------------
 
-    def _enter_runtime(self, condition: threading.Condition | None = None) -> None:
+    def enter_runtime(self) -> tuple[int, bool]:
+        """Begin runtime code that holds locks: no asynchronous `Evaporated` reaches the thread
+        until `leave_runtime` (one already pending is taken back). Nests; returns the token
+        for `leave_runtime`.
+
+        Why: `with condition:` runs Python frames (`Condition.__enter__`/`__exit__`); an
+        asynchronous exception landing in one of them while the lock is held would leave the
+        lock held for good, and every later waiter on it would hang.
+        """
         with self._lock:
-            if self._injected:  # first, so that a late delivery leaves the state untouched
+            took_back = self._injected
+            if took_back:  # first, so that a late delivery leaves the state untouched
                 self._injected = False
                 _take_back_async_exception(self.ident)
-            self._mode = _RUNTIME
-            self._waiting_on = condition
+            previous = self._mode
+            if previous == _USER:
+                self._mode = _RUNTIME
+            return previous, took_back
 
-    def _leave_runtime(self) -> None:
+    def leave_runtime(self, token: tuple[int, bool]) -> bool:
+        """End a section begun by `enter_runtime`.
+
+        Returns True when an evaporation was held back by the section (a pending `Evaporated`
+        taken back, or an interrupt that found the thread here) and is still due: the caller
+        must then raise `Evaporated` itself, on its normal path, where the asynchronous one
+        would have landed.
+        """
+        previous, took_back = token
         with self._lock:
             self._waiting_on = None
-            if self._mode == _RUNTIME:
+            if self._mode == _RUNTIME and previous == _USER:
                 self._mode = _USER
+                took_back, self._missed = took_back or self._missed, False
+        return took_back and self.evaporation_due()
+
+    def _wait_on(self, condition: threading.Condition) -> None:
+        """Register the condition a wait blocks on, so that `interrupt` can notify it."""
+        with self._lock:
+            self._waiting_on = condition
 
     def seal(self) -> None:
         """Mark the thread as finishing: no asynchronous exception can reach it after this."""
@@ -116,6 +144,8 @@ class Runner:
             if condition is None and self._mode == _USER and not self._injected and self.ident is not None:
                 self._injected = injected = True
                 _inject_async_exception(self.ident)
+            elif condition is None and self._mode == _RUNTIME:
+                self._missed = True  # raised by the runtime code when it leaves (leave_runtime)
         if condition is not None:
             with condition:
                 condition.notify_all()
@@ -217,28 +247,56 @@ def wait_until(
     runner = current_runner()
     if runner.evaporation_due():
         raise Evaporated()
-    with condition:
-        if predicate():
-            return True
-        if timeout is not None and timeout <= 0:
-            return False
-        clock = current_clock()
-        deadline = None if timeout is None else clock.now() + timeout
-        handle = None if deadline is None else clock.register(deadline, condition)
-        runner._enter_runtime(condition)
-        try:
-            while True:
-                if runner.evaporation_due():
-                    raise Evaporated()
-                if predicate():
-                    return True
-                if deadline is not None and clock.now() >= deadline:
-                    return False
-                clock.wait(condition, deadline)
-        finally:
-            runner._leave_runtime()
-            if handle is not None:
-                clock.unregister(handle)
+    token = runner.enter_runtime()  # before taking the condition's lock, left after releasing it
+    try:
+        with condition:
+            satisfied = _wait_locked(runner, condition, predicate, timeout)
+    finally:
+        due = runner.leave_runtime(token)
+    if due:
+        raise Evaporated()
+    return satisfied
+
+
+def _wait_locked(runner: Runner, condition: threading.Condition, predicate: Callable[[], object],
+                 timeout: float | None) -> bool:
+    """The body of `wait_until`, with `condition` held and the runner in runtime mode."""
+    if predicate():
+        return True
+    if timeout is not None and timeout <= 0:
+        return False
+    clock = current_clock()
+    deadline = None if timeout is None else clock.now() + timeout
+    handle = None if deadline is None else clock.register(deadline, condition)
+    runner._wait_on(condition)
+    try:
+        while True:
+            if runner.evaporation_due():
+                raise Evaporated()
+            if predicate():
+                return True
+            if deadline is not None and clock.now() >= deadline:
+                return False
+            clock.wait(condition, deadline)
+    finally:
+        if handle is not None:
+            clock.unregister(handle)
+
+
+def notify_waiters(condition: threading.Condition) -> None:
+    """Wake every thread waiting on `condition`; safe against asynchronous evaporation.
+
+    Raises `Evaporated` only where an asynchronous one was about to land anyway.
+    """
+    runner = current_runner()
+    token = runner.enter_runtime()
+    try:
+        with condition:
+            condition.notify_all()
+    finally:
+        due = runner.leave_runtime(token)
+    if due:
+        raise Evaporated()
 
 
 def sleep(seconds: float) -> None:

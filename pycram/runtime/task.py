@@ -204,8 +204,18 @@ class Task:
                 if task._runner is not None and task._runner not in runners:
                     runners.append(task._runner)
                 stack.extend(task.children)
-        for runner in runners:
-            runner.interrupt()
+        caller = current_runner()
+        token = caller.enter_runtime()  # interrupting takes the waiters' condition locks
+        try:
+            for runner in runners:
+                if runner is not caller:
+                    runner.interrupt()
+        finally:
+            due = caller.leave_runtime(token)
+        if due:
+            raise Evaporated()
+        if caller in runners:  # a task evaporating itself (or an ancestor): deliver as usual
+            caller.interrupt()
 
     def __repr__(self) -> str:
         return f"<Task {self.path} {self.status.get_value().value}>"
