@@ -285,3 +285,30 @@ def test_asynchronous_evaporation_never_leaves_a_condition_lock_held():
             lock = fluent._condition()._lock
             assert lock.acquire(timeout=2.0), f"round {round_}: {fluent.name}'s condition lock was left held"
             lock.release()
+
+
+def test_as_task_runs_each_call_as_a_named_child_task():
+    from pycram.runtime import as_task
+
+    @as_task
+    def grab(item: str) -> str:
+        """Grab something."""
+        if item == "nothing":
+            raise LookupError("the gripper closed on nothing")
+        return f"holding {item}"
+
+    @as_task(name="put down", kind="action")
+    def place() -> None:
+        pass
+
+    parent = current_task()
+    before = len(parent.children)
+    assert grab("mug") == "holding mug"
+    with pytest.raises(LookupError):
+        grab("nothing")
+    place()
+    ok, failed, placed = parent.children[before:]
+    assert (ok.name, ok.kind, ok.status.get_value(), ok.result) == ("grab", "plan", TaskStatus.SUCCEEDED, "holding mug")
+    assert failed.status.get_value() is TaskStatus.FAILED and isinstance(failed.exception, LookupError)
+    assert (placed.name, placed.kind) == ("put down", "action")
+    assert grab.__name__ == "grab" and grab.__doc__ == "Grab something."

@@ -26,7 +26,7 @@ import math
 from pycram.designator import LocationDesignator, MotionDesignator, perform
 from pycram.fluent import Fluent, whenever
 from pycram.language import State, failure_handling, par, plan, retry, seq, try_in_order
-from pycram.runtime import sleep
+from pycram.runtime import as_task, sleep
 
 log = logging.getLogger("pycram.demo")
 
@@ -101,6 +101,7 @@ def location(*properties: tuple) -> object:
 # -- helpers, as in the thesis ----------------------------------------------------------------------
 
 
+@as_task
 @plan
 def reset_robot() -> None:
     """Grippers open, arms parked, torso up — concurrently; then drive to the start pose."""
@@ -117,6 +118,7 @@ def reset_robot() -> None:
     motion(type="moving", pose=goal.get_value(), frame="map")
 
 
+@as_task
 @plan
 def grab_item() -> None:
     """Drive to `goal` and, once within 10 cm, grasp what lies at `look_goal` (thesis `grab_item`).
@@ -148,6 +150,7 @@ def grab_item() -> None:
     log.info("grasped the item at %s", _point(target))
 
 
+@as_task
 @plan
 def place_item() -> None:
     """Put the held item down at `look_goal` and take the arm back (thesis `place_item`)."""
@@ -227,6 +230,7 @@ def fetch_and_place() -> None:
         raise errors[0]  # what stopped the task, e.g. NoItemGrasped
 
 
+@as_task
 @plan
 def transport() -> None:
     """Drive to `goal` holding the item; whenever it is taken away, stop, get it back, retry."""

@@ -13,6 +13,7 @@ them outlives it.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import sys
 import threading
@@ -42,6 +43,7 @@ __all__ = [
     "current_task",
     "run_subtask",
     "task_scope",
+    "as_task",
     "format_task_tree",
 ]
 
@@ -267,6 +269,27 @@ def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task
     task.result = result
     task._end(TaskStatus.SUCCEEDED)
     return result
+
+
+def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, kind: str = "plan") -> Any:
+    """Decorator: each call of the function runs as a child task named after it (`run_subtask`).
+
+    `@as_task` or `@as_task(name="fetch", kind="action")`; the default name is the function's
+    `__name__`, the default kind "plan". Stack it *above* `@plan`. The task tree then shows
+    `grab_item [plan] failed — GraspFailed: ...` instead of only the expressions inside.
+    Returns what the function returns and raises what it raises.
+    """
+
+    def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
+        task_name = name or function.__name__
+
+        @functools.wraps(function)
+        def run(*args: Any, **kwargs: Any) -> Any:
+            return run_subtask(task_name, function, *args, kind=kind, **kwargs)
+
+        return run
+
+    return decorate if fn is None else decorate(fn)
 
 
 class task_scope:
