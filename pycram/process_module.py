@@ -262,8 +262,11 @@ class ProcessModule:
         return None
 
     def _cancel(self, designator: Any) -> None:
-        """Cancel hook (override): called after ``_execute(designator)`` was evaporated, in the
-        same thread, protected from evaporation. Stop the hardware here."""
+        """Cancel hook (override): called when the execution of ``designator`` was evaporated or
+        cancelled, in the caller's thread, protected from evaporation -- while running (after
+        ``_execute(designator)`` was interrupted: stop the hardware here) and while still queued
+        (``self.current`` is then another execution or None: nothing of this designator runs,
+        so stop nothing that another caller started)."""
 
     def execute(self, designator: Any) -> Any:
         """Queue ``designator``, wait for its turn, run ``_execute`` and return its result.
@@ -429,11 +432,14 @@ class ProcessModule:
 
     def _settle(self, execution: Execution, started: bool, outcome: ProcessModuleStatus,
                 error: Optional[BaseException], result: Any) -> None:
-        """Run the cancel hook if a started execution did not end by itself, then free the
+        """Run the cancel hook if the execution was cancelled (see `_cancel`), then free the
         module / leave the queue and record the outcome. Idempotent for a settled execution.
         Raises ``Evaporated`` at the end if the calling task is evaporating."""
         with no_evaporation():
-            if started and outcome is ProcessModuleStatus.CANCELLED:
+            # evaporated or cancelled -- while running, or while still queued (then nothing of
+            # it runs: the hook may release what was reserved for it, and must not stop another
+            # caller's motion); a module taken offline is not a cancellation of this designator
+            if outcome is ProcessModuleStatus.CANCELLED and (started or execution.exception is None):
                 try:
                     logger.debug("%s: cancelling %r", self.name, execution.designator)
                     self._cancel(execution.designator)

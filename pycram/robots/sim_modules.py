@@ -121,6 +121,9 @@ class SimProcessModule(ProcessModule):
         return outcome.value
 
     def _cancel(self, designator: Any) -> None:
+        current = self.current
+        if current is None or current.designator is not designator:
+            return  # evaporated while queued: the running command belongs to another caller
         handle, self._handle = self._handle, None
         if handle is not None and not handle.done:
             logger.info("%s: cancelling %s", self.name, handle.name)

@@ -283,6 +283,21 @@ def test_evaporating_a_running_drive_stops_the_base(robot):
     motion(type="moving", pose=START)
 
 
+def test_evaporating_a_queued_drive_leaves_the_running_one_alone(robot):
+    world = robot.world
+    go_to_start(robot)
+    goal = (START[0] + 1.0, START[1] + 1.0, 0.0)
+    running = ProcessModule.perform(MotionDesignator(type="moving", pose=goal, wait=False))
+    navigation = robot.process_module("navigation")
+    # a second drive waits in the queue and is evaporated there: its cancel hook must not
+    # stop the drive that is running for another caller
+    state = pursue(lambda: motion(type="moving", pose=START), lambda: (navigation.queued >= 1).wait_for())
+    assert state.get_value() is State.SUCCEEDED
+    reached = running.wait()
+    assert math.hypot(reached.x - goal[0], reached.y - goal[1]) < 0.05
+    motion(type="moving", pose=START)
+
+
 # --------------------------------------------------------------------------- failures
 
 
