@@ -27,8 +27,7 @@ def demo(tmp_path, **options):
 
 def grasp_attempts(tree_text: str) -> list[str]:
     """The status words of the three grasp attempts (`try_in_order` steps), in order."""
-    attempts = re.findall(r"try_in_order@kitchen_plan\.py:\d+#\d \[step\] (\w+)", tree_text)
-    return attempts
+    return re.findall(r"try_in_order@kitchen_plan\.py:\d+#\d \[step\] (\w+)", tree_text)
 
 
 def assert_pictures(result):

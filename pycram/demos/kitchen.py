@@ -9,6 +9,7 @@ the timeline PNG to the output folder, and returns 0 only when the item rests on
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import math
 import os
@@ -252,9 +253,10 @@ def _item_on_cooker_1(world: Any, item: str, counter_height: float) -> bool:
     held = any(state.get_value().holding == item for state in world.gripper_states.values())
     on_top = counter_height < z < counter_height + 0.15
     near = math.hypot(x - PLACE_XY[0], y - PLACE_XY[1]) < 0.15
+    tilt = _tilt(pose.orientation)
     log.info("the %s ends at (%.2f, %.2f, %.2f), tilted %.0f deg%s", item, x, y, z,
-             math.degrees(_tilt(pose.orientation)), ", held" if held else "")
-    return not held and on_top and near and _tilt(pose.orientation) < math.radians(20)
+             math.degrees(tilt), ", held" if held else "")
+    return not held and on_top and near and tilt < math.radians(20)
 
 
 def _tilt(quaternion: tuple[float, float, float, float]) -> float:
@@ -398,17 +400,12 @@ def _task_tree_display(result: DemoResult) -> Any:
     return tree
 
 
+@functools.cache
 def _stderr_console() -> Any:
     """The one rich console of the demo's terminal output (progress line and log records)."""
-    global _CONSOLE
-    if _CONSOLE is None:
-        from rich.console import Console
+    from rich.console import Console
 
-        _CONSOLE = Console(stderr=True)
-    return _CONSOLE
-
-
-_CONSOLE: Any = None
+    return Console(stderr=True)
 
 
 def _log_to_terminal() -> None:
