@@ -221,13 +221,39 @@ def _robot_from_active(recorder: Any) -> None:
         recorder.set_run_info(robot=str(getattr(robot, "name", robot)))
 
 
+#: `--steal` above this is refused: the plan gives up long before (it retries a few times).
+_MAX_STEALS = 100
+
+
+def _check_output_folder(output: str) -> None:
+    """Refuse (exit code 2, one line) an `--output` folder that cannot be created or written.
+
+    Creates nothing: the folder must be a writable directory, or its nearest existing ancestor
+    must be one (the demo creates the rest).
+    """
+    import os
+
+    path = Path(output).expanduser()
+    existing = path
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing == path and not path.is_dir():
+        _fail(f"--output {output}: exists and is not a folder", code=2)
+    if not existing.is_dir():
+        _fail(f"--output {output}: cannot create the folder, {existing} is not a folder", code=2)
+    if not os.access(existing, os.W_OK | os.X_OK):
+        _fail(f"--output {output}: cannot write to {existing} (permission denied)", code=2)
+
+
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
-    item_at: int = typer.Option(1, "--item-at", help="Where the item starts: position 1, 2 or 3 (0: no item)."),
-    steal: int = typer.Option(0, "--steal", help="How many times the item is taken from the gripper while the robot carries it."),
-    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
+                                help="Where the item starts: position 1, 2 or 3 (0: no item)."),
+    steal: int = typer.Option(0, "--steal", min=0, max=_MAX_STEALS,
+                              help="How many times the item is taken from the gripper while the robot carries it."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed (a non-negative integer)."),
     realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
     interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
     record: Optional[bool] = typer.Option(None, "--record/--no-record",
@@ -236,6 +262,8 @@ def demo_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
+    if output is not None:
+        _check_output_folder(output)
     try:
         from pycram.demos.kitchen import main as demo_main
     except ModuleNotFoundError as e:

@@ -167,6 +167,41 @@ def test_demo_passes_options_through(monkeypatch, db):
     assert calls["record"] is True
 
 
+@pytest.fixture
+def fake_demo(monkeypatch):
+    """A stand-in for the demo that records whether it was started."""
+    started = []
+    fake = types.ModuleType("pycram.demos.kitchen")
+    fake.main = lambda **kwargs: started.append(kwargs) or 0
+    monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
+    return started
+
+
+def test_demo_output_that_cannot_be_written_is_one_line_and_exit_2(fake_demo, tmp_path):
+    """Tests run as root: a path under a regular file is what cannot be created."""
+    a_file = tmp_path / "a-file"
+    a_file.write_text("not a folder")
+    for output, expected in ((a_file / "sub", f"{a_file} is not a folder"),
+                             (a_file, "exists and is not a folder")):
+        result = _invoke("demo", "--output", str(output))
+        assert result.exit_code == 2, result.output
+        lines = result.output.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: --output"), result.output
+        assert expected in lines[0] and "Traceback" not in result.output
+    assert fake_demo == []
+    assert _invoke("demo", "--output", str(tmp_path / "new" / "folder")).exit_code == 0
+    assert not (tmp_path / "new").exists()  # the check creates nothing; the demo does
+
+
+@pytest.mark.parametrize("option,value", [("--steal", "-1"), ("--steal", "101"), ("--item-at", "4"),
+                                          ("--item-at", "-1"), ("--seed", "-3")])
+def test_demo_options_out_of_range_are_refused_with_exit_2(fake_demo, option, value):
+    result = _invoke("demo", option, value)
+    assert result.exit_code == 2, result.output
+    assert option in result.output and "Traceback" not in result.output
+    assert fake_demo == []
+
+
 def test_demo_missing_is_a_clear_error(monkeypatch):
     monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", None)
     result = _invoke("demo")
