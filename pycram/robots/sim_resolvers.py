@@ -39,7 +39,7 @@ executing it.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Iterator, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 from pycram.sim.kitchen import COUNTERS, FREE_FLOOR
 from pycram.sim.types import Pose2D, yaw_to_quat
@@ -103,6 +103,40 @@ def _relative_to(base: Pose2D, pose: Pose2D) -> Pose2D:
                   base.yaw + pose.yaw)
 
 
+def base_goal_in_map(world: Any, pose: Any, frame: Any = None) -> Pose2D:
+    """A base goal ``pose`` given in ``frame`` (``'map'``, the default, or ``'base_footprint'``:
+    relative to the base pose now) as a ``Pose2D`` in the map frame."""
+    pose = _pose2d(pose)
+    frame = frame or "map"
+    if frame == "base_footprint":
+        return _relative_to(world.base_pose.get_value(), pose)
+    if frame != "map":
+        raise ValueError(f"unknown frame {frame!r}; available: map, base_footprint")
+    return pose
+
+
+def free_floor(world: Any) -> tuple[float, float, float, float]:
+    """The region (x_min, y_min, x_max, y_max) [m, map] of ``world``'s environment where the
+    base may stand: goals of ``moving`` and the base poses of ``to_reach`` must lie in it.
+
+    The one place resolvers learn the environment's extent (today the simulated kitchen's
+    ``FREE_FLOOR`` for every world; meant to read the world's environment description).
+    """
+    return FREE_FLOOR
+
+
+def on_free_floor(world: Any, x: float, y: float) -> bool:
+    """``True`` iff (x, y) [m, map] lies on :func:`free_floor` of ``world``."""
+    x0, y0, x1, y1 = free_floor(world)
+    return x0 <= x <= x1 and y0 <= y <= y1
+
+
+def describe_free_floor(world: Any) -> str:
+    """``the free floor x in [-0.45, 3.0] m, y in [-0.9, 3.5] m`` (for messages)."""
+    x0, y0, x1, y1 = free_floor(world)
+    return f"the free floor x in [{x0:g}, {x1:g}] m, y in [{y0:g}, {y1:g}] m"
+
+
 def approach_target(description: Any, base: Pose2D, target: Sequence[float],
                     phase: Optional[str]) -> tuple[tuple[float, float, float], tuple[float, ...]]:
     """Tool position [m, map] and orientation (w, x, y, z) for ``phase`` of reaching ``target``.
@@ -156,12 +190,7 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
         solutions = []
         wait = desig.prop_value("wait") is not False
         if desig.check_constraints([("type", "moving"), "pose"]):
-            pose = _pose2d(desig.prop_value("pose"))
-            frame = desig.prop_value("frame") or "map"
-            if frame == "base_footprint":
-                pose = _relative_to(world.base_pose.get_value(), pose)
-            elif frame != "map":
-                raise ValueError(f"unknown frame {frame!r}; available: map, base_footprint")
+            pose = base_goal_in_map(world, desig.prop_value("pose"), desig.prop_value("frame"))
             solutions.append(desig.make_dictionary(
                 [("cmd", "navigate"), ("pose", pose), ("frame", "map"), ("wait", wait)]))
         if desig.check_constraints([("type", "cancelling_movement")]):
@@ -276,23 +305,35 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
 
     Yields base poses (``Pose2D``, map frame) from which the arm (default
     ``description.DEFAULT_ARM``) reaches the point: the best one first, then the same with the
-    base 5 cm further back, 5 cm closer and 10 cm further back. Returns ``None`` for other
-    location designators.
+    base 5 cm further back, 5 cm closer and 10 cm further back -- each only if it lies on the
+    environment's free floor (:func:`free_floor`). Raises ``NoSolutionError`` saying why when
+    none does (the point is outside the environment, or too far from the floor). Returns
+    ``None`` for other location designators.
     """
     d = description
 
-    def to_reach(desig: Any) -> Optional[Iterator[Pose2D]]:
+    def to_reach(desig: Any) -> Optional[list[Pose2D]]:
         if not desig.check_constraints(["to_reach"]):
             return None
         point = _point(desig.prop_value("to_reach"))
+        if not all(math.isfinite(v) for v in point):
+            raise ValueError(f"the point to reach must be finite [m], got {point}")
         arm = physical_arm(d, desig.prop_value("arm") or d.DEFAULT_ARM)
         current = world.base_pose.get_value()
+        candidates = [base_pose_to_reach(d, point, arm, current, extra)
+                      for extra in (0.0, 0.05, -0.05, 0.10)]
+        poses = [pose for pose in candidates if on_free_floor(world, pose.x, pose.y)]
+        if not poses:
+            from pycram.designators.core import NoSolutionError
 
-        def poses() -> Iterator[Pose2D]:
-            for extra in (0.0, 0.05, -0.05, 0.10):
-                yield base_pose_to_reach(d, point, arm, current, extra)
-
-        return poses()
+            where = ("outside the environment" if not on_free_floor(world, point[0], point[1])
+                     and _counter_normal(point[0], point[1]) is None else "out of reach")
+            best = candidates[0]
+            raise NoSolutionError(
+                f"Cannot resolve {desig!r}: the point {point} [m, map] is {where}: the "
+                f"{d.NAME} {arm} arm would reach it from (x={best.x:.2f}, y={best.y:.2f}), but "
+                f"the base can only stand on {describe_free_floor(world)}", designator=desig)
+        return poses
 
     to_reach.__qualname__ = f"{d.NAME}_to_reach"
     return to_reach
