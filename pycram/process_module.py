@@ -55,6 +55,7 @@ from typing import Any, Callable, ClassVar, Optional
 
 from pycram import events
 from pycram.designators.core import DesignatorError, callable_name, known_solution
+from pycram.designators.motion import MotionDesignator
 from pycram.designators.motion_types import (active_motion_types, check_motion,
                                              describe_known_types)
 from pycram.fluent import Fluent
@@ -502,8 +503,6 @@ class ProcessModule:
 
 def _check_motion(designator: Any) -> None:
     """Check a motion designator against the active robot's motion types (before it is queued)."""
-    from pycram.designators.motion import MotionDesignator
-
     if isinstance(designator, MotionDesignator):
         check_motion(designator)
 
