@@ -22,30 +22,17 @@ from pycram.designators.motion_types import vocabulary_table  # noqa: E402
 from pycram.language import pursue  # noqa: E402
 from pycram.process_module import (NoProcessModuleError, ProcessModuleStatus,  # noqa: E402
                                    UnknownMotionTypeError)
+from pycram.robot import current_robot  # noqa: E402
 from pycram.runtime import sleep  # noqa: E402
 
 T = 60.0  # [s of simulated time]
 START = (0.8, 0.6, 0.0)
 
 
-@pytest.fixture(scope="module", params=["pr2", "tiago"])
-def robot(request):
-    from pycram import robots
-    from pycram.sim import World
-
-    world = World(request.param)
-    loaded = robots.load(request.param, world)
-    with loaded:
-        perform(MotionDesignator(type="moving", pose=START))
-        yield loaded
-    loaded.shutdown()
-    world.close()
-
-
 def refused(error_type, **properties):
     """Perform a motion that must be refused at once: return the error; assert nothing moved
     and no process module was asked (all still idle, nothing queued)."""
-    robot = _active()
+    robot = current_robot()
     before = robot.world.base_pose.get_value()
     statuses = {name: m.status.get_value() for name, m in robot.process_modules.items()}
     outcome = {}
@@ -64,12 +51,6 @@ def refused(error_type, **properties):
     assert {n: m.status.get_value() for n, m in robot.process_modules.items()} == statuses
     assert all(m.queue_length == 0 for m in robot.process_modules.values())
     return error
-
-
-def _active():
-    from pycram.robot import current_robot
-
-    return current_robot()
 
 
 # --------------------------------------------------------------------------- keys and types

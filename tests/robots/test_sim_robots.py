@@ -29,20 +29,6 @@ PLACE = (-0.72, 1.9)  # the place spot on cooker #1 [m]
 START = (0.8, 0.6, 0.0)
 
 
-@pytest.fixture(scope="module", params=["pr2", "tiago"])
-def robot(request):
-    """A world and its robot (loaded with ``pycram.robots.load``), active for the module."""
-    from pycram import robots
-    from pycram.sim import World
-
-    world = World(request.param)
-    loaded = robots.load(request.param, world)
-    with loaded:
-        yield loaded
-    loaded.shutdown()
-    world.close()
-
-
 def motion(**properties):
     return perform(MotionDesignator(**properties))
 
