@@ -39,7 +39,7 @@ class MotionDesignator(LazyDesignator):
     def _no_solution_message(self) -> str:
         message = super()._no_solution_message()
         types = active_motion_types()
-        if types and self.prop_value("type") not in types:
+        if types and str(self.prop_value("type")) not in {str(t) for t in types}:
             message += f"; {describe_known_types(types, self.prop_value('type'))}"
         return message
 
