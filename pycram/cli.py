@@ -178,8 +178,13 @@ def run_command(
     plan: Optional[str] = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
     robot: Optional[str] = typer.Option(None, "--robot", help="Robot name recorded for the run."),
 ) -> None:
-    """Run a plan script; arguments after FILE go to the script (in sys.argv)."""
-    from pycram.macros import run_script
+    """Run a plan script; arguments after FILE go to the script (in sys.argv).
+
+    The script owns logging (`logging.basicConfig` in it works as under `python FILE.py`);
+    an exception it raises is reported with a traceback that starts at the script's code, and
+    the exit code is 1.
+    """
+    from pycram.macros import format_script_error, run_script
 
     recorder = None
     if _record_flag(record):
@@ -197,6 +202,9 @@ def run_command(
     except KeyboardInterrupt as e:
         outcome, error, code = "interrupted", e, 130
         raise
+    except Exception as e:
+        outcome, error, code = "failed", e, 1
+        sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
     except BaseException as e:
         outcome, error, code = "failed", e, 1
         raise
@@ -276,9 +284,16 @@ def demo_command(
     raise typer.Exit(int(code or 0))
 
 
+@app.callback()
+def _configure_logging(ctx: typer.Context) -> None:
+    # `pycram run` leaves logging to the script (its basicConfig must not be a no-op); the
+    # other commands show the library's warnings.
+    if ctx.invoked_subcommand != "run":
+        logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `pycram` script. Returns the exit code (also when typer exits)."""
-    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         app(args=argv, prog_name="pycram", standalone_mode=True)
     except SystemExit as e:
