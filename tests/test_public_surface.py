@@ -202,3 +202,12 @@ def test_the_checker_catches_an_undocumented_name(tmp_path, monkeypatch):
     verdict = {name: _is_documented("surface_probe", name, getattr(module, name)) for name in module.__all__}
     assert verdict == {"documented": True, "bare": False, "LIMIT": False, "DOCUMENTED_LIMIT": True,
                        "COMMENTED": True}
+
+
+def test_the_reference_table_of_expressions_matches_their_docstrings():
+    # docs/reference/language.md repeats the expressions' docstrings (griffe cannot read the
+    # docstring of a callable object); this keeps the copy honest.
+    language = importlib.import_module("pycram.language")
+    page = (REFERENCE / "language.md").read_text(encoding="utf-8")
+    for name in ("seq", "try_in_order", "par", "try_all", "pursue"):
+        assert f"| `{name}` | {getattr(language, name).__doc__} |" in page, name
