@@ -38,8 +38,7 @@ EXAMPLES = examples()
 
 def test_the_examples_are_found():
     pages = {example_id.split("#")[0] for example_id, _ in EXAMPLES}
-    assert {"getting-started.md", "language.md", "designators.md", "robots.md", "simulator.md",
-            "traces.md"} <= pages
+    assert {"getting-started.md", "language.md", "designators.md", "robots.md", "simulator.md", "traces.md"} <= pages
     assert len(EXAMPLES) >= 15
 
 
@@ -53,11 +52,10 @@ def test_example_runs(example_id, code, tmp_path):
     env.setdefault("MUJOCO_GL", "egl")
     env["PYCRAM_RECORD"] = "0"
     env["PYCRAM_DB_URL"] = f"sqlite:///{tmp_path / 'runs.sqlite3'}"  # never the user's database
-    result = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True,
-                            text=True, timeout=TIMEOUT)
-    assert result.returncode == 0, (
-        f"docs/{example_id} failed (exit {result.returncode}):\n{result.stderr[-3000:]}"
+    result = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=TIMEOUT
     )
+    assert result.returncode == 0, f"docs/{example_id} failed (exit {result.returncode}):\n{result.stderr[-3000:]}"
 
 
 def test_a_failing_example_is_reported(tmp_path):

@@ -158,8 +158,15 @@ MODULES = public_modules()
 
 def test_the_public_modules_are_found():
     # The walk must find the core modules; if it found none, every test below would pass vacuously.
-    for core in ("pycram.fluent", "pycram.language", "pycram.runtime", "pycram.designator",
-                 "pycram.process_module", "pycram.macros", "pycram.trace"):
+    for core in (
+        "pycram.fluent",
+        "pycram.language",
+        "pycram.runtime",
+        "pycram.designator",
+        "pycram.process_module",
+        "pycram.macros",
+        "pycram.trace",
+    ):
         assert core in MODULES
     assert "pycram.sim._runtime" not in MODULES
 
@@ -200,8 +207,7 @@ def test_the_checker_catches_an_undocumented_name(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
     module = importlib.import_module("surface_probe")
     verdict = {name: _is_documented("surface_probe", name, getattr(module, name)) for name in module.__all__}
-    assert verdict == {"documented": True, "bare": False, "LIMIT": False, "DOCUMENTED_LIMIT": True,
-                       "COMMENTED": True}
+    assert verdict == {"documented": True, "bare": False, "LIMIT": False, "DOCUMENTED_LIMIT": True, "COMMENTED": True}
 
 
 def test_the_reference_table_of_expressions_matches_their_docstrings():

@@ -52,7 +52,7 @@ def test_the_tools_are_pinned_and_installed_by_make_test():
         assert re.fullmatch(r"[A-Za-z0-9_.\-\[\]]+==[\w.]+", requirement), f"not pinned exactly: {requirement}"
     dev_names = {r.split("==")[0] for r in extras["dev"]}
     assert {"ruff", "mypy", "build"} <= dev_names
-    assert "pycram[docs]" in extras["dev"]          # `make test` installs .[all,dev]
+    assert "pycram[docs]" in extras["dev"]  # `make test` installs .[all,dev]
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     assert "-e '.[all,dev]'" in makefile
 
