@@ -24,14 +24,14 @@ bench: $(STAMP)
 
 # The documentation site, built into site/ with warnings as errors (offline: no fonts or CDN).
 docs: $(STAMP)
-	$(VENV)/bin/mkdocs build --strict --quiet
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 # Lint, format, types and docs (not yet part of .ci/run: the tree-wide clean-up is pending).
 check: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
 	$(VENV)/bin/mypy
-	$(VENV)/bin/mkdocs build --strict --quiet
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 # Build the wheel, install it into a fresh virtual environment, run its CLI and a small plan.
 wheel: $(STAMP)
