@@ -9,6 +9,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PYTHON="${PYTHON:-.venv/bin/python}"
+case "$PYTHON" in  # an absolute path: the script changes directory below
+    */*) PYTHON="$(cd "$(dirname "$PYTHON")" && pwd)/$(basename "$PYTHON")" ;;
+    *) PYTHON="$(command -v "$PYTHON")" ;;
+esac
 REPO="$PWD"
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/pycram-wheel.XXXXXX")"
 trap 'rm -rf "$WORK"' EXIT
