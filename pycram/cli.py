@@ -35,6 +35,22 @@ app = typer.Typer(
 console = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
+
+def _print_version(value: bool) -> None:
+    if value:
+        from pycram._version import __version__
+
+        console.print(f"pycram {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(False, "--version", help="Print PyCRAM's version and exit.",
+                                 callback=_print_version, is_eager=True),
+) -> None:
+    """PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs."""
+
 #: Runs of this many identical successful siblings are shown as one line / box / row (×N);
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
 _COLLAPSE = 3

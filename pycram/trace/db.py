@@ -113,8 +113,10 @@ def display_url(url: str | URL) -> str:
         return str(url)
 
 
+#: SQLAlchemy metadata holding the trace tables (all named ``pycram_*``).
 metadata = sa.MetaData()
 
+#: One row per recorded run: plan, robot, start/end, outcome.
 runs_table = sa.Table(
     "pycram_runs", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -134,6 +136,7 @@ runs_table = sa.Table(
     sa.Column("info", sa.Text),  # JSON object of extra metadata
 )
 
+#: One row per task of a run's task tree: name, parent, status, times, error.
 tasks_table = sa.Table(
     "pycram_tasks", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -154,6 +157,7 @@ tasks_table = sa.Table(
 )
 sa.Index("ix_pycram_tasks_name", tasks_table.c.name)
 
+#: One row per performed designator: its properties and what it resolved to.
 designators_table = sa.Table(
     "pycram_designators", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -169,6 +173,7 @@ designators_table = sa.Table(
 )
 sa.Index("ix_pycram_designators_run", designators_table.c.run_id)
 
+#: One row per process-module execution: module, designator, outcome, times.
 executions_table = sa.Table(
     "pycram_executions", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -186,6 +191,7 @@ executions_table = sa.Table(
 )
 sa.Index("ix_pycram_executions_run", executions_table.c.run_id)
 
+#: Sampled values of watched fluents, with the active clock's time [s].
 fluent_samples_table = sa.Table(
     "pycram_fluent_samples", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
