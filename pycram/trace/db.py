@@ -239,7 +239,10 @@ sa.Index("ix_pycram_fluent_samples_run_name", fluent_samples_table.c.run_id, flu
 def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
     cursor = dbapi_connection.cursor()
     try:
-        cursor.execute("PRAGMA journal_mode=WAL")
+        try:
+            cursor.execute("PRAGMA journal_mode=WAL")
+        except Exception as e:  # a read-only file cannot switch its journal; reading still works
+            log.debug("SQLite: cannot switch to write-ahead logging: %s", e)
         cursor.execute("PRAGMA synchronous=NORMAL")
         cursor.execute("PRAGMA foreign_keys=ON")
     finally:
