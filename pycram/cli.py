@@ -156,8 +156,12 @@ def show_command(
 ) -> None:
     """Print a run's task tree with statuses, durations and failures.
 
-    Runs of 3 or more consecutive identical successful sibling tasks (e.g. a motion repeated by
-    a `whenever` loop) are shown as one line with a count, unless --expand.
+    Every process-module execution is shown (a blocking one under the task that performed it).
+    A failure shows its error where it was raised; enclosing tasks it failed say "passed on".
+    Tree times are on the plan's clock (the header says: simulated or wall clock); the run's
+    duration and start are wall-clock. Runs of 3 or more consecutive identical successful
+    sibling tasks (e.g. a motion repeated by a `whenever` loop) are shown as one line with a
+    count, unless --expand.
     """
     from pycram.trace import query
     from pycram.trace.display import STATUS_STYLE, clock_label, format_duration, task_tree

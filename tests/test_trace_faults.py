@@ -334,3 +334,56 @@ def test_postgres_database_dropped_mid_run(postgres_db):
     for key in [k for k in _engines if name in k]:
         _engines.pop(key).dispose()
     _one_line_error(_invoke("runs", "--db", url), f'database "{name}" does not exist')
+
+
+# -- migrating a database of schema 1, on both kinds ----------------------------------------------
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def any_db(request, tmp_path):
+    if request.param == "sqlite":
+        return f"sqlite:///{tmp_path / 'runs.sqlite3'}"
+    return request.getfixturevalue("postgres_db")[0]
+
+
+def test_schema_1_is_migrated_concurrently_and_read(any_db):
+    """Several processes (here: engines in threads) connecting to a database of schema 1 at
+    once each add the missing columns or find them added; old rows read as before."""
+    import threading
+
+    from pycram.trace.db import connect, create_engine, ensure_schema
+
+    engine = connect(any_db)
+    with engine.begin() as conn:  # back to schema 1
+        conn.exec_driver_sql("ALTER TABLE pycram_tasks DROP COLUMN error_origin")
+        conn.exec_driver_sql("ALTER TABLE pycram_runs DROP COLUMN clock")
+        conn.exec_driver_sql("ALTER TABLE pycram_runs DROP COLUMN lost_records")
+        conn.exec_driver_sql("INSERT INTO pycram_runs (uuid, plan, started_at, outcome) "
+                             "VALUES ('old', 'old run', '2026-01-01 10:00:00', 'failed')")
+        run_id = conn.exec_driver_sql("SELECT id FROM pycram_runs").scalar()
+        conn.exec_driver_sql(
+            "INSERT INTO pycram_tasks (run_id, task_id, parent_id, name, kind, status, error_type, error_message) "
+            f"VALUES ({run_id}, 1, NULL, 'seq', 'seq', 'failed', 'Boom', 'x'), "
+            f"({run_id}, 2, 1, 'grab', 'step', 'failed', 'Boom', 'x')")
+    engine.dispose()
+    errors: list = []
+
+    def migrate() -> None:
+        other = create_engine(any_db)
+        try:
+            ensure_schema(other)
+        except Exception as e:  # pragma: no cover - reported below
+            errors.append(e)
+        finally:
+            other.dispose()
+
+    threads = [threading.Thread(target=migrate) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    columns = {c["name"] for c in sa.inspect(engine).get_columns("pycram_tasks")}
+    assert "error_origin" in columns
+    engine.dispose()
+    assert [r.name for r in query.failed_tasks(url=any_db)] == ["grab"]
+    assert query.get_run(run_id, any_db).clock is None
