@@ -54,6 +54,15 @@ def _steps(prefix: str, n: int) -> None:
         seq(lambda: None, name=f"{prefix} {i}")
 
 
+def _recording_then(url: str, plan: str, damage, steps: int = 2):
+    """A started recorder that has committed `steps` tasks "before i"; then `damage(recorder)`."""
+    recorder = start_recording(url, plan=plan)
+    _steps("before", steps)
+    assert recorder.flush()
+    damage(recorder)
+    return recorder
+
+
 # -- URLs and missing databases --------------------------------------------------------------------
 
 @pytest.mark.parametrize("url, fragments", [
@@ -153,10 +162,7 @@ def _rename(path: Path, old: str, new: str) -> None:
 
 def test_a_table_dropped_under_the_writer_loses_records_not_the_plan(tmp_path, caplog):
     path = tmp_path / "runs.sqlite3"
-    recorder = start_recording(f"sqlite:///{path}", plan="dropped")
-    _steps("before", 3)
-    assert recorder.flush()
-    _drop(path, "pycram_tasks")
+    recorder = _recording_then(f"sqlite:///{path}", "dropped", lambda _: _drop(path, "pycram_tasks"))
     state = seq(lambda: None, lambda: None, name="after")  # the plan goes on as if nothing happened
     assert state.get_value() is State.SUCCEEDED
     with caplog.at_level(logging.WARNING, logger="pycram.trace.recorder"):
@@ -175,10 +181,8 @@ def test_a_table_dropped_under_the_writer_loses_records_not_the_plan(tmp_path, c
 def test_a_database_that_recovers_loses_nothing(tmp_path):
     """Batches that fail are kept and written with the next batch that succeeds."""
     path = tmp_path / "runs.sqlite3"
-    recorder = start_recording(f"sqlite:///{path}", plan="recovers")
-    _steps("before", 2)
-    assert recorder.flush()
-    _rename(path, "pycram_tasks", "pycram_tasks_away")
+    recorder = _recording_then(f"sqlite:///{path}", "recovers",
+                               lambda _: _rename(path, "pycram_tasks", "pycram_tasks_away"))
     _steps("during", 3)
     events.process_module_executed("base", "go", "succeeded", 1.0, 2.0)
     assert recorder.flush()
@@ -199,9 +203,8 @@ def test_rows_beyond_the_backlog_limit_are_dropped_and_counted(tmp_path, monkeyp
 
     monkeypatch.setattr(recorder_module, "BACKLOG_LIMIT", 5)
     path = tmp_path / "runs.sqlite3"
-    recorder = start_recording(f"sqlite:///{path}", plan="backlog")
-    assert recorder.flush()
-    _rename(path, "pycram_executions", "pycram_executions_away")
+    recorder = _recording_then(f"sqlite:///{path}", "backlog",
+                               lambda _: _rename(path, "pycram_executions", "pycram_executions_away"))
     for i in range(20):
         events.process_module_executed("base", f"go {i}", "succeeded", float(i), i + 0.5)
     assert recorder.flush()
@@ -216,13 +219,14 @@ def test_rows_beyond_the_backlog_limit_are_dropped_and_counted(tmp_path, monkeyp
 
 def test_a_directory_in_place_of_the_file_mid_run(tmp_path):
     path = tmp_path / "runs.sqlite3"
-    recorder = start_recording(f"sqlite:///{path}", plan="replaced")
-    _steps("before", 2)
-    assert recorder.flush()
-    recorder._engine.dispose()  # the writer must reconnect: the file is gone, a folder is there
-    for suffix in ("", "-wal", "-shm"):
-        Path(f"{path}{suffix}").unlink(missing_ok=True)
-    path.mkdir()
+
+    def replace_by_a_folder(recorder) -> None:
+        recorder._engine.dispose()  # the writer must reconnect: the file is gone, a folder is there
+        for suffix in ("", "-wal", "-shm"):
+            Path(f"{path}{suffix}").unlink(missing_ok=True)
+        path.mkdir()
+
+    recorder = _recording_then(f"sqlite:///{path}", "replaced", replace_by_a_folder)
     _steps("after", 2)
     recorder.finish("succeeded")
     assert recorder.lost_records >= 3 and "unable to open database file" in recorder.loss_report()
@@ -303,13 +307,16 @@ def postgres_db():
 def test_postgres_connections_killed_mid_run_lose_nothing(postgres_db):
     """The server drops every connection (as on a restart): the writer reconnects."""
     url, admin, name = postgres_db
-    recorder = start_recording(url, plan="reconnects")
-    _steps("before", 3)
-    assert recorder.flush()
-    with admin.connect() as conn:
-        killed = conn.execute(sa.text("SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
-                                      "WHERE datname = :name AND pid <> pg_backend_pid()"), {"name": name}).scalar()
-    assert killed >= 1
+    killed = []
+
+    def terminate_connections(_) -> None:
+        with admin.connect() as conn:
+            killed.append(conn.execute(sa.text(
+                "SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
+                "WHERE datname = :name AND pid <> pg_backend_pid()"), {"name": name}).scalar())
+
+    recorder = _recording_then(url, "reconnects", terminate_connections, steps=3)
+    assert killed[0] >= 1
     _steps("after", 3)
     run_id = recorder.finish("succeeded")
     assert recorder.lost_records == 0
@@ -320,11 +327,12 @@ def test_postgres_connections_killed_mid_run_lose_nothing(postgres_db):
 
 def test_postgres_database_dropped_mid_run(postgres_db):
     url, admin, name = postgres_db
-    recorder = start_recording(url, plan="dropped")
-    _steps("before", 2)
-    assert recorder.flush()
-    with admin.connect() as conn:
-        conn.execute(sa.text(f"DROP DATABASE {name} WITH (FORCE)"))
+
+    def drop_database(_) -> None:
+        with admin.connect() as conn:
+            conn.execute(sa.text(f"DROP DATABASE {name} WITH (FORCE)"))
+
+    recorder = _recording_then(url, "dropped", drop_database)
     state = seq(lambda: None, name="after")
     assert state.get_value() is State.SUCCEEDED
     recorder.finish("succeeded")
