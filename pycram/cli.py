@@ -8,8 +8,10 @@
     pycram timeline [RUN] -o tl.png     which branches ran when (Gantt chart)
 
 The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
-`pycram.trace.db`); a database named with `--db` must exist for the inspecting commands.
-A database that cannot be read gives a one-line error and exit code 1. Recording for `run`/`demo` is on unless `--no-record` or `PYCRAM_RECORD=0`.
+`pycram.trace.db`); a database named with `--db` must exist for the inspecting commands, and
+one that cannot be read gives a one-line error and exit code 1. Recording for `run`/`demo` is
+on unless `--no-record` or `PYCRAM_RECORD=0`; records the database could not take are counted
+and reported at the end of the run (the plan's outcome does not depend on them).
 Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the commands that
 need them.
 """
