@@ -166,7 +166,7 @@ runs_table = sa.Table(
     # the kind of clock task and execution times were taken from: "simulated", "wall-clock",
     # both joined by "+" in order of appearance; NULL in runs recorded before schema 2
     sa.Column("clock", sa.String(64)),
-    sa.Column("lost_records", sa.Integer),  # trace rows that could not be written (None: 0 or unknown)
+    sa.Column("lost_records", sa.Integer),  # trace rows that could not be written (NULL: not known)
 )
 
 tasks_table = sa.Table(
@@ -259,6 +259,7 @@ def _hide_password(url: str) -> str:
     """`url` with the password of `scheme://user:password@host` replaced by ***."""
     return re.sub(r"(://[^/:@]*:)[^/@]*@", r"\1***@", url)
 
+
 _engines: dict[str, Engine] = {}
 _engines_lock = threading.Lock()
 
@@ -304,7 +305,8 @@ def create_engine(url: str | None) -> Engine:
         kwargs["connect_args"] = {"timeout": 30.0, "check_same_thread": False}
     else:
         kwargs["pool_pre_ping"] = True
-        kwargs["connect_args"] = {"connect_timeout": 10}  # [s]: a vanished server is an error, not a hang
+        if "connect_timeout" not in parsed.query:  # [s]: a vanished server is an error, not a hang
+            kwargs["connect_args"] = {"connect_timeout": 10}
     try:
         engine = sa.create_engine(parsed, **kwargs)
     except sa_exc.NoSuchModuleError:
