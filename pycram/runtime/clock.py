@@ -32,7 +32,8 @@ class Clock:
     then `unregister(handle)`. `wait` is called with `condition` held and must release it while
     blocking (as `threading.Condition.wait` does); spurious wake-ups are allowed.
 
-    `kind` says what its times mean to a reader of a trace: "wall-clock" or "simulated".
+    `kind` says what its times mean to a reader of a trace: "wall-clock", "simulated" ("custom"
+    for a subclass that does not say).
     """
 
     kind = "custom"
