@@ -41,8 +41,8 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Iterator, Optional, Sequence
 
-from pycram.sim.kitchen import COUNTERS, FREE_FLOOR
 from pycram.sim.types import Pose2D, yaw_to_quat
+from pycram.world.environment import FURNITURE_TOPS
 
 __all__ = [
     "make_motion_resolver",
@@ -227,38 +227,36 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
 # --------------------------------------------------------------------------- locations
 
 
-def _counter_normal(x: float, y: float) -> Optional[tuple[float, float]]:
-    """Outward normal (towards the free floor) of the counter edge in front of (x, y), or None
-    when (x, y) is on no counter of the simulated kitchen."""
-    fx0, fy0, fx1, fy1 = FREE_FLOOR
+def _counter_normal(environment: Any, x: float, y: float) -> Optional[tuple[float, float]]:
+    """Outward normal (towards the free floor) of the counter or table edge nearest to (x, y),
+    or None when (x, y) is on no counter or table of ``environment`` (its description)."""
     best: Optional[tuple[float, tuple[float, float]]] = None
-    for box in COUNTERS:
-        (cx, cy, _), (hx, hy, _) = box.center, box.half
-        if not (abs(x - cx) <= hx + 1e-6 and abs(y - cy) <= hy + 1e-6):
+    for surface in environment.surfaces_of_kind(*FURNITURE_TOPS):
+        if not surface.contains(x, y, -1e-6):
             continue
-        for n in ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
-            edge_x = cx + n[0] * hx if n[0] else x
-            edge_y = cy + n[1] * hy if n[1] else y
-            probe_x, probe_y = edge_x + 0.3 * n[0], edge_y + 0.3 * n[1]
-            if not (fx0 <= probe_x <= fx1 and fy0 <= probe_y <= fy1):
+        for (ax, ay), _, n in surface.edges():
+            distance = (ax - x) * n[0] + (ay - y) * n[1]  # to the edge's line, along its normal
+            edge_x, edge_y = x + distance * n[0], y + distance * n[1]
+            if not environment.is_free_floor(edge_x + 0.3 * n[0], edge_y + 0.3 * n[1]):
                 continue
-            distance = math.hypot(edge_x - x, edge_y - y)
             if best is None or distance < best[0]:
                 best = (distance, n)
     return None if best is None else best[1]
 
 
 def base_pose_to_reach(description: Any, point: Sequence[float], arm: str,
-                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0) -> Pose2D:
+                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0,
+                       environment: Any = None) -> Pose2D:
     """The base pose from which ``arm`` reaches ``point`` [m, map].
 
-    The base faces the counter the point lies on (heading against the counter edge's outward
-    normal); off the counters it faces the point from the ``current`` base position. The point
+    The base faces the counter or table of ``environment`` (a description) the point lies on
+    (heading against the edge's outward normal); off them, or without an environment, it faces
+    the point from the ``current`` base position. The point
     is then at ``description.REACH_POINT_IN_BASE[arm]`` (+ ``extra_standoff`` [m] ahead) in the
     base frame.
     """
     x, y, _ = _point(point)
-    normal = _counter_normal(x, y)
+    normal = None if environment is None else _counter_normal(environment, x, y)
     if normal is not None:
         yaw = math.atan2(-normal[1], -normal[0])
     elif current is not None:
@@ -290,7 +288,7 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
 
         def poses() -> Iterator[Pose2D]:
             for extra in (0.0, 0.05, -0.05, 0.10):
-                yield base_pose_to_reach(d, point, arm, current, extra)
+                yield base_pose_to_reach(d, point, arm, current, extra, world.environment)
 
         return poses()
 

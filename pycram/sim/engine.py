@@ -109,10 +109,15 @@ class Engine:
                           for it, b in zip(scene.items, self.item_bodies.values())}
         self.item_dof = {it.name: int(self.model.jnt_dofadr[self.model.body_jntadr[b]])
                          for it, b in zip(scene.items, self.item_bodies.values())}
-        # robot joints reported in joint states: everything but the items' free joints
+        # robot joints reported in joint states: everything but the items' free joints and furniture
+        furniture_joints = {c.joint_name for c in scene.environment.containers}
         self.robot_joints = [(self.model.joint(j).name, int(self.model.jnt_qposadr[j]), int(self.model.jnt_dofadr[j]))
                              for j in range(self.model.njnt)
-                             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE]
+                             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
+                             and self.model.joint(j).name not in furniture_joints]
+        from .furniture import Furniture  # (furniture's controllers import this module)
+
+        self.furniture = Furniture(self)
         self.obstacles = {f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])
                           for i in range(self._count_obstacles())}
         self.obstacles_used: set[str] = set()

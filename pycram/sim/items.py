@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
 
 from . import collision
-from .kitchen import COUNTER_HEIGHT
 
 
 @dataclass(frozen=True)
@@ -15,7 +15,8 @@ class ItemSpec:
     """A free rigid item.
 
     `shape` is "box" (half sizes x, y, z) or "cylinder" (radius, half height); `position` is the
-    centre [m] in the map frame (None for z: resting on the counter top); `mass` in [kg].
+    centre [m] in the map frame (None for z: resting on the surface below, see
+    `resting_position`); `mass` in [kg]; `yaw` [rad] turns the item about the vertical.
     """
 
     name: str
@@ -25,16 +26,18 @@ class ItemSpec:
     mass: float
     position: tuple[float, float, float | None]
     rgba: tuple[float, float, float, float] = (0.2, 0.35, 0.8, 1.0)
+    yaw: float = 0.0
 
     @property
     def half_height(self) -> float:
         """Half the item's height [m]."""
         return self.size[2] if self.shape == "box" else self.size[1]
 
-    def resting_position(self) -> tuple[float, float, float]:
-        """Centre [m] with z resolved (on the counter top when not given)."""
+    def resting_position(self, support_height: float) -> tuple[float, float, float]:
+        """Centre [m] with z resolved: when not given, the item stands on a surface at
+        `support_height` [m] (1 mm above it)."""
         x, y, z = self.position
-        return (x, y, COUNTER_HEIGHT + self.half_height + 0.001 if z is None else z)
+        return (x, y, support_height + self.half_height + 0.001 if z is None else z)
 
 
 #: The default items: a pot-like mug at cooker #2 (the one the demo fetches) and a box on the
@@ -45,9 +48,12 @@ DEFAULT_ITEMS = (
 )
 
 
-def add_item(spec: mujoco.MjSpec, item: ItemSpec) -> None:
-    """Add `item` as a free body named `item.name` with one collision geom of the same name."""
-    body = spec.worldbody.add_body(name=item.name, pos=list(item.resting_position()))
+def add_item(spec: mujoco.MjSpec, item: ItemSpec, position: tuple[float, float, float]) -> None:
+    """Add `item` at `position` [m] as a free body named `item.name` with one collision geom of
+    the same name."""
+    half_yaw = 0.5 * item.yaw
+    body = spec.worldbody.add_body(name=item.name, pos=list(position),
+                                   quat=[math.cos(half_yaw), 0.0, 0.0, math.sin(half_yaw)])
     body.add_freejoint(name=f"{item.name}_free")
     if item.shape == "box":
         gtype, size = mujoco.mjtGeom.mjGEOM_BOX, list(item.size)
