@@ -104,7 +104,10 @@ class Engine:
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
         self.item_geoms = {it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name)
                            for it in scene.items}
-        self.geom_item = {g: name for name, g in self.item_geoms.items()}
+        #: every geom of each item (items of several parts: bowls, plates)
+        self.item_part_geoms = {name: [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == b]
+                                for name, b in self.item_bodies.items()}
+        self.geom_item = {g: name for name, gs in self.item_part_geoms.items() for g in gs}
         self.item_qpos = {it.name: int(self.model.jnt_qposadr[self.model.body_jntadr[b]])
                           for it, b in zip(scene.items, self.item_bodies.values())}
         self.item_dof = {it.name: int(self.model.jnt_dofadr[self.model.body_jntadr[b]])

@@ -124,7 +124,7 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
                 offscreen_size: tuple[int, int] = (640, 480),
                 environment: str | Environment = environments.DEFAULT_ENVIRONMENT) -> Scene:
     """Compile `environment` (a name or a description) with `robot` ("pr2" or "tiago") and
-    `items` (default: `DEFAULT_ITEMS`, which belong to the thesis kitchen).
+    `items` (default: `DEFAULT_ITEMS` in the thesis kitchen, none elsewhere).
 
     An item without a z stands on the highest open surface below it (the floor when there is
     none). Offscreen renders are limited to `offscreen_size` [px]. Raises `UnknownNameError`
@@ -133,7 +133,9 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     t0 = time.perf_counter()
     env = environments.load(environment)
     desc = load_description(robot)
-    items = tuple(DEFAULT_ITEMS if items is None else items)
+    if items is None:  # the default items belong to the thesis kitchen
+        items = DEFAULT_ITEMS if env.name == environments.DEFAULT_ENVIRONMENT else ()
+    items = tuple(items)
     names = [it.name for it in items]
     if len(set(names)) != len(names):
         raise ValueError(f"item names must be unique: {names}")

@@ -30,7 +30,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from pycram.environments import DEFAULT_ENVIRONMENT
+from pycram.environments import load as load_environment
 from pycram.world.environment import Environment
+from pycram.world.objects import object_type
+from pycram.world.scenes import random_scene
 
 from ._runtime import Fluent, ManualClock, current_clock, set_clock
 from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
@@ -64,6 +67,12 @@ class World:
     simulated in a background thread. The robot starts at `base_pose` (default: the
     environment's place "start").
 
+    Items are given as `ItemSpec`s (`items`; by default the thesis kitchen's `DEFAULT_ITEMS`
+    there and none elsewhere) and/or as object type names (`objects`, e.g. ``["cup", "bowl",
+    "cup"]``), which are placed at random, non-overlapping spots on the environment's surfaces
+    and inside its containers, the same for the same `seed` (see `pycram.world.scenes`); they
+    are named after their type ("cup", "cup 2") and `placements` says where each started.
+
     Construction builds the scene (< 1 s) and starts the thread. `close()` (or leaving the
     `with` block) stops it and joins it; every command still running ends with reason "closed".
     All public methods are thread-safe and never block unless documented (`snapshot`,
@@ -72,10 +81,17 @@ class World:
 
     def __init__(self, robot: str = "pr2", items: Sequence[ItemSpec] | None = None, *,
                  environment: str | Environment = DEFAULT_ENVIRONMENT,
+                 objects: Sequence[str] | None = None, seed: int = 0,
                  base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
                  offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
-        self.scene = build_scene(robot, items, offscreen_size, environment)
+        env = load_environment(environment)
+        #: Where the `objects` started (a random scene from `seed`; empty without objects).
+        self.placements = random_scene(env, objects, seed) if objects else []
+        if self.placements:
+            items = list(items or []) + [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw)
+                                         for p in self.placements]
+        self.scene = build_scene(robot, items, offscreen_size, env)
         self.description = self.scene.description
         #: The environment's description (data: surfaces, containers, places, free floor).
         self.environment = self.scene.environment
@@ -416,8 +432,8 @@ class World:
         def fn(eng: Engine) -> list[VisibleItem]:
             ids = self._get_renderers().segmentation(eng.data, HEAD_CAMERA, width, height)
             seen = []
-            for name, geom in eng.item_geoms.items():
-                rows, cols = np.nonzero(ids == geom)
+            for name, geoms in eng.item_part_geoms.items():
+                rows, cols = np.nonzero(np.isin(ids, geoms))
                 if len(rows) >= min_pixels:
                     seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), len(rows),
                                             (float(cols.mean()), float(rows.mean()))))
