@@ -118,7 +118,7 @@ ENVIRONMENT = Environment(
         Place("start", (2.0, 1.5, 1.5708)),
         Place("kitchen", (1.3, 3.6, 1.5708)),
         Place("fridge", (3.3, 3.2, 1.5708)),
-        Place("drawers", (1.5, 2.9, 3.1416)),
+        Place("drawers", (1.6, 2.9, 3.1416)),
         Place("table south", (4.3, 0.9, 1.5708)),
         Place("table north", (4.3, 3.1, -1.5708)),
     ),

@@ -6,7 +6,8 @@ its centre named after it. Each container becomes a body of its own: a drawer (b
 walls) on a slide joint, or a door panel on a hinge, with a handle bar, a site at the handle's
 grasp point, joint damping and friction loss (so it moves only when pulled hard enough and stays
 where it is left), and an inactive joint equality that makes it "stuck" when activated. The
-builder also adds the floor, a light, the overview camera and parked obstacles.
+builder also adds the floor, a light, the overview camera, a top-down plan camera and parked
+obstacles.
 """
 
 from __future__ import annotations
@@ -25,6 +26,10 @@ _HANDLE_RGBA = [0.35, 0.35, 0.38, 1]
 #: Drawer and door bodies are wood-like [kg/m^3].
 _FURNITURE_DENSITY = 400.0
 _HANDLE_STANDOFF = 0.04  # [m] between a front panel and its handle bar
+#: An orthographic camera looking straight down on the whole environment (image up: +y).
+PLAN_CAMERA = "plan"
+PLAN_CAMERA_HEIGHT = 8.0  # [m]
+PLAN_ASPECT = 4.0 / 3.0  # width / height of images of the plan camera
 
 
 def stuck_equality(container: str) -> str:
@@ -100,6 +105,23 @@ def add_environment(spec: mujoco.MjSpec, env: Environment) -> None:
     cam = env.camera
     world.add_camera(name=cam.name, pos=list(cam.position), fovy=cam.fovy,
                      quat=look_at_quat(cam.position, cam.target))
+    px0, py0, px1, py1 = plan_view(env)
+    top = world.add_camera(name=PLAN_CAMERA, pos=[(px0 + px1) / 2, (py0 + py1) / 2, PLAN_CAMERA_HEIGHT],
+                           fovy=py1 - py0, quat=look_at_quat((0, 0, 1), (0, 0, 0)))
+    top.proj = mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC
+
+
+def plan_view(env: Environment, margin: float = 0.4) -> tuple[float, float, float, float]:
+    """The floor rectangle (x_min, y_min, x_max, y_max) [m] the plan camera sees in a 4:3 image:
+    the environment's `plan_bounds` with `margin`, widened to the image's aspect ratio."""
+    x0, y0, x1, y1 = env.plan_bounds
+    x0, y0, x1, y1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+    w, h = x1 - x0, y1 - y0
+    if w < h * PLAN_ASPECT:
+        x0, x1 = x0 - (h * PLAN_ASPECT - w) / 2, x1 + (h * PLAN_ASPECT - w) / 2
+    else:
+        y0, y1 = y0 - (w / PLAN_ASPECT - h) / 2, y1 + (w / PLAN_ASPECT - h) / 2
+    return (x0, y0, x1, y1)
 
 
 def _add_container(spec: mujoco.MjSpec, c: Container) -> None:
@@ -150,4 +172,5 @@ def _add_container(spec: mujoco.MjSpec, c: Container) -> None:
     eq.solref = [0.005, 1.0]
 
 
-__all__ = ["add_environment", "look_at_quat", "stuck_equality", "N_OBSTACLES", "OBSTACLE_PARKING"]
+__all__ = ["add_environment", "look_at_quat", "stuck_equality", "plan_view", "N_OBSTACLES", "OBSTACLE_PARKING",
+           "PLAN_CAMERA", "PLAN_ASPECT"]

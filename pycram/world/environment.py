@@ -262,6 +262,13 @@ class Environment:
         return self.place("start").pose
 
     # --- geometry -----------------------------------------------------------------------
+    @property
+    def plan_bounds(self) -> Rect:
+        """The rectangle around the floor and everything standing on it (walls included)."""
+        rects = list(self.floor) + [b.footprint for b in self.static] + [c.body.footprint for c in self.containers]
+        return (min(r[0] for r in rects), min(r[1] for r in rects), max(r[2] for r in rects),
+                max(r[3] for r in rects))
+
     def obstacles(self) -> list[Box]:
         """Static boxes and closed container bodies that stand in the way of a driving base
         (they collide and reach down to less than 0.3 m above the floor)."""
