@@ -17,8 +17,9 @@ from .types import GripperState, JointStates, Pose, Pose2D
 
 _log = logging.getLogger(__name__)
 
-#: Where items taken "aside" by fault injection are put (on the floor, out of the kitchen) [m].
-ASIDE_AREA = (4.5, 4.0)
+#: Items taken "aside" by fault injection are put on the floor this far [m] beyond the
+#: environment's plan (east of everything, out of the way).
+ASIDE_DISTANCE = 1.5
 #: A closing gripper grasps an item only while its fingers are at least this far apart [m]:
 #: fully closed fingers have nothing between them, whatever touches their outsides.
 MIN_GRASP_OPENING = 0.003
@@ -284,10 +285,11 @@ class Engine:
         mujoco.mj_forward(self.model, self.data)
 
     def aside_position(self, item: str) -> tuple[float, float, float]:
-        """A free spot on the floor away from the kitchen for `item`."""
+        """A free spot on the floor for `item`, beyond the environment (east of it)."""
         self._aside_count += 1
         spec = self.scene.item(item)
-        return (ASIDE_AREA[0], ASIDE_AREA[1] + 0.3 * self._aside_count, spec.half_height + 0.002)
+        _, y0, x1, _ = self.scene.environment.plan_bounds
+        return (x1 + ASIDE_DISTANCE, y0 + 0.3 * self._aside_count, spec.half_height + 0.002)
 
     def place_obstacle(self, name: str, x: float, y: float) -> None:
         self.data.mocap_pos[self.obstacles[name]] = (x, y, 0.0)

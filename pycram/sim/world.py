@@ -524,7 +524,7 @@ class World:
                   to: Sequence[float] | None = None) -> CommandHandle:
         """Take an item away, as a person would: out of `gripper` (the item it holds) or `item` by name.
 
-        The item goes to `to` [m] or aside onto the floor out of the kitchen. The gripper keeps
+        The item goes to `to` [m] or aside onto the floor beyond the environment. The gripper keeps
         its command, so a closed gripper closes fully. Value: the item's name (None if nothing).
         """
         if gripper is not None:
