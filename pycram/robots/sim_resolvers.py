@@ -51,6 +51,8 @@ __all__ = [
     "physical_gripper",
     "approach_target",
     "base_pose_to_reach",
+    "make_location_generator",
+    "known_objects_of",
 ]
 
 
@@ -328,3 +330,49 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
 
     to_reach.__qualname__ = f"{d.NAME}_to_reach"
     return to_reach
+
+
+def known_objects_of(world: Any) -> list:
+    """The objects of a simulated `world` as `pycram.locations.KnownObject`s (name, type, centre,
+    yaw, footprint radius, half height).
+
+    A stand-in for the robot's belief (issue 15) with the same standing as prospection: the
+    world as it is now.
+    """
+    from pycram.locations import KnownObject
+
+    poses = world.item_poses.get_value()
+    out = []
+    for item in world.scene.items:
+        pose = poses.get(item.name)
+        if pose is None:
+            continue
+        w, x, y, z = pose.orientation
+        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        radius = math.hypot(item.size[0], item.size[1]) if item.shape == "box" else item.size[0]
+        out.append(KnownObject(item.name, item.type, tuple(pose.position), yaw, radius, item.half_height))
+    return out
+
+
+def make_location_generator(world: Any, description: Any) -> Callable[[Any], Any]:
+    """The location generator of the robot of `description` in the simulated `world`: the
+    general reasoning of :mod:`pycram.locations` (``to_reach``, ``to_see``, ``to_open``, ``on``,
+    ``in``), with prospection from the world and the world's objects as known objects. Returns
+    ``None`` for designators outside that vocabulary."""
+    from pycram.locations import LocationReasoner, RobotGeometry
+
+    def prospection() -> Any:
+        make = getattr(world, "prospection", None)
+        if make is None:
+            raise LookupError(f"{world!r} offers no prospection")
+        return make()
+
+    reasoner = LocationReasoner(RobotGeometry.from_description(description), lambda: world.environment,
+                                prospection, lambda: known_objects_of(world))
+
+    def locations(desig: Any) -> Any:
+        return reasoner.generator(desig)
+
+    locations.__qualname__ = f"{description.NAME}_locations"
+    locations.reasoner = reasoner  # type: ignore[attr-defined]
+    return locations

@@ -19,6 +19,7 @@ BASE = {
     "linear_acceleration": 0.8,  # [m/s^2]
     "angular_acceleration": 1.5,  # [rad/s^2]
     "radius": 0.47,  # [m] circumscribed radius of the footprint (corner of the 0.67 m square)
+    "inscribed_radius": 0.335,  # [m] circle the footprint always covers (half the 0.67 m square)
     "collision_links": ("base_link", "torso_lift_link"),
 }
 

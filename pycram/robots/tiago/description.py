@@ -17,6 +17,7 @@ BASE = {
     "linear_acceleration": 0.8,  # [m/s^2]
     "angular_acceleration": 1.5,  # [rad/s^2]
     "radius": 0.28,  # [m]
+    "inscribed_radius": 0.27,  # [m] circle the footprint always covers (the round base)
     "collision_links": ("base_link", "torso_fixed_link", "torso_fixed_column_link"),
 }
 

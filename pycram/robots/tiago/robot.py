@@ -16,7 +16,7 @@ from typing import Any, Optional
 
 from pycram.process_module import ProcessModule
 from pycram.robots import sim_modules as sm
-from pycram.robots.sim_resolvers import (make_motion_resolver, make_to_reach_generator,
+from pycram.robots.sim_resolvers import (make_location_generator, make_motion_resolver,
                                          physical_arm, physical_gripper)
 from pycram.robots.sim_vocabulary import motion_types
 from pycram.robots.tiago import description
@@ -44,7 +44,7 @@ def make_robot(world: Any) -> sm.SimRobot:
 
     robot.motion_types.update(motion_types(world, description))
     robot.motion_resolvers.append(make_motion_resolver(world, description))
-    robot.location_generators.append(make_to_reach_generator(world, description))
+    robot.location_generators.append(make_location_generator(world, description))
 
     def available_process_modules(desig: Any) -> Optional[ProcessModule]:
         """Thesis ch. 4.2.2: choose TIAGo's module by the designator's type; any arm or gripper

@@ -1,0 +1,549 @@
+"""Location reasoning: costmaps ranked best-first, candidates validated by prospection.
+
+`LocationReasoner` resolves the robot- and environment-agnostic location vocabulary:
+
+===================================  ===========================================================
+designator                           solutions
+===================================  ===========================================================
+``('to_reach', t)`` [``('arm', a)``,  `BaseLocation` from which the arm executes the whole grasp
+``('grasp', g)``, ``('action',        sequence (pre_grasp, grasp, lift; with ``('action',
+'place')``]                           'place')``: pre_place, place, retreat) without collision; it
+                                     names the arm and grasp found
+``('to_see', t)``                    `BaseLocation` from which the head camera sees ``t``
+                                     (at least half of it, unoccluded)
+``('to_open', c)`` [``('arm', a)``,   `BaseLocation` from which the arm grasps the handle of the
+``('opening', q)``]                   drawer or door ``c`` and follows its opening trajectory
+``('on', s)`` [``('near', o)``,       `Spot`: a free spot on surface ``s`` where an object of that
+``('for', type/object)``]             type fits without touching the known objects
+``('in', c)`` [same options]         `Spot` inside container ``c`` (its interior surfaces)
+===================================  ===========================================================
+
+A target ``t`` is an object designator, a believed object, a named place/surface/container or a
+point (see `pycram.locations.targets`). Designators with other properties are not ours
+(``None``: other generators answer them, e.g. a world's named places).
+
+How: layers over the floor (`pycram.locations.costmap`) -- occupancy from the environment's
+description inflated by the robot's inscribed radius, a Gaussian reachability ring around the
+target from the arm's comfortable reach (robot description), a preference for facing the
+furniture squarely, and for ``to_see`` a viewing ring -- are summed, and cells are taken
+cheapest first, lazily. Each candidate is checked with prospection (`Prospection.in_collision`,
+`reachable` for the IK sequence, `visible`) in the world as it is now; solutions keep
+`SPACING` apart, so the next solution is a different place, never a repeat.
+
+Bounded: at most `MAX_CANDIDATES` candidates are checked per designator. When none passes,
+`NoSolutionError` says how many were tried and what ruled them out, e.g. ``312 candidates: 280
+in collision, 32 unreachable for arm 'left' (out_of_reach 20, collision 12)``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import math
+from collections import Counter
+from typing import Any, Callable, Iterator, Optional, Sequence
+
+import numpy as np
+
+from pycram.designators.core import NoSolutionError
+from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Surface
+from pycram.world.objects import Grasp, ObjectType, object_type
+
+from .costmap import (Costmap, FloorGrid, angle_difference, distance_layer, occupancy_layer, ring_layer)
+from .robot_geometry import RobotGeometry
+from .solutions import BaseLocation, Spot
+from .targets import KnownObject, Target, as_target
+
+__all__ = ["LocationReasoner", "VOCABULARY", "MAX_CANDIDATES", "SPACING", "grasp_sequence"]
+
+log = logging.getLogger(__name__)
+
+#: The keys location reasoning understands; a designator with any other key is left to others.
+VOCABULARY = frozenset({"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for",
+                        "action", "opening"})
+#: Candidates checked with prospection per designator before giving up.
+MAX_CANDIDATES = 300
+#: Distance [m] between two solutions of one designator (base poses or spots).
+SPACING = 0.1
+#: Spots on surfaces: grid cell [m], free space [m] to other objects and to the surface's edge.
+SPOT_RESOLUTION = 0.02
+SPOT_GAP = 0.02
+SPOT_EDGE_MARGIN = 0.03
+#: Footprint radius [m] and half height [m] assumed for ``('on', s)`` without ``('for', ...)``.
+DEFAULT_OBJECT = (0.05, 0.0)
+#: Viewing ring for ``to_see`` [m]: preferred distance, spread, nearest, farthest.
+VIEW_RING = (1.3, 0.5, 0.6, 3.0)
+#: Reach ring spread [m] and its limits around the arm's comfortable distance [m].
+REACH_SIGMA, REACH_INSIDE, REACH_OUTSIDE = 0.12, 0.35, 0.30
+#: Facing the furniture: angle [rad] scale of its cost; a grasp's approach may deviate this much
+#: [rad] from the base heading.
+FACING_SCALE = 0.6
+APPROACH_TOLERANCE = 0.45
+#: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
+TOP_PENALTY = 0.3
+#: Default opening [m for drawers, rad for doors] followed by ``to_open``.
+DRAWER_OPENING, DOOR_OPENING = 0.3, 1.2
+#: Grasp phases of ``to_reach`` by action.
+PHASES = {"grasp": ("pre_grasp", "grasp", "lift"), "place": ("pre_place", "place", "retreat")}
+#: Approach side in the object's frame -> angle [rad] of that side.
+_SIDE_ANGLE = {"+x": 0.0, "-x": math.pi, "+y": math.pi / 2, "-y": -math.pi / 2}
+_POINT_GRASP = Grasp("side", 0.07, 0.0)
+
+
+def _quat_yaw(yaw: float) -> tuple[float, float, float, float]:
+    return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def _quat_down(yaw: float) -> tuple[float, float, float, float]:
+    """Tool x pointing down, tool y across `yaw` (rotation about z by yaw, then about y by 90 deg)."""
+    cz, sz, c, s = math.cos(yaw / 2), math.sin(yaw / 2), math.cos(math.pi / 4), math.sin(math.pi / 4)
+    return (cz * c, -sz * s, cz * s, sz * c)
+
+
+def grasp_sequence(geometry: RobotGeometry, point: Sequence[float], heading: float, approach: str,
+                   action: str = "grasp") -> list[tuple[tuple[float, float, float], tuple]]:
+    """Tool poses (position [m], orientation (w, x, y, z)) of the grasp or place sequence at
+    `point`: the tool points along `heading` [rad] (horizontal approaches) or down (``'top'``),
+    each phase offset by the robot's ``APPROACH_OFFSETS`` (back along the approach, up)."""
+    x, y, z = point
+    out = []
+    for phase in PHASES[action]:
+        back, up = geometry.approach_offsets.get(phase, (0.0, 0.0))
+        if approach == "top":
+            out.append(((x, y, z + back + up), _quat_down(heading)))
+        else:
+            c, s = math.cos(heading), math.sin(heading)
+            out.append(((x - c * back, y - s * back, z + up), _quat_yaw(heading)))
+    return out
+
+
+class _Tally:
+    """Why candidates failed, for the error message."""
+
+    def __init__(self) -> None:
+        self.tried = 0
+        self.reasons: Counter[str] = Counter()
+        self.details: dict[str, Counter[str]] = {}
+
+    def fail(self, reason: str, detail: Optional[str] = None) -> None:
+        self.reasons[reason] += 1
+        if detail:
+            self.details.setdefault(reason, Counter())[detail] += 1
+
+    def summary(self) -> str:
+        parts = []
+        for reason, n in self.reasons.most_common():
+            detail = self.details.get(reason)
+            more = f" ({', '.join(f'{k} {v}' for k, v in detail.most_common())})" if detail else ""
+            parts.append(f"{n} {reason}{more}")
+        return f"{self.tried} candidates: " + ", ".join(parts) if parts else f"{self.tried} candidates"
+
+
+class LocationReasoner:
+    """Resolves the location vocabulary for one robot (see the module docstring).
+
+    `environment()` returns the environment's description, `prospection()` the robot's
+    `Prospection` in the current world, `known_objects()` the objects believed to be around
+    (`KnownObject`s; used for free spots and to look up targets by name). All are called at
+    resolution time, so answers reflect the world as it is then.
+    """
+
+    def __init__(self, geometry: RobotGeometry, environment: Callable[[], Environment],
+                 prospection: Callable[[], Any], known_objects: Callable[[], Sequence[KnownObject]] = lambda: (),
+                 max_candidates: int = MAX_CANDIDATES) -> None:
+        self.geometry = geometry
+        self.environment = environment
+        self.prospection = prospection
+        self.known_objects = known_objects
+        self.max_candidates = max_candidates
+
+    # ------------------------------------------------------------------ entry point
+    def generator(self, desig: Any) -> Optional[Iterator[Any]]:
+        """The location generator: an iterator of solutions, or None when `desig` is not ours."""
+        keys = [k for k, _ in desig.properties]
+        if not keys or any(k not in VOCABULARY for k in keys):
+            return None
+        for key, method in (("to_reach", self.to_reach), ("to_see", self.to_see), ("to_open", self.to_open),
+                            ("on", self.on), ("in", self.inside)):
+            if desig.prop_value(key) is not None:
+                return method(desig)
+        return None
+
+    def _fail(self, desig: Any, what: str) -> NoSolutionError:
+        return NoSolutionError(f"Cannot resolve {desig!r}: {what}", designator=desig)
+
+    def _target(self, value: Any) -> Target:
+        return as_target(value, self.environment(), self.known_objects())
+
+    # ------------------------------------------------------------------ to_reach
+    def to_reach(self, desig: Any) -> Iterator[BaseLocation]:
+        target = self._target(desig.prop_value("to_reach"))
+        action = desig.prop_value("action") or "grasp"
+        if action not in PHASES:
+            raise ValueError(f"('action', {action!r}) is not one of {sorted(PHASES)}")
+        arms = self._arms(desig.prop_value("arm"))
+        grasps = self._grasps(target, desig.prop_value("grasp"))
+        env = self.environment()
+        grid = FloorGrid.of(env)
+        occupancy = occupancy_layer(env, grid, self.geometry.inscribed_radius)
+        facing = self._facing_yaws(env, target)
+        streams = []
+        maps = {}
+        for arm in arms:
+            yaw = self._natural_yaw(grid, target.position, arm)
+            costmap = Costmap(grid, {"occupancy": occupancy})
+            d0 = self.geometry.reach_distance(arm)
+            costmap.add("reach", ring_layer(grid, target.position, d0, REACH_SIGMA,
+                                            max(0.2, d0 - REACH_INSIDE), d0 + REACH_OUTSIDE))
+            if facing:
+                costmap.add("facing", self._facing_layer(yaw, facing))
+            costmap.add("grasp", self._grasp_layer(yaw, grasps, target))
+            maps[arm] = costmap
+            streams.append(_ranked(costmap, arms.index(arm), arm))
+        self.last_costmaps = maps
+
+        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+            cost, _, arm, r, c = cell
+            x, y = maps[arm].xy(r, c)
+            natural = _wrap(math.atan2(target.position[1] - y, target.position[0] - x)
+                            - self.geometry.reach_bearing(arm))
+            prosp = self.prospection()
+            tucked = dict(self.geometry.tucked)
+            if prosp.in_collision((x, y, natural), tucked):
+                return None, ("in collision", None)
+            failure = None
+            for grasp, heading in self._grasp_options(grasps, target, natural):
+                yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
+                point = self._grasp_point(target, grasp)
+                poses = grasp_sequence(self.geometry, point, yaw if grasp.approach != "top" else heading,
+                                       grasp.approach, action)
+                answer = prosp.reachable(arm, poses, (x, y, yaw), tucked)
+                if answer:
+                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=answer.solutions), None
+                failure = (f"unreachable for arm {arm!r}", answer.reason)
+            return None, failure or ("no fitting grasp", None)
+
+        return self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps)
+
+    def _arms(self, requested: Any) -> list[str]:
+        if requested is not None:
+            return [self.geometry.arm(requested)]
+        others = [a for a in self.geometry.arms if a != self.geometry.default_arm]
+        return [self.geometry.default_arm] + others
+
+    def _grasps(self, target: Target, requested: Any) -> list[Grasp]:
+        grasps = list(target.type.grasps) if target.type is not None else [_POINT_GRASP]
+        if requested is not None:
+            chosen = [g for g in grasps if g.approach == requested]
+            if not chosen:
+                raise ValueError(f"no grasp {requested!r} for {target.describe()}; available: "
+                                 f"{[g.approach for g in grasps]}")
+            return chosen
+        return grasps
+
+    @staticmethod
+    def _grasp_point(target: Target, grasp: Grasp) -> tuple[float, float, float]:
+        x, y, z = target.position
+        if target.type is None:
+            return (x, y, z)
+        return (x, y, z - target.type.half_height + grasp.height)
+
+    @staticmethod
+    def _grasp_heading(grasp: Grasp, target: Target) -> Optional[float]:
+        """Tool heading [rad] a directional grasp requires (None: any horizontal heading)."""
+        side = _SIDE_ANGLE.get(grasp.approach)
+        return None if side is None else target.yaw + side + math.pi
+
+    def _grasp_options(self, grasps: list[Grasp], target: Target, natural: float) -> list[tuple[Grasp, float]]:
+        """Grasps that fit a base heading `natural`, the best-aligned first, with their heading."""
+        options = []
+        for g in grasps:
+            heading = self._grasp_heading(g, target)
+            if heading is None:  # any heading; top grasps after the horizontal ones
+                options.append((TOP_PENALTY if g.approach == "top" else 0.0, g, natural))
+            elif angle_difference(heading, natural) <= APPROACH_TOLERANCE:
+                options.append((angle_difference(heading, natural), g, heading))
+        return [(g, h) for _, g, h in sorted(options, key=lambda o: o[0])]
+
+    def _natural_yaw(self, grid: FloorGrid, point: Sequence[float], arm: str) -> np.ndarray:
+        """Per cell: the base heading that puts `point` at `arm`'s comfortable reach point."""
+        return np.arctan2(point[1] - grid.y, point[0] - grid.x) - self.geometry.reach_bearing(arm)
+
+    @staticmethod
+    def _facing_yaws(env: Environment, target: Target) -> list[float]:
+        """Headings [rad] that face squarely the edges of the counter or table under `target`."""
+        x, y, _ = target.position
+        for surface in env.surfaces_of_kind(*FURNITURE_TOPS):
+            if surface.contains(x, y, -1e-6):
+                return [math.atan2(-n[1], -n[0]) for _, _, n in surface.edges()]
+        return []
+
+    @staticmethod
+    def _facing_layer(yaw: np.ndarray, facing: list[float]) -> np.ndarray:
+        diff = np.min([np.abs((yaw - f + np.pi) % (2 * np.pi) - np.pi) for f in facing], axis=0)
+        return (diff / FACING_SCALE) ** 2
+
+    def _grasp_layer(self, yaw: np.ndarray, grasps: list[Grasp], target: Target) -> np.ndarray:
+        """0 where some grasp fits the cell's heading (``inf`` where none does)."""
+        best = np.full(yaw.shape, np.inf)
+        for g in grasps:
+            heading = self._grasp_heading(g, target)
+            if heading is None:
+                best = np.minimum(best, TOP_PENALTY if g.approach == "top" else 0.0)
+                continue
+            diff = np.abs((yaw - heading + np.pi) % (2 * np.pi) - np.pi)
+            best = np.minimum(best, np.where(diff <= APPROACH_TOLERANCE, (diff / APPROACH_TOLERANCE) ** 2, np.inf))
+        return best
+
+    # ------------------------------------------------------------------ to_see
+    def to_see(self, desig: Any) -> Iterator[BaseLocation]:
+        target = self._target(desig.prop_value("to_see"))
+        env = self.environment()
+        grid = FloorGrid.of(env)
+        preferred, sigma, low, high = VIEW_RING
+        costmap = Costmap(grid, {"occupancy": occupancy_layer(env, grid, self.geometry.inscribed_radius),
+                                 "view": ring_layer(grid, target.position, preferred, sigma, low, high)})
+        self.last_costmaps = {"view": costmap}
+        what = target.name if target.kind == "object" and target.name else target.position
+
+        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+            cost, _, _, r, c = cell
+            x, y = costmap.xy(r, c)
+            yaw = math.atan2(target.position[1] - y, target.position[0] - x)
+            prosp = self.prospection()
+            if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+                return None, ("in collision", None)
+            seen = prosp.visible(what, (x, y, yaw), 0.5, self.geometry.tucked)
+            if seen:
+                return BaseLocation(x, y, yaw, cost=cost, visible=seen.fraction), None
+            if seen.in_view < 0.5:
+                return None, ("out of the camera's view", None)
+            return None, ("occluded", seen.occluders[0] if seen.occluders else None)
+
+        cells = _ranked(costmap, 0, None)
+        return self._search(desig, cells, validate, "to_see", target, {"view": costmap})
+
+    # ------------------------------------------------------------------ to_open
+    def to_open(self, desig: Any) -> Iterator[BaseLocation]:
+        env = self.environment()
+        value = desig.prop_value("to_open")
+        name = value.name if isinstance(value, Container) else value
+        container = env.container(name)
+        lo, hi = container.limits
+        wanted = desig.prop_value("opening")
+        opening = min(hi, DRAWER_OPENING if container.kind == "drawer" else DOOR_OPENING) if wanted is None \
+            else float(wanted)
+        if not lo <= opening <= hi:
+            raise ValueError(f"opening {opening} of {container.name!r} is outside its limits {container.limits}")
+        steps = [opening * k / 3 for k in range(4)]
+        trajectory = [container.handle_position(q) for q in steps]
+        headings = [self._pull_heading(container, q) for q in steps]
+        arms = self._arms(desig.prop_value("arm"))
+        grid = FloorGrid.of(env)
+        swept = self._swept_rects(container, opening)
+        occupancy = occupancy_layer(env, grid, self.geometry.inscribed_radius, swept)
+        if container.kind == "door":
+            occupancy = occupancy.copy()
+            hx, hy = container.hinge
+            reach = max(math.hypot(x - hx, y - hy) for x, y in _corners(container.body.footprint))
+            occupancy[np.hypot(grid.x - hx, grid.y - hy) < reach + self.geometry.inscribed_radius] = np.inf
+        middle = tuple(np.mean(trajectory, axis=0))
+        maps, streams = {}, []
+        for i, arm in enumerate(arms):
+            d0 = self.geometry.reach_distance(arm)
+            costmap = Costmap(grid, {"occupancy": occupancy,
+                                     "reach": ring_layer(grid, middle, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4),
+                                                         d0 + 0.4)})
+            costmap.add("facing", self._facing_layer(self._natural_yaw(grid, middle, arm), [headings[0]]))
+            maps[arm] = costmap
+            streams.append(_ranked(costmap, i, arm))
+        self.last_costmaps = maps
+
+        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+            cost, _, arm, r, c = cell
+            x, y = maps[arm].xy(r, c)
+            yaw = _wrap(math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm))
+            prosp = self.prospection()
+            if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+                return None, ("in collision", None)
+            back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
+            hx, hy, hz = trajectory[0]
+            c0, s0 = math.cos(headings[0]), math.sin(headings[0])
+            poses = [((hx - c0 * back, hy - s0 * back, hz), _quat_yaw(headings[0]))]
+            poses += [(p, _quat_yaw(h)) for p, h in zip(trajectory, headings)]
+            answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
+            if answer:
+                return BaseLocation(x, y, yaw, arm, "handle", cost, joints=answer.solutions), None
+            return None, (f"unreachable for arm {arm!r}", answer.reason)
+
+        target = Target(container.handle, "container", container.name, thing=container)
+        return self._search(desig, heapq.merge(*streams), validate, "to_open", target, maps)
+
+    @staticmethod
+    def _pull_heading(container: Container, q: float) -> float:
+        """Tool heading [rad] at the handle when the joint is at `q`: against the opening motion."""
+        dx, dy = container.opening_direction
+        if container.kind == "door":
+            a = container.hinge_sign * q
+            dx, dy = math.cos(a) * dx - math.sin(a) * dy, math.sin(a) * dx + math.cos(a) * dy
+        return math.atan2(-dy, -dx)
+
+    @staticmethod
+    def _swept_rects(container: Container, opening: float) -> list[tuple[float, float, float, float]]:
+        if container.kind != "drawer":
+            return []
+        x0, y0, x1, y1 = container.body.footprint
+        dx, dy = container.opening_direction
+        return [(min(x0, x0 + dx * opening), min(y0, y0 + dy * opening),
+                 max(x1, x1 + dx * opening), max(y1, y1 + dy * opening))]
+
+    # ------------------------------------------------------------------ on / in
+    def on(self, desig: Any) -> Iterator[Spot]:
+        env = self.environment()
+        value = desig.prop_value("on")
+        surface = value if isinstance(value, Surface) else env.surface(value)
+        return self._spots(desig, [surface], None)
+
+    def inside(self, desig: Any) -> Iterator[Spot]:
+        env = self.environment()
+        value = desig.prop_value("in")
+        container = value if isinstance(value, Container) else env.container(value)
+        if not container.interior:
+            raise self._fail(desig, f"{container.name!r} has no surfaces inside")
+        return self._spots(desig, list(container.interior), container.name)
+
+    def _object_size(self, value: Any, known: Sequence[KnownObject]) -> tuple[float, float, str, Optional[str]]:
+        """(footprint radius [m], half height [m], description, name) of the object to put down."""
+        if value is None:
+            return DEFAULT_OBJECT[0], DEFAULT_OBJECT[1], "an object", None
+        if isinstance(value, ObjectType):
+            return value.footprint_radius, value.half_height, f"a {value.name}", None
+        if isinstance(value, str):
+            for k in known:
+                if k.name == value:
+                    return float(k.radius), float(k.half_height), f"the {k.name}", k.name
+            t = object_type(value)
+            return t.footprint_radius, t.half_height, f"a {t.name}", None
+        target = as_target(value, None, known)
+        if target.type is None:
+            raise ValueError(f"('for', {value!r}): need an object type, a known object or an object with a type")
+        return target.type.footprint_radius, target.type.half_height, target.describe(), target.name
+
+    def _spots(self, desig: Any, surfaces: list[Surface], container: Optional[str]) -> Iterator[Spot]:
+        known = list(self.known_objects())
+        radius, half, what, own = self._object_size(desig.prop_value("for"), known)
+        near = desig.prop_value("near")
+        near_xy = None if near is None else self._target(near).position[:2]
+        fitting = [s for s in surfaces if s.clearance >= 2 * half + 0.01]
+        if not fitting:
+            raise self._fail(desig, f"{what} ({2 * half:.2f} m tall) fits on none of "
+                             f"{[s.name for s in surfaces]} (clearance "
+                             f"{', '.join(f'{s.clearance:.2f} m' for s in surfaces)})")
+        candidates = []
+        tally = _Tally()
+        for surface in fitting:
+            x0, y0, x1, y1 = surface.bounds
+            xs = np.arange(x0 + SPOT_RESOLUTION / 2, x1, SPOT_RESOLUTION)
+            ys = np.arange(y0 + SPOT_RESOLUTION / 2, y1, SPOT_RESOLUTION)
+            gx, gy = np.meshgrid(xs, ys)
+            inside = np.ones(gx.shape, bool)
+            for (ax, ay), _, n in surface.edges():
+                inside &= (gx - ax) * -n[0] + (gy - ay) * -n[1] >= radius + SPOT_EDGE_MARGIN
+            tally.tried += int(gx.size)
+            tally.reasons["too close to the edge"] += int((~inside).sum())
+            free = inside.copy()
+            z = surface.height + half
+            for k in known:
+                if k.name == own:
+                    continue
+                kz0, kz1 = k.position[2] - k.half_height, k.position[2] + k.half_height
+                if kz1 <= surface.height - 0.01 or kz0 >= surface.height + 2 * half + 0.01:
+                    continue
+                blocked = np.hypot(gx - k.position[0], gy - k.position[1]) < radius + k.radius + SPOT_GAP
+                tally.details.setdefault("occupied", Counter())[k.name] += int((blocked & free).sum())
+                tally.reasons["occupied"] += int((blocked & free).sum())
+                free &= ~blocked
+            if near_xy is not None:
+                cost = np.hypot(gx - near_xy[0], gy - near_xy[1])
+            else:
+                cx, cy, _ = surface.centroid
+                cost = np.hypot(gx - cx, gy - cy)
+            for i in np.flatnonzero(free.ravel()):
+                candidates.append((float(cost.ravel()[i]), float(gx.ravel()[i]), float(gy.ravel()[i]), z,
+                                   surface.name))
+        candidates.sort()
+        if not candidates:
+            raise self._fail(desig, f"no free spot for {what} (footprint radius {radius:.2f} m) on "
+                             f"{', '.join(s.name for s in fitting)}: {tally.summary()}")
+
+        def spots() -> Iterator[Spot]:
+            given: list[tuple[float, float]] = []
+            for cost, x, y, z, name in candidates:
+                if any(math.hypot(x - gx_, y - gy_) < SPACING for gx_, gy_ in given):
+                    continue
+                given.append((x, y))
+                yield Spot(x, y, z, name, container, None if own else _type_name(desig.prop_value("for")), cost)
+        return spots()
+
+    # ------------------------------------------------------------------ the search
+    def _search(self, desig: Any, cells: Iterator[tuple], validate: Callable, kind: str,
+                target: Target, maps: dict[str, Costmap]) -> Iterator[BaseLocation]:
+        """Walk `cells` (cost, tie, arm, row, col) cheapest first; validate each; yield the valid
+        ones at least `SPACING` apart; after `max_candidates` checks or when the costmap is used
+        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
+        tally = _Tally()
+        given: list[BaseLocation] = []
+        checked_cells: set[tuple] = set()
+        for cell in cells:
+            if tally.tried >= self.max_candidates:
+                break
+            cost, _, arm, r, c = cell
+            x, y = next(iter(maps.values())).xy(r, c)
+            if any(math.hypot(x - g.x, y - g.y) < SPACING for g in given):
+                continue
+            if (arm, r, c) in checked_cells:
+                continue
+            checked_cells.add((arm, r, c))
+            tally.tried += 1
+            solution, failure = validate(cell)
+            if solution is not None:
+                given.append(solution)
+                yield solution
+            else:
+                tally.fail(*failure)
+        if not given:
+            if tally.tried == 0:
+                raise self._fail(desig, f"no base pose on the free floor fits: every cell of the "
+                                 f"{self.environment().name} floor near {target.describe()} is ruled out "
+                                 f"by the costmap layers ({_layer_summary(maps)})")
+            raise self._fail(desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: "
+                             f"{tally.summary()}")
+
+
+def _layer_summary(maps: dict[str, Costmap]) -> str:
+    out = []
+    for name, costmap in maps.items():
+        out.append(f"{name}: " + ", ".join(f"{k} forbids {v} cells" for k, v in costmap.ruled_out_by().items()))
+    return "; ".join(out)
+
+
+def _ranked(costmap: Costmap, tie: int, arm: Optional[str]) -> Iterator[tuple]:
+    """The cells of `costmap` cheapest first as (cost, tie, arm, row, column)."""
+    for r, c, cost in costmap.cells():
+        yield cost, tie, arm, r, c
+
+
+def _wrap(angle: float) -> float:
+    """`angle` [rad] wrapped to [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def _corners(rect: Sequence[float]) -> list[tuple[float, float]]:
+    x0, y0, x1, y1 = rect
+    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+
+def _type_name(value: Any) -> Optional[str]:
+    if isinstance(value, ObjectType):
+        return value.name
+    return value if isinstance(value, str) else None

@@ -1,0 +1,80 @@
+"""The robot numbers location reasoning needs, read from a robot's description module.
+
+Location reasoning is robot-agnostic: it asks a `RobotGeometry` how big the base is, where each
+arm reaches comfortably, how the grasp phases are offset and how the arms are tucked away. Every
+number comes from the description module (``pycram.robots.<name>.description``): ``BASE``
+(``radius``: circumscribed, ``inscribed_radius``), ``ARMS``, ``ARM_ALIASES``, ``DEFAULT_ARM``,
+``REACH_POINT_IN_BASE``, ``APPROACH_OFFSETS``, ``ARM_CONFIGURATIONS`` (``park``). Lengths in [m].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+__all__ = ["RobotGeometry"]
+
+
+@dataclass(frozen=True)
+class RobotGeometry:
+    """A robot as location reasoning sees it.
+
+    `inscribed_radius` [m]: a circle around the base centre the robot always covers (cells
+    closer than this to an obstacle are surely in collision); `circumscribed_radius` [m]: a
+    circle the base never leaves. `reach_points` per physical arm: (ahead, left) [m] in the base
+    frame where a point to reach lies comfortably. `approach_offsets`: phase -> (back along the
+    approach [m], up [m]). `tucked`: joint name -> position of every arm's park configuration.
+    """
+
+    name: str
+    arms: tuple[str, ...]
+    default_arm: str
+    arm_aliases: Mapping[Any, str]
+    reach_points: Mapping[str, tuple[float, float]]
+    inscribed_radius: float
+    circumscribed_radius: float
+    approach_offsets: Mapping[str, tuple[float, float]]
+    tucked: Mapping[str, float]
+    arm_joints: Mapping[str, tuple[str, ...]]
+
+    @classmethod
+    def from_description(cls, d: Any) -> "RobotGeometry":
+        """The geometry of the robot described by module `d` (see the module docstring)."""
+        tucked: dict[str, float] = {}
+        for arm, spec in d.ARMS.items():
+            park = d.ARM_CONFIGURATIONS[arm].get("park")
+            if park is not None:
+                tucked.update(zip(spec["joints"], park))
+        radius = float(d.BASE["radius"])
+        return cls(name=d.NAME, arms=tuple(d.ARMS), default_arm=d.DEFAULT_ARM,
+                   arm_aliases=dict(d.ARM_ALIASES),
+                   reach_points={a: tuple(map(float, p)) for a, p in d.REACH_POINT_IN_BASE.items()},
+                   inscribed_radius=float(d.BASE.get("inscribed_radius", radius / math.sqrt(2.0))),
+                   circumscribed_radius=radius,
+                   approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
+                   tucked=tucked, arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()})
+
+    def arm(self, name: Any) -> str:
+        """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""
+        try:
+            return self.arm_aliases[name]
+        except (KeyError, TypeError):
+            raise ValueError(f"{self.name} has no arm {name!r}; available: "
+                             f"{sorted({str(k) for k in self.arm_aliases})}") from None
+
+    def reach_distance(self, arm: str) -> float:
+        """Distance [m] from the base centre to the comfortable reach point of `arm`."""
+        return math.hypot(*self.reach_points[arm])
+
+    def reach_bearing(self, arm: str) -> float:
+        """Angle [rad] of the reach point of `arm` from the base's heading (left positive)."""
+        ahead, left = self.reach_points[arm]
+        return math.atan2(left, ahead)
+
+    def tucked_except(self, arm: str | None) -> dict[str, float]:
+        """The park configuration of every arm but `arm` (joint name -> position)."""
+        if arm is None:
+            return dict(self.tucked)
+        own = set(self.arm_joints.get(arm, ()))
+        return {j: v for j, v in self.tucked.items() if j not in own}

@@ -1,0 +1,58 @@
+"""What location designators resolve to: base poses that say how, and spots for objects."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+__all__ = ["BaseLocation", "Spot"]
+
+
+@dataclass(frozen=True)
+class BaseLocation:
+    """A base pose (map frame: x [m], y [m], yaw [rad]) found for a location designator.
+
+    Usable wherever a base pose is (``('moving', pose=...)`` reads x, y, yaw). `arm` and `grasp`
+    say which arm and which grasp (approach, see `pycram.world.objects.APPROACHES`) the
+    solution was validated for (None where they do not apply); `joints` the arm's joint
+    solutions of the validated sequence; `cost` its rank in the costmap (lower is better);
+    `visible` the fraction of the target the head camera sees (``to_see``).
+    """
+
+    x: float
+    y: float
+    yaw: float
+    arm: Optional[str] = None
+    grasp: Optional[str] = None
+    cost: float = 0.0
+    visible: Optional[float] = None
+    joints: tuple = field(default=(), repr=False, compare=False)
+
+    def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
+        return iter((self.x, self.y, self.yaw))
+
+
+class Spot(tuple):
+    """A point (x, y, z) [m, map] where an object can be put: its centre when it stands there.
+
+    Unpacks as a 3-tuple; `surface` names the surface, `container` the container it lies in
+    (or None), `type` the object type it was found for (or None), `cost` its rank.
+    """
+
+    surface: str
+    container: Optional[str]
+    type: Optional[str]
+    cost: float
+
+    def __new__(cls, x: float, y: float, z: float, surface: str, container: Optional[str] = None,
+                type: Optional[str] = None, cost: float = 0.0) -> "Spot":
+        spot = super().__new__(cls, (float(x), float(y), float(z)))
+        spot.surface, spot.container, spot.type, spot.cost = surface, container, type, cost
+        return spot
+
+    @property
+    def position(self) -> tuple[float, float, float]:
+        return (self[0], self[1], self[2])
+
+    def __repr__(self) -> str:
+        return f"Spot(({self[0]:.3f}, {self[1]:.3f}, {self[2]:.3f}) on {self.surface!r})"

@@ -1,0 +1,143 @@
+"""What a location designator may point at, reduced to what reasoning needs.
+
+A target is an object designator (resolved with ``reference()``), a believed or perceived object
+(anything with a ``pose``/``position`` and a ``type``), a named place, surface or container of the
+environment, or a pose (a point (x, y, z) [m], or a base pose with x, y, yaw). `as_target`
+turns each into a `Target`; nothing else is accepted (a ``ValueError`` says what was given).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional, Sequence
+
+from pycram.world.environment import Container, Environment, Surface
+from pycram.world.objects import ObjectType, object_type
+
+__all__ = ["Target", "as_target", "KnownObject"]
+
+
+@dataclass(frozen=True)
+class Target:
+    """A thing to reach, see, put something on or open.
+
+    `position` [m, map]: the object's centre (or the point); `type` its object type when known;
+    `name` the name the world knows it by (for visibility), `yaw` [rad] its turn about z;
+    `kind`: "object", "point", "place", "surface" or "container"; `thing` the environment part
+    for surfaces and containers.
+    """
+
+    position: tuple[float, float, float]
+    kind: str
+    name: Optional[str] = None
+    type: Optional[ObjectType] = None
+    yaw: float = 0.0
+    thing: Any = None
+
+    def describe(self) -> str:
+        if self.kind == "object":
+            return f"{self.name or self.type.name if self.type else 'object'}"
+        if self.kind in ("place", "surface", "container"):
+            return f"{self.kind} {self.name!r}"
+        return "(" + ", ".join(f"{v:.2f}" for v in self.position) + ")"
+
+
+@dataclass(frozen=True)
+class KnownObject:
+    """An object reasoning knows of (from belief or perception): name, type, centre [m], yaw
+    [rad], footprint `radius` [m] and `half_height` [m] (from its type when not given)."""
+
+    name: str
+    type: str
+    position: tuple[float, float, float]
+    yaw: float = 0.0
+    radius: Optional[float] = None
+    half_height: Optional[float] = None
+
+    def __post_init__(self) -> None:
+        if self.radius is None or self.half_height is None:
+            otype = object_type(self.type)
+            if self.radius is None:
+                object.__setattr__(self, "radius", otype.footprint_radius)
+            if self.half_height is None:
+                object.__setattr__(self, "half_height", otype.half_height)
+
+
+def _yaw_of(orientation: Any) -> float:
+    try:
+        w, x, y, z = (float(v) for v in orientation)
+    except (TypeError, ValueError):
+        return 0.0
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _point(value: Any) -> Optional[tuple[float, float, float]]:
+    try:
+        p = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        return None
+    return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None  # type: ignore[return-value]
+
+
+def _object_like(value: Any) -> Optional[Target]:
+    otype = getattr(value, "type", None)
+    pose = getattr(value, "pose", None)
+    holder = pose if pose is not None and hasattr(pose, "position") else value
+    position = _point(getattr(holder, "position", None))
+    if position is None or otype is None:
+        return None
+    if isinstance(otype, str):
+        try:
+            otype = object_type(otype)
+        except KeyError:
+            otype = None
+    elif not isinstance(otype, ObjectType):
+        otype = None
+    yaw = getattr(value, "yaw", None)
+    if yaw is None:
+        yaw = _yaw_of(getattr(holder, "orientation", None))
+    return Target(position, "object", getattr(value, "name", None), otype, float(yaw))
+
+
+def as_target(value: Any, environment: Optional[Environment] = None,
+              known_objects: Sequence[KnownObject] = ()) -> Target:
+    """`value` as a `Target` (see the module docstring).
+
+    A string names, in this order, a place, a surface or a container of `environment`, or one of
+    `known_objects`. Raises ``ValueError`` naming the value and what a target may be.
+    """
+    if isinstance(value, Target):
+        return value
+    if hasattr(value, "reference") and callable(value.reference):  # a designator
+        value = value.reference()
+    if isinstance(value, Surface):
+        return Target(value.centroid, "surface", value.name, thing=value)
+    if isinstance(value, Container):
+        return Target(value.handle, "container", value.name, thing=value)
+    if isinstance(value, str):
+        if environment is not None:
+            for kind, things in (("place", environment.places), ("surface", environment.all_surfaces()),
+                                 ("container", environment.containers)):
+                for thing in things:
+                    if thing.name == value:
+                        return as_target(thing, environment) if kind != "place" else Target(
+                            (thing.pose[0], thing.pose[1], 0.0), "place", thing.name, yaw=thing.pose[2], thing=thing)
+        for known in known_objects:
+            if known.name == value:
+                return as_target(known, environment)
+        names = ([p.name for p in environment.places] + [s.name for s in environment.all_surfaces()]
+                 + [c.name for c in environment.containers]) if environment is not None else []
+        raise ValueError(f"unknown target {value!r}: not a place, surface or container of "
+                         f"{environment.name if environment else 'the environment'} nor a known object; "
+                         f"known: {sorted(names + [k.name for k in known_objects])}")
+    found = _object_like(value)
+    if found is not None:
+        return found
+    point = _point(value)
+    if point is not None:
+        return Target(point, "point")
+    if all(hasattr(value, a) for a in ("x", "y", "yaw")):
+        return Target((float(value.x), float(value.y), 0.0), "place", yaw=float(value.yaw))
+    raise ValueError(f"a location target is an object (with a pose and a type), an object designator, "
+                     f"a named place/surface/container or a point (x, y, z) [m]; got {value!r}")
