@@ -383,8 +383,14 @@ def scene_command(
                                 help="Comma-separated object types to place at random ('' for none)."),
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
+    costmap: str = typer.Option("", "--costmap",
+                                help="Draw a location designator's costmap layers and chosen poses instead, "
+                                     "e.g. \"to_reach cup\" or \"on table, for bowl\"."),
 ) -> None:
-    """A labelled picture of a scene: plan and overview with surfaces, containers and objects."""
+    """A labelled picture of a scene: plan and overview with surfaces, containers and objects.
+
+    With --costmap: the costmap layers of a location designator over the floor plan and the
+    poses it chose (or why there are none)."""
     try:
         from pycram.demos.scene_picture import VIEW_SIZE, write_scene_picture
         from pycram.sim import World
@@ -397,6 +403,9 @@ def scene_command(
         world = World(robot, environment=env, seed=seed, objects=types or None, offscreen_size=VIEW_SIZE)
     except (KeyError, PlacementError) as e:
         _fail(str(e).strip("'\""))
+    if costmap:
+        _costmap_picture(world, robot, costmap, output, f"{env} · seed {seed} · {robot} · {costmap}")
+        return
     try:
         path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
         for p in world.placements:
@@ -405,6 +414,44 @@ def scene_command(
     finally:
         world.close()
     console.print(f"wrote {escape(str(path))}")
+
+
+def _costmap_picture(world: object, robot_name: str, text: str, output: Path, title: str) -> None:
+    """`pycram scene --costmap`: resolve the location `text` with the robot, draw its costmap."""
+    from pycram import robots
+    from pycram.demos.costmap_picture import parse_location, write_costmap_picture
+
+    try:
+        try:
+            properties = parse_location(text)
+        except ValueError as e:
+            _fail(str(e))
+        robot = robots.load(robot_name, world)
+        try:
+            path, solutions, error = write_costmap_picture(world, robot, properties, output, title=title)
+        finally:
+            robot.shutdown()
+    finally:
+        world.close()  # type: ignore[attr-defined]
+    for s in solutions:
+        console.print(f"  {escape(repr(s))}")
+    if error:
+        console.print(f"[red]{escape(error)}[/red]")
+    console.print(f"wrote {escape(str(path))}")
+
+
+@app.command("costmap")
+def costmap_command(
+    location: str = typer.Argument(..., help="The location, e.g. \"to_reach cup\" or \"on table, for bowl\"."),
+    env: str = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen."),
+    seed: int = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene)."),
+    objects: str = typer.Option(_SCENE_OBJECTS, "--objects",
+                                help="Comma-separated object types to place at random ('' for none)."),
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    output: Path = typer.Option(Path("costmap.png"), "--output", "-o", help="PNG file to write."),
+) -> None:
+    """The costmap layers of a location designator over the floor plan, and the poses it chose."""
+    scene_command(env=env, seed=seed, objects=objects, robot=robot, output=output, costmap=location)
 
 
 def main(argv: list[str] | None = None) -> int:

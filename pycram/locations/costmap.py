@@ -25,10 +25,20 @@ import numpy as np
 from pycram.world.environment import Environment, Rect
 
 __all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer", "distance_layer",
-           "rect_distance"]
+           "rect_distance", "floor_obstacles"]
 
 #: Cell size [m] of the floor grids.
 RESOLUTION = 0.05
+#: Boxes whose bottom is below this height [m] stand in the robot's way (table tops included:
+#: the base may fit under them, its torso and arms do not).
+OBSTACLE_BELOW = 1.3
+
+
+def floor_obstacles(environment: Environment) -> list[Rect]:
+    """Footprints of the colliding static boxes and closed container bodies that reach below
+    `OBSTACLE_BELOW` (walls, counters, table tops and legs, cabinets, doors)."""
+    boxes = [b for b in environment.static if b.collides] + [c.body for c in environment.containers]
+    return [b.footprint for b in boxes if b.z_range[0] < OBSTACLE_BELOW]
 
 
 @dataclass(frozen=True)
@@ -89,7 +99,7 @@ def rect_distance(grid: FloorGrid, rect: Rect) -> np.ndarray:
 def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float,
                     extra: Sequence[Rect] = ()) -> np.ndarray:
     """0 where a circle of `radius` [m] around the cell centre lies on the environment's floor and
-    off every obstacle (`Environment.obstacles`, the boxes in `extra`), else ``inf``. Cached per
+    off every obstacle (`floor_obstacles`, the boxes in `extra`), else ``inf``. Cached per
     environment and radius (without `extra`)."""
     key = (environment.name, id(environment), round(radius, 4), grid.bounds, grid.resolution)
     base = _OCCUPANCY.get(key)
@@ -98,8 +108,8 @@ def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float,
         for x0, y0, x1, y1 in environment.floor:
             inside |= ((grid.x >= x0 + radius) & (grid.x <= x1 - radius)
                        & (grid.y >= y0 + radius) & (grid.y <= y1 - radius))
-        for box in environment.obstacles():
-            inside &= rect_distance(grid, box.footprint) >= radius
+        for rect in floor_obstacles(environment):
+            inside &= rect_distance(grid, rect) >= radius
         base = _OCCUPANCY[key] = np.where(inside, 0.0, np.inf)
     if not extra:
         return base
