@@ -37,6 +37,8 @@ GRIPPER = "right"
 EMPTY_GRIPPER = 0.01
 #: Start grasping when the base is this close to its goal [m] (thesis: 10 cm).
 CLOSE_ENOUGH = 0.1
+#: The item the demo fetches, by the name the world knows it by (its spot on cooker #1 must fit it).
+ITEM = "mug"
 
 
 class GraspFailed(Exception):
@@ -170,7 +172,7 @@ def _point(p) -> str:
 def aim_at(place: tuple) -> None:
     """Set the base goal to a pose from which the arm reaches `place`, and look at `place`."""
     look_goal.set_value(place)
-    goal.set_value(location(("to_reach", place)))
+    goal.set_value(location(("to_reach", place), ("arm", ARM)))
 
 
 # -- the demo --------------------------------------------------------------------------------------------
@@ -217,7 +219,7 @@ def fetch_and_place() -> None:
                         )
                 if True:
                     phase.set_value("transporting")
-                    aim_at(location(("on", "cooker #1")))
+                    aim_at(location(("on", "cooker #1"), ("for", ITEM)))
                     transport()
                 if True:
                     phase.set_value("placing")
