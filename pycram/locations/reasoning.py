@@ -485,6 +485,20 @@ class LocationReasoner:
                 yield Spot(x, y, z, name, container, None if own else _type_name(desig.prop_value("for")), cost)
         return spots()
 
+    def _empty_costmap(self, maps: dict[str, Costmap], target: Target) -> str:
+        """Why no cell of the costmaps is left: the layer that alone rules out every cell, or
+        the layers that do together."""
+        env = self.environment()
+        where = "(" + ", ".join(f"{v:.1f}" for v in target.position) + ") [m, map]"
+        alone = sorted({name for m in maps.values() for name, layer in m.layers.items()
+                        if name != "occupancy" and bool(np.isinf(layer).all())})
+        if alone:
+            return (f"{target.describe()} at {where} is outside the environment: no cell of the floor of "
+                    f"{env.name} lies within the layer {alone[0]!r} around it")
+        return (f"every cell of the floor of {env.name} within reach of {target.describe()} at {where} is "
+                f"occupied (layer 'occupancy': furniture and walls inflated by the {self.geometry.name}'s "
+                f"{self.geometry.inscribed_radius:.2f} m footprint radius; {_layer_summary(maps)})")
+
     # ------------------------------------------------------------------ the search
     def _search(self, desig: Any, cells: Iterator[tuple], validate: Callable, kind: str,
                 target: Target, maps: dict[str, Costmap]) -> Iterator[BaseLocation]:
@@ -513,9 +527,7 @@ class LocationReasoner:
                 tally.fail(*failure)
         if not given:
             if tally.tried == 0:
-                raise self._fail(desig, f"no base pose on the free floor fits: every cell of the "
-                                 f"{self.environment().name} floor near {target.describe()} is ruled out "
-                                 f"by the costmap layers ({_layer_summary(maps)})")
+                raise self._fail(desig, self._empty_costmap(maps, target))
             raise self._fail(desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: "
                              f"{tally.summary()}")
 

@@ -187,16 +187,17 @@ def test_location_to_reach_and_full_grasp_sequence(robot):
     motion(type="subscribing_gripper", gripper="right", fl=opening)
     motion(type="setting_torso", position="up")
     motion(type="setting_gripper", gripper="right", position=1)
-    base = LocationDesignator([("to_reach", target)]).reference()
-    assert abs(base.yaw - (-math.pi / 2)) < 1e-6  # faces the back counter
-    ahead, left = d.REACH_POINT_IN_BASE[d.DEFAULT_ARM]
-    assert abs(base.y - (target[1] + ahead)) < 1e-6 and abs(base.x - (target[0] - left)) < 1e-6
+    base = LocationDesignator([("to_reach", target), ("arm", "right")]).reference()
+    assert abs(base.yaw - (-math.pi / 2)) < 0.35  # faces the back counter (roughly squarely)
+    assert base.arm == d.ARM_ALIASES["right"] and base.grasp == "side"
+    assert 0.4 < math.dist((base.x, base.y), target[:2]) < 1.0
     reached = motion(type="moving", pose=base, frame="map")
     assert distance(reached, base) < 0.02
     for phase in ("pre_grasp", "grasp"):
         tool = motion(type="reaching", arm="right", target=target, phase=phase)
         back, up = d.APPROACH_OFFSETS[phase]
-        wanted = (target[0], target[1] + back, target[2] + up)  # approach along -y
+        wanted = (target[0] - back * math.cos(base.yaw), target[1] - back * math.sin(base.yaw),
+                  target[2] + up)  # approach along the base's heading
         assert math.dist(tool.position, wanted) < 0.025, phase
     closed = motion(type="setting_gripper", gripper="right", position=0)
     assert closed > 0.01 and opening.get_value() > 0.01
@@ -206,8 +207,9 @@ def test_location_to_reach_and_full_grasp_sequence(robot):
     assert opening.get_value() > 0.01  # still holding the mug
     assert world.item_poses.get_value()["mug"].position[2] > target[2] + 0.05
     # the alternatives of the location designator stand further back / closer
-    second = LocationDesignator([("to_reach", target)]).next_solution().reference()
-    assert second != base and abs(second.yaw - base.yaw) < 1e-6
+    first = LocationDesignator([("to_reach", target), ("arm", "right")])
+    second = first.next_solution().reference()
+    assert math.dist((second.x, second.y), (base.x, base.y)) >= 0.1 - 1e-9  # another place, no repeat
     # give the mug back to the counter and open the gripper
     put_mug(world, SLOT_1)
     motion(type="setting_gripper", gripper="right", position=1)
@@ -220,8 +222,8 @@ def test_place_spot_on_the_other_counter_is_reachable(robot):
     target = item_centre(world, PLACE)
     go_to_start(robot)
     motion(type="setting_torso", position="up")
-    base = LocationDesignator([("to_reach", target)]).reference()
-    assert abs(abs(base.yaw) - math.pi) < 1e-6  # faces the left counter
+    base = LocationDesignator([("to_reach", target), ("arm", "right"), ("action", "place")]).reference()
+    assert abs(abs(base.yaw) - math.pi) < 0.35  # faces the left counter
     motion(type="moving", pose=base)
     for phase in ("pre_place", "place", "retreat"):
         motion(type="reaching", arm="right", target=target, phase=phase)
