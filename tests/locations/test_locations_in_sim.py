@@ -1,0 +1,162 @@
+"""Location reasoning judged by the simulator: the solutions really work.
+
+- every ``to_reach`` solution tried lets the robot grasp the object (drive there, pre-grasp,
+  grasp, close, lift: the object is held and lifted), for several random apartment scenes, both
+  robots (two arms: PR2; one arm: TIAGo);
+- ``to_see`` solutions show the object in the head camera's segmentation;
+- ``on`` spots hold the object upright where it was put;
+- ``NoSolutionError`` says which constraint ruled the candidates out.
+
+Simulator truth (item poses, segmentation) is used only to judge; the reasoning gets the objects
+as believed objects (name, type, pose).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+pytest.importorskip("mujoco")
+prospection = pytest.importorskip("pycram.world.prospection")
+
+import mujoco  # noqa: E402
+
+from pycram import robots  # noqa: E402
+from pycram.designator import LocationDesignator, MotionDesignator, perform  # noqa: E402
+from pycram.designators.core import NoSolutionError  # noqa: E402
+from pycram.locations import KnownObject, Spot  # noqa: E402
+from pycram.sim import World  # noqa: E402
+from pycram.world.objects import object_type  # noqa: E402
+
+T = 60.0
+#: (seed, object): scenes of `random_scene(apartment, ["cup", "milk", "bowl"], seed)` with the
+#: object on the counter or the table.
+GRASPS = [(1, "cup"), (9, "cup"), (13, "milk")]
+
+
+def motion(**properties):
+    return perform(MotionDesignator(**properties))
+
+
+def believed(world, name):
+    """The object `name` as the robot believes it (here: as it is; a test judges with truth)."""
+    pose = world.item_poses.get_value()[name]
+    w, x, y, z = pose.orientation
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    item = world.scene.item(name)
+    return KnownObject(name, item.type, tuple(pose.position), yaw)
+
+
+def settle(world, seconds):
+    t = world.sim_time.get_value() + seconds
+    assert (world.sim_time >= t).wait_for(seconds + 10.0)
+
+
+def tilt(orientation):
+    """Angle [rad] between the object's z axis and the vertical."""
+    w, x, y, z = orientation
+    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
+
+
+@pytest.fixture(params=["pr2", "tiago"])
+def robot_name(request):
+    return request.param
+
+
+def make(robot_name, seed, objects=("cup", "milk", "bowl")):
+    world = World(robot_name, environment="apartment", seed=seed, objects=list(objects))
+    return world, robots.load(robot_name, world)
+
+
+@pytest.mark.parametrize("seed,name", GRASPS)
+def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, name):
+    world, robot = make(robot_name, seed)
+    try:
+        with robot:
+            d = robot.description
+            motion(type="setting_torso", position="up")
+            target = believed(world, name)
+            location = LocationDesignator([("to_reach", target)]).reference()
+            assert location.arm in d.ARMS and location.grasp in [g.approach for g in object_type(name).grasps]
+            gripper = d.ARMS[location.arm]["gripper"]
+            motion(type="setting_gripper", gripper=gripper, position=1)
+            reached = motion(type="moving", pose=location)
+            assert math.hypot(reached.x - location.x, reached.y - location.y) < 0.03
+            otype = object_type(name)
+            grasp = next(g for g in otype.grasps if g.approach == location.grasp)
+            x, y, z = target.position
+            point = (x, y, z - otype.half_height + grasp.height)
+            motion(type="reaching", arm=location.arm, target=point, phase="pre_grasp")
+            motion(type="reaching", arm=location.arm, target=point, phase="grasp")
+            motion(type="setting_gripper", gripper=gripper, position=0)
+            assert world.gripper_states[gripper].get_value().holding == name
+            motion(type="reaching", arm=location.arm, target=point, phase="lift")
+            assert world.item_poses.get_value()[name].position[2] > z + 0.05
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_to_see_solutions_show_the_object_in_the_head_camera(robot_name):
+    world, robot = make(robot_name, 1)
+    try:
+        with robot:
+            motion(type="setting_torso", position="up")
+            solutions = LocationDesignator([("to_see", believed(world, "cup"))]).solutions()
+            for location, _ in zip(solutions, range(2)):
+                assert location.visible >= 0.5
+                motion(type="moving", pose=location)
+                cup = world.item_poses.get_value()["cup"].position
+                motion(type="pointing_head", coordinates=cup)
+                outcome = world.request_segmentation().wait(T)
+                assert outcome is not None and outcome.succeeded, outcome
+                ids = outcome.value
+                cup_geoms = {g for g in range(world.scene.model.ngeom)
+                             if (mujoco.mj_id2name(world.scene.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "")
+                             .split(":")[0] == "cup"}
+                pixels = int(sum((ids == g).sum() for g in cup_geoms))
+                assert pixels >= 20, f"the cup covers only {pixels} pixels seen from {location}"
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_on_spots_hold_the_object_upright(robot_name):
+    world, robot = make(robot_name, 1)  # milk and bowl stand on the table
+    try:
+        with robot:
+            spots = LocationDesignator([("on", "table"), ("for", "cup"), ("near", believed(world, "milk"))])
+            for spot, _ in zip(spots.solutions(), range(3)):
+                assert isinstance(spot, Spot) and spot.surface == "table"
+                outcome = world.move_item("cup", spot.position).wait(T)
+                assert outcome is not None and outcome.succeeded
+                settle(world, 1.0)
+                poses = world.item_poses.get_value()
+                cup = poses["cup"]
+                assert tilt(cup.orientation) < math.radians(5)
+                assert math.dist(cup.position, spot.position) < 0.01
+                for other in ("milk", "bowl"):  # nothing was pushed away
+                    assert tilt(poses[other].orientation) < math.radians(5)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_no_solution_error_names_the_ruling_constraint(robot_name):
+    world, robot = make(robot_name, 0, objects=())
+    try:
+        with robot:
+            # a point inside the closed drawer cabinet: nothing reaches it
+            designator = LocationDesignator([("to_reach", (0.3, 2.9, 0.2))])
+            with pytest.raises(NoSolutionError) as info:
+                designator.reference()
+            message = str(info.value)
+            assert "candidates:" in message
+            assert "unreachable for arm 'right'" in message or "in collision" in message, message
+            # a container the object does not fit in
+            with pytest.raises(NoSolutionError, match=r"milk \(0.20 m tall\) fits on none of"):
+                LocationDesignator([("in", "drawer 1"), ("for", "milk")]).reference()
+    finally:
+        robot.shutdown()
+        world.close()
