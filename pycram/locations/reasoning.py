@@ -61,6 +61,9 @@ log = logging.getLogger(__name__)
 #: The keys location reasoning understands; a designator with any other key is left to others.
 VOCABULARY = frozenset({"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for",
                         "action", "opening"})
+#: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
+#: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
+BASE_CLEARANCE = 0.1
 #: Candidates checked with prospection per designator before giving up.
 MAX_CANDIDATES = 300
 #: Distance [m] between two solutions of one designator (base poses or spots).
@@ -157,6 +160,11 @@ class LocationReasoner:
         self.known_objects = known_objects
         self.max_candidates = max_candidates
 
+    @property
+    def _base_radius(self) -> float:
+        """The base's inscribed radius plus the clearance it keeps [m] (the occupancy inflation)."""
+        return self.geometry.inscribed_radius + BASE_CLEARANCE
+
     # ------------------------------------------------------------------ entry point
     def generator(self, desig: Any) -> Optional[Iterator[Any]]:
         """The location generator: an iterator of solutions, or None when `desig` is not ours."""
@@ -185,7 +193,7 @@ class LocationReasoner:
         grasps = self._grasps(target, desig.prop_value("grasp"))
         env = self.environment()
         grid = FloorGrid.of(env)
-        occupancy = occupancy_layer(env, grid, self.geometry.inscribed_radius)
+        occupancy = occupancy_layer(env, grid, self._base_radius)
         facing = self._facing_yaws(env, target)
         streams = []
         maps = {}
@@ -301,7 +309,7 @@ class LocationReasoner:
         env = self.environment()
         grid = FloorGrid.of(env)
         preferred, sigma, low, high = VIEW_RING
-        costmap = Costmap(grid, {"occupancy": occupancy_layer(env, grid, self.geometry.inscribed_radius),
+        costmap = Costmap(grid, {"occupancy": occupancy_layer(env, grid, self._base_radius),
                                  "view": ring_layer(grid, target.position, preferred, sigma, low, high)})
         self.last_costmaps = {"view": costmap}
         what = target.name if target.kind == "object" and target.name else target.position
@@ -341,7 +349,7 @@ class LocationReasoner:
         arms = self._arms(desig.prop_value("arm"))
         grid = FloorGrid.of(env)
         swept = self._swept_rects(container, opening)
-        occupancy = occupancy_layer(env, grid, self.geometry.inscribed_radius, swept)
+        occupancy = occupancy_layer(env, grid, self._base_radius, swept)
         if container.kind == "door":
             occupancy = occupancy.copy()
             hx, hy = container.hinge
@@ -497,7 +505,7 @@ class LocationReasoner:
                     f"{env.name} lies within the layer {alone[0]!r} around it")
         return (f"every cell of the floor of {env.name} within reach of {target.describe()} at {where} is "
                 f"occupied (layer 'occupancy': furniture and walls inflated by the {self.geometry.name}'s "
-                f"{self.geometry.inscribed_radius:.2f} m footprint radius; {_layer_summary(maps)})")
+                f"{self._base_radius:.2f} m footprint radius with clearance; {_layer_summary(maps)})")
 
     # ------------------------------------------------------------------ the search
     def _search(self, desig: Any, cells: Iterator[tuple], validate: Callable, kind: str,
