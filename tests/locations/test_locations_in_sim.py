@@ -87,6 +87,8 @@ def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, nam
             grasp = next(g for g in otype.grasps if g.approach == location.grasp)
             x, y, z = target.position
             point = (x, y, z - otype.half_height + grasp.height)
+            # as the demo does: the arm comes up over the furniture, then approaches
+            motion(type="setting_arm_configuration", arm=location.arm, configuration="carry")
             motion(type="reaching", arm=location.arm, target=point, phase="pre_grasp")
             motion(type="reaching", arm=location.arm, target=point, phase="grasp")
             motion(type="setting_gripper", gripper=gripper, position=0)
