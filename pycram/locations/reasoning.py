@@ -219,13 +219,16 @@ class LocationReasoner:
             tucked = dict(self.geometry.tucked)
             if prosp.in_collision((x, y, natural), tucked):
                 return None, ("in collision", None)
+            raised = self.geometry.raised(arm)
+            if prosp.in_collision((x, y, natural), raised):
+                return None, (f"arm {arm!r} hits the furniture when raised to approach", None)
             failure = None
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
                 point = self._grasp_point(target, grasp)
                 poses = grasp_sequence(self.geometry, point, yaw if grasp.approach != "top" else heading,
                                        grasp.approach, action)
-                answer = prosp.reachable(arm, poses, (x, y, yaw), tucked)
+                answer = prosp.reachable(arm, poses, (x, y, yaw), raised)
                 if answer:
                     return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=answer.solutions), None
                 failure = (f"unreachable for arm {arm!r}", answer.reason)

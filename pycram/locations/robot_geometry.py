@@ -25,6 +25,8 @@ class RobotGeometry:
     circle the base never leaves. `reach_points` per physical arm: (ahead, left) [m] in the base
     frame where a point to reach lies comfortably. `approach_offsets`: phase -> (back along the
     approach [m], up [m]). `tucked`: joint name -> position of every arm's park configuration.
+    `ready` per arm: the configuration the arm is raised to before it approaches (``carry``: over
+    the furniture), joint name -> position.
     """
 
     name: str
@@ -37,6 +39,7 @@ class RobotGeometry:
     approach_offsets: Mapping[str, tuple[float, float]]
     tucked: Mapping[str, float]
     arm_joints: Mapping[str, tuple[str, ...]]
+    ready: Mapping[str, Mapping[str, float]] = None  # type: ignore[assignment]
 
     @classmethod
     def from_description(cls, d: Any) -> "RobotGeometry":
@@ -53,7 +56,9 @@ class RobotGeometry:
                    inscribed_radius=float(d.BASE.get("inscribed_radius", radius / math.sqrt(2.0))),
                    circumscribed_radius=radius,
                    approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
-                   tucked=tucked, arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()})
+                   tucked=tucked, arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()},
+                   ready={a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry"]))
+                          for a, s in d.ARMS.items() if "carry" in d.ARM_CONFIGURATIONS[a]})
 
     def arm(self, name: Any) -> str:
         """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""
@@ -71,6 +76,10 @@ class RobotGeometry:
         """Angle [rad] of the reach point of `arm` from the base's heading (left positive)."""
         ahead, left = self.reach_points[arm]
         return math.atan2(left, ahead)
+
+    def raised(self, arm: str) -> dict[str, float]:
+        """Every arm tucked but `arm`, which is raised to its `ready` configuration."""
+        return {**self.tucked, **(self.ready or {}).get(arm, {})}
 
     def tucked_except(self, arm: str | None) -> dict[str, float]:
         """The park configuration of every arm but `arm` (joint name -> position)."""

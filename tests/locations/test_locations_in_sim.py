@@ -32,7 +32,7 @@ from pycram.world.objects import object_type  # noqa: E402
 T = 60.0
 #: (seed, object): scenes of `random_scene(apartment, ["cup", "milk", "bowl"], seed)` with the
 #: object on the counter or the table.
-GRASPS = [(1, "cup"), (9, "cup"), (13, "milk")]
+GRASPS = [(3, "cup"), (9, "cup"), (13, "milk"), (1, "cup")]
 
 
 def motion(**properties):
@@ -71,6 +71,8 @@ def make(robot_name, seed, objects=("cup", "milk", "bowl")):
 
 @pytest.mark.parametrize("seed,name", GRASPS)
 def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, name):
+    if (robot_name, seed) == ("tiago", 1):
+        pytest.skip("the cup stands 0.46 m deep on the counter: beyond TIAGo's reach (see the next test)")
     world, robot = make(robot_name, seed)
     try:
         with robot:
@@ -95,6 +97,18 @@ def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, nam
             assert world.gripper_states[gripper].get_value().holding == name
             motion(type="reaching", arm=location.arm, target=point, phase="lift")
             assert world.item_poses.get_value()[name].position[2] > z + 0.05
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_an_object_out_of_reach_says_so():
+    world, robot = make("tiago", 1)  # the cup stands 0.46 m deep on the counter
+    try:
+        with robot:
+            motion(type="setting_torso", position="up")
+            with pytest.raises(NoSolutionError, match=r"\d+ candidates: .*unreachable for arm 'right'"):
+                LocationDesignator([("to_reach", believed(world, "cup"))]).reference()
     finally:
         robot.shutdown()
         world.close()
@@ -157,8 +171,8 @@ def test_no_solution_error_names_the_ruling_constraint(robot_name):
             assert "candidates:" in message
             assert "unreachable for arm 'right'" in message or "in collision" in message, message
             # a container the object does not fit in
-            with pytest.raises(NoSolutionError, match=r"milk \(0.20 m tall\) fits on none of"):
-                LocationDesignator([("in", "drawer 1"), ("for", "milk")]).reference()
+            with pytest.raises(NoSolutionError, match=r"cereal \(0.28 m tall\) fits on none of"):
+                LocationDesignator([("in", "drawer 1"), ("for", "cereal")]).reference()
     finally:
         robot.shutdown()
         world.close()
