@@ -83,14 +83,14 @@ def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, nam
             assert location.arm in d.ARMS and location.grasp in [g.approach for g in object_type(name).grasps]
             gripper = d.ARMS[location.arm]["gripper"]
             motion(type="setting_gripper", gripper=gripper, position=1)
+            # as the demo does: the arm is raised over the furniture before the base gets close
+            motion(type="setting_arm_configuration", arm=location.arm, configuration="carry")
             reached = motion(type="moving", pose=location)
             assert math.hypot(reached.x - location.x, reached.y - location.y) < 0.03
             otype = object_type(name)
             grasp = next(g for g in otype.grasps if g.approach == location.grasp)
             x, y, z = target.position
             point = (x, y, z - otype.half_height + grasp.height)
-            # as the demo does: the arm comes up over the furniture, then approaches
-            motion(type="setting_arm_configuration", arm=location.arm, configuration="carry")
             motion(type="reaching", arm=location.arm, target=point, phase="pre_grasp")
             motion(type="reaching", arm=location.arm, target=point, phase="grasp")
             motion(type="setting_gripper", gripper=gripper, position=0)
