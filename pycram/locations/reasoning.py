@@ -67,7 +67,7 @@ BASE_CLEARANCE = 0.1
 #: The arm must reach this much [m] below the grasp pose too, without touching anything: the
 #: executed motion passes through configurations IK did not check (prospection allows contacts
 #: of a little over 1 cm).
-CONTACT_MARGIN = 0.03
+CONTACT_MARGIN = 0.015
 #: Candidates checked with prospection per designator before giving up.
 MAX_CANDIDATES = 300
 #: Distance [m] between two solutions of one designator (base poses or spots).
