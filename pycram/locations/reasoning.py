@@ -69,9 +69,12 @@ BASE_CLEARANCE = 0.1
 #: of a little over 1 cm).
 CONTACT_MARGIN = 0.015
 #: Candidates checked with prospection per designator before giving up.
-MAX_CANDIDATES = 300
+MAX_CANDIDATES = 100
 #: Distance [m] between two solutions of one designator (base poses or spots).
 SPACING = 0.1
+#: Cells closer than this [m] to a candidate that failed for the same arm are not checked (the
+#: grid's neighbours, diagonals included: their answer is almost always the same).
+FAILED_SPACING = 0.075
 #: Spots on surfaces: grid cell [m], free space [m] to other objects and to the surface's edge.
 SPOT_RESOLUTION = 0.02
 SPOT_GAP = 0.02
@@ -525,7 +528,7 @@ class LocationReasoner:
         up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
         tally = _Tally()
         given: list[BaseLocation] = []
-        checked_cells: set[tuple] = set()
+        failed: list[tuple[Optional[str], float, float]] = []
         for cell in cells:
             if tally.tried >= self.max_candidates:
                 break
@@ -533,15 +536,15 @@ class LocationReasoner:
             x, y = next(iter(maps.values())).xy(r, c)
             if any(math.hypot(x - g.x, y - g.y) < SPACING for g in given):
                 continue
-            if (arm, r, c) in checked_cells:
+            if any(a == arm and math.hypot(x - fx, y - fy) < FAILED_SPACING for a, fx, fy in failed):
                 continue
-            checked_cells.add((arm, r, c))
             tally.tried += 1
             solution, failure = validate(cell)
             if solution is not None:
                 given.append(solution)
                 yield solution
             else:
+                failed.append((arm, x, y))
                 tally.fail(*failure)
         if not given:
             if tally.tried == 0:
