@@ -143,8 +143,11 @@ class _Tally:
     def summary(self) -> str:
         parts = []
         for reason, n in self.reasons.most_common():
+            if not n:
+                continue
             detail = self.details.get(reason)
-            more = f" ({', '.join(f'{k} {v}' for k, v in detail.most_common())})" if detail else ""
+            more = (f" ({', '.join(f'{k} {v}' for k, v in detail.most_common() if v)})"
+                    if detail and any(detail.values()) else "")
             parts.append(f"{n} {reason}{more}")
         return f"{self.tried} candidates: " + ", ".join(parts) if parts else f"{self.tried} candidates"
 
