@@ -427,6 +427,8 @@ def _costmap_picture(world: object, robot_name: str, text: str, output: Path, ti
         except ValueError as e:
             _fail(str(e))
         robot = robots.load(robot_name, world)
+        up = robot.description.TORSO_POSITIONS["up"]
+        world.set_torso(up).wait(30.0)  # type: ignore[attr-defined]  # as plans do before reaching
         try:
             path, solutions, error = write_costmap_picture(world, robot, properties, output, title=title)
         finally:

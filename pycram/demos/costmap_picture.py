@@ -57,6 +57,7 @@ def write_costmap_picture(world: Any, robot: Any, properties: Sequence[tuple[str
     with robot:
         designator = LocationDesignator(list(properties))
         try:
+            designator.reference()  # raises the error saying why, when there is no solution
             solutions = [s for s, _ in zip(designator.solutions(), range(count))]
         except DesignatorError as e:
             error = str(e)
