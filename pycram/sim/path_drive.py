@@ -1,0 +1,147 @@
+"""Driving the base along a planned, collision-free path, re-planning when the way gets blocked.
+
+`PlannedDrive` is the controller behind `World.drive_to`: it plans a path on the occupancy grid
+of the current state (`pycram.world.navigation.PathPlanner`; the straight line when it is free)
+and drives it waypoint by waypoint with `BaseDrive` segments. Every control tick it watches the
+movable parts of the environment (obstacles, doors, drawers); when one moved and the rest of
+the path is no longer free, it stops the base, waits until it stands still, and plans again
+from where it stopped. It fails with reason "no_path" (message: the planner's reason) only when
+no path exists; contact and lag failures of the segments stay what they are ("collision",
+"blocked"), as the last line of defence.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Optional
+
+import numpy as np
+
+from pycram.world.navigation import Footprint, NoPathError, PathPlanner
+from pycram.world.prospection import BasePose
+
+from .controllers import BaseDrive, Controller, fail
+from .engine import Engine
+from .occupancy import FloorMap, base_footprint, build_floor_map
+from .robot_model import BASE_JOINTS
+from .types import Outcome, Pose2D
+
+_log = logging.getLogger(__name__)
+
+#: Tolerances [m], [rad] at intermediate waypoints (the goal keeps BaseDrive's own).
+WAYPOINT_TOLERANCE = (0.03, 0.05)
+#: The base counts as stopped below this planar speed [m/s] (and a tenth of it in [rad/s]).
+STOPPED_SPEED = 0.02
+
+
+class Navigation:
+    """A scene's floor map, the robot's footprint and the planner of the current state; used by
+    the simulation thread only. The planner is rebuilt when a movable geom moved."""
+
+    def __init__(self, eng: Engine) -> None:
+        self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
+        self.footprint: Footprint = base_footprint(eng.scene, eng.data)
+        self._state: Optional[np.ndarray] = None
+        self._planner: Optional[PathPlanner] = None
+
+    def planner(self, eng: Engine) -> tuple[PathPlanner, bool]:
+        """The planner of the current state, and whether it is new (something moved)."""
+        state = self.floor.movable_state(eng.data)
+        if self._planner is not None and self._state is not None and np.array_equal(state, self._state):
+            return self._planner, False
+        self._state = state
+        self._planner = PathPlanner(self.floor.grid(eng.model, eng.data), self.footprint)
+        return self._planner, True
+
+
+def navigation_of(eng: Engine) -> Navigation:
+    """The engine's `Navigation`, built on first use (a few ms)."""
+    nav = getattr(eng, "_navigation", None)
+    if nav is None:
+        nav = eng._navigation = Navigation(eng)  # type: ignore[attr-defined]
+    return nav
+
+
+def _pose(p: Pose2D) -> BasePose:
+    return BasePose(p.x, p.y, p.yaw)
+
+
+class PlannedDrive(Controller):
+    """Drive the base to `goal` (map frame) around obstacles; see the module docstring.
+
+    The outcome's value is the final `Pose2D` (also on failure: where the base stopped).
+    `replans` counts the plans made after the first (for tests and traces).
+    """
+
+    channel = "base"
+
+    def __init__(self, goal: Pose2D) -> None:
+        self.goal = goal
+        self.waypoints: list[BasePose] = []
+        self.segment: Optional[BaseDrive] = None
+        self.stopping = False
+        self.replans = 0
+
+    def _plan(self, eng: Engine) -> Optional[Outcome]:
+        planner, _ = navigation_of(eng).planner(eng)
+        here = eng.base_pose()
+        try:
+            self.waypoints = planner.plan(_pose(here), _pose(self.goal))
+        except NoPathError as exc:
+            return fail("no_path", str(exc), here)
+        if len(self.waypoints) > 1:
+            _log.info("drive to (%.2f, %.2f): path around obstacles with %d waypoints",
+                      self.goal.x, self.goal.y, len(self.waypoints))
+        return self._next_segment(eng)
+
+    def _next_segment(self, eng: Engine) -> Optional[Outcome]:
+        w = self.waypoints.pop(0)
+        if self.waypoints:
+            self.segment = BaseDrive(Pose2D(w.x, w.y, w.yaw), *WAYPOINT_TOLERANCE)
+        else:
+            self.segment = BaseDrive(self.goal)
+        return self.segment.start(eng)
+
+    def start(self, eng: Engine) -> Optional[Outcome]:
+        return self._plan(eng)
+
+    def _remaining_free(self, eng: Engine, planner: PathPlanner) -> bool:
+        here = _pose(eng.base_pose())
+        rest = ([BasePose(self.segment.goal.x, self.segment.goal.y, self.segment.goal.yaw)]
+                if self.segment is not None else []) + self.waypoints
+        prev, escape = here, None if planner.pose_free(here.x, here.y, here.yaw) else here
+        for w in rest:
+            if not planner.segment_free(prev, w, escape):
+                return False
+            prev = w
+        return True
+
+    def update(self, eng: Engine, t: float) -> Optional[Outcome]:
+        if self.stopping:
+            v = math.hypot(*(float(eng.data.qvel[i]) for i in eng.base_dof[:2]))
+            if v > STOPPED_SPEED or abs(float(eng.data.qvel[eng.base_dof[2]])) > STOPPED_SPEED * 10:
+                return None
+            self.stopping = False
+            self.replans += 1
+            return self._plan(eng)
+        planner, changed = navigation_of(eng).planner(eng)
+        if changed and not self._remaining_free(eng, planner):
+            _log.info("drive to (%.2f, %.2f): the path is blocked; stopping to re-plan", self.goal.x, self.goal.y)
+            eng.hold(list(BASE_JOINTS))
+            self.segment = None
+            self.stopping = True
+            return None
+        assert self.segment is not None
+        out = self.segment.update(eng, t)
+        if out is None or not out.succeeded:
+            return out
+        if self.waypoints:
+            return self._next_segment(eng)
+        return out
+
+    def stop(self, eng: Engine) -> None:
+        eng.hold(list(BASE_JOINTS))
+
+
+__all__ = ["PlannedDrive", "Navigation", "navigation_of"]

@@ -1,0 +1,8 @@
+"""The world model layer: what reasoning may know and ask about the world, backend-neutral.
+
+Modules here use the standard library and numpy only; a backend (``pycram.sim``, later ROS)
+implements the interfaces. Reasoning code imports from here, never from a backend.
+
+- :mod:`pycram.world.prospection` -- "what if" questions without moving the robot.
+- :mod:`pycram.world.navigation` -- occupancy grids and base path planning.
+"""
