@@ -155,7 +155,7 @@ class SimProspection(Prospection):
         mujoco.mj_kinematics(self.model, d)
 
     def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
-        """(robot geom, environment geom) pairs that touch in `d` (kinematics computed)."""
+        """Distinct (robot part, environment part) pairs that touch in `d` (kinematics computed)."""
         mujoco.mj_collision(self.model, d)
         n = d.ncon
         if n == 0:
@@ -166,11 +166,11 @@ class SimProspection(Prospection):
         hit1 = self._is_robot[g1] & self._is_env[g2]
         hit2 = self._is_robot[g2] & self._is_env[g1]
         sel = (hit1 | hit2) & (dist < -COLLISION_TOLERANCE)
-        out = []
+        out: dict[tuple[str, str], None] = {}
         for i in np.nonzero(sel)[0]:
             a, b = (int(g1[i]), int(g2[i])) if hit1[i] else (int(g2[i]), int(g1[i]))
-            out.append((self._geom_name(a), self._geom_name(b)))
-        return out
+            out[(self._geom_name(a), self._geom_name(b))] = None
+        return list(out)
 
     def _geom_name(self, g: int) -> str:
         name = self.model.geom(g).name
