@@ -12,9 +12,12 @@ How a path is planned
 2. Otherwise A* (8-connected, octile heuristic, so optimal on the grid) searches the cells where
    at least the footprint's inscribed circle (plus ``clearance``) fits; cells where only some
    headings fit cost more, so paths keep their distance from furniture where they can.
-3. The A* cell path gets yaws (uniform turn by path length) and is shortened greedily: from
-   each waypoint the farthest later waypoint reachable on a straight, footprint-checked segment
-   is taken. Every segment of the result is footprint-checked at ``resolution``/2 spacing.
+3. The A* cell path gets headings (a uniform turn by path length, or turning at the start, or
+   at the end, whichever is free; where the footprint does not fit at the profile's heading,
+   the nearest heading that fits) and is shortened greedily: from each
+   waypoint the farthest later waypoint reachable on a straight, footprint-checked segment is
+   taken. Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells
+   where the footprint fits at no heading are blocked and A* searches again.
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
 question gives the same path, which tests and traces rely on), and "no path exists" is a
@@ -51,6 +54,8 @@ SQRT2 = math.sqrt(2.0)
 #: A robot that already touches something may move this far [m] from its start unchecked, to
 #: get clear (e.g. after a drive stopped on contact).
 ESCAPE_RADIUS = 0.15
+#: A* searches per plan: after each, cells where the footprint fits at no heading are blocked.
+MAX_SEARCHES = 8
 
 
 class NavigationFailure(Exception):
@@ -196,7 +201,8 @@ class PathPlanner:
         self._sure_free = ~dilate(grid.occupied, (footprint.circumscribed_radius + self._margin + half) / res)
         self._normals, self._offsets = footprint._edges()
         occ_rows, occ_cols = np.nonzero(grid.occupied)
-        self._occ_rows, self._occ_cols = occ_rows, occ_cols
+        self._occ_xy = np.column_stack([grid.origin[0] + (occ_cols + 0.5) * res,
+                                        grid.origin[1] + (occ_rows + 0.5) * res])
         self.cost_weight = cost_weight
         self._reach = footprint.circumscribed_radius + self._margin
 
@@ -204,25 +210,35 @@ class PathPlanner:
     def pose_free(self, x: float, y: float, yaw: float) -> bool:
         """Does the footprint at (x, y, yaw), grown by the clearance, stay off occupied cells?
         Off-map poses count as free (nothing is known there)."""
+        return self._free(np.array([x], float), np.array([y], float), np.array([yaw], float))
+
+    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray) -> bool:
+        """Whether every pose (xs[i], ys[i], yaws[i]) is free (see `pose_free`)."""
         g = self.grid
-        row, col = g.cell(x, y)
-        if g.inside(row, col):
-            if self._sure_hit[row, col]:
-                return False
-            if self._sure_free[row, col]:
-                return True
-        k = int(math.ceil(self._reach / g.resolution)) + 1
-        r0, r1 = max(0, row - k), min(g.shape[0], row + k + 1)
-        c0, c1 = max(0, col - k), min(g.shape[1], col + k + 1)
-        if r0 >= r1 or c0 >= c1:
+        rows = np.floor((ys - g.origin[1]) / g.resolution).astype(int)
+        cols = np.floor((xs - g.origin[0]) / g.resolution).astype(int)
+        inside = (rows >= 0) & (rows < g.shape[0]) & (cols >= 0) & (cols < g.shape[1])
+        r, c = rows[inside], cols[inside]
+        if self._sure_hit[r, c].any():
+            return False
+        unsure = np.nonzero(inside)[0][~self._sure_free[r, c]]
+        if unsure.size == 0:
             return True
-        rr, cc = np.nonzero(g.occupied[r0:r1, c0:c1])
-        if rr.size == 0:
+        xs, ys, yaws = xs[unsure], ys[unsure], yaws[unsure]
+        reach = self._reach
+        occ = self._occ_xy
+        near = ((occ[:, 0] >= xs.min() - reach) & (occ[:, 0] <= xs.max() + reach)
+                & (occ[:, 1] >= ys.min() - reach) & (occ[:, 1] <= ys.max() + reach))
+        occ = occ[near]
+        if occ.size == 0:
             return True
-        res = g.resolution
-        px = g.origin[0] + (cc + c0 + 0.5) * res - x
-        py = g.origin[1] + (rr + r0 + 0.5) * res - y
-        c, s = math.cos(yaw), math.sin(yaw)
+        dx = occ[None, :, 0] - xs[:, None]  # poses x occupied cells
+        dy = occ[None, :, 1] - ys[:, None]
+        pose, cell = np.nonzero(dx * dx + dy * dy <= reach * reach)
+        if pose.size == 0:
+            return True
+        c, s = np.cos(yaws[pose]), np.sin(yaws[pose])
+        px, py = dx[pose, cell], dy[pose, cell]
         bx, by = c * px + s * py, -s * px + c * py  # into the base frame
         d = np.outer(bx, self._normals[:, 0]) + np.outer(by, self._normals[:, 1]) - self._offsets
         return not bool(np.any(np.all(d <= self._margin, axis=1)))
@@ -235,14 +251,12 @@ class PathPlanner:
         # sample so that neither the centre nor a corner moves more than half a cell per step
         n = max(1, int(math.ceil(max(dist, abs(dyaw) * self.footprint.circumscribed_radius)
                                  / (0.5 * self.grid.resolution))))
-        for i in range(n + 1):
-            s = i / n
-            x, y = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y)
-            if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
-                continue
-            if not self.pose_free(x, y, a.yaw + s * dyaw):
-                return False
-        return True
+        s = np.linspace(0.0, 1.0, n + 1)
+        xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
+        if escape is not None:
+            keep = np.hypot(xs - escape.x, ys - escape.y) >= ESCAPE_RADIUS
+            xs, ys, yaws = xs[keep], ys[keep], yaws[keep]
+        return self._free(xs, ys, yaws)
 
     # ------------------------------------------------------------------ planning
     def plan(self, start: object, goal: object) -> list[BasePose]:
@@ -262,15 +276,15 @@ class PathPlanner:
                 raise NoPathError("outside_map", f"the {name} (x={pose.x:.2f}, y={pose.y:.2f}) is off "
                                   f"the map of the floor", a, b)
         bad: set[tuple[int, int]] = set()
-        for _attempt in range(4):
+        for _attempt in range(MAX_SEARCHES):
             cells = self._astar(sc, gc, bad, escape is None)
             if cells is None:
                 raise NoPathError("no_path", f"no collision-free path from (x={a.x:.2f}, y={a.y:.2f}) to "
                                   f"(x={b.x:.2f}, y={b.y:.2f})", a, b)
-            path, bad_cell = self._shorten(a, b, cells, escape)
-            if bad_cell is None:
+            path, misfits = self._shorten(a, b, cells, escape)
+            if not misfits:
                 return path
-            bad.add(bad_cell)  # the footprint did not fit there at the path's heading
+            bad |= misfits  # the footprint fits there at no heading (or cannot turn there)
         raise NoPathError("no_path", "no path where the footprint fits at the headings it needs", a, b)
 
     def _astar(self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]],
@@ -328,28 +342,71 @@ class PathPlanner:
         return None
 
     def _shorten(self, a: BasePose, b: BasePose, cells: list[tuple[int, int]],
-                 escape: Optional[BasePose]) -> tuple[list[BasePose], Optional[tuple[int, int]]]:
-        """Poses along the cell path with yaws by path length, shortened greedily. Returns the
-        waypoints and None, or a cell whose raw step was not free (to block and search again)."""
+                 escape: Optional[BasePose]) -> tuple[list[BasePose], set[tuple[int, int]]]:
+        """Poses along the cell path, shortened greedily, or the cells to block and search again.
+
+        Headings: the first of these profiles in which every step of the cell path is free --
+        turning uniformly along the path, turning at the start, turning at the end -- where at
+        each cell the nearest heading (steps of pi/16) that fits replaces the profile's when that
+        one does not fit. When none is free, the cells where the best profile failed are returned.
+        """
         pts = [(a.x, a.y)] + [self.grid.center(r, c) for r, c in cells[1:-1]] + [(b.x, b.y)]
         lengths = [0.0]
         for (x0, y0), (x1, y1) in zip(pts, pts[1:]):
             lengths.append(lengths[-1] + math.hypot(x1 - x0, y1 - y0))
         total = lengths[-1] or 1.0
         dyaw = _wrap(b.yaw - a.yaw)
-        poses = [BasePose(x, y, a.yaw + dyaw * (s / total)) for (x, y), s in zip(pts, lengths)]
-        poses[-1] = b
+        profiles = (lambda s: a.yaw + dyaw * s, lambda s: a.yaw + dyaw, lambda s: a.yaw)
+        fewest: Optional[set[tuple[int, int]]] = None
+        for profile in profiles:
+            poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, escape)
+            if not bad:
+                return self._greedy(poses, escape), bad
+            if fewest is None or len(bad) < len(fewest):
+                fewest = bad
+        return [], fewest or set()
+
+    def _headed(self, a: BasePose, b: BasePose, pts: list[tuple[float, float]], lengths: list[float],
+                total: float, cells: list[tuple[int, int]], profile: Callable[[float], float],
+                escape: Optional[BasePose]) -> tuple[list[BasePose], set[tuple[int, int]]]:
+        poses = [a]
+        bad: set[tuple[int, int]] = set()
+        for i in range(1, len(pts) - 1):
+            (x, y), yaw = pts[i], profile(lengths[i] / total)
+            fitting = self._fitting_yaw(x, y, yaw, escape)
+            if fitting is None:
+                bad.add(cells[i])
+            poses.append(BasePose(x, y, yaw if fitting is None else fitting))
+        poses.append(b)
+        if not bad:
+            for i in range(len(poses) - 1):  # every raw step must be free (turns included)
+                if not self.segment_free(poses[i], poses[i + 1], escape):
+                    bad.update(cells[j] for j in (i, i + 1) if 0 < j < len(cells) - 1)
+        return poses, bad
+
+    def _greedy(self, poses: list[BasePose], escape: Optional[BasePose]) -> list[BasePose]:
+        """From each pose, the farthest later one reachable on a free straight segment."""
         out: list[BasePose] = []
         i, n = 0, len(poses)
         while i < n - 1:
             j = n - 1
             while j > i + 1 and not self.segment_free(poses[i], poses[j], escape):
                 j -= 1
-            if j == i + 1 and not self.segment_free(poses[i], poses[j], escape):
-                return [], cells[min(j, len(cells) - 1)]
             out.append(poses[j])
             i = j
-        return out, None
+        return out
+
+    def _fitting_yaw(self, x: float, y: float, yaw: float, escape: Optional[BasePose]) -> Optional[float]:
+        """`yaw` if the footprint fits there at it, else the nearest heading (in steps of
+        pi/16) that fits, else None."""
+        if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+            return yaw
+        for k in range(17):
+            for sign in ((1,) if k == 0 else (1, -1)):
+                candidate = yaw + sign * k * math.pi / 16
+                if self.pose_free(x, y, candidate):
+                    return candidate
+        return None
 
 
 def path_length(start: BasePose, waypoints: Sequence[BasePose]) -> float:
