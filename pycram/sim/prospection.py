@@ -33,6 +33,8 @@ from .scene import Scene
 
 #: Geom groups a camera sees (MuJoCo's default visualisation: groups 0, 1 and 2).
 VISIBLE_GROUPS = np.array([1, 1, 1, 0, 0, 0], np.uint8)
+#: Visibility rays start this far [m] ahead of the camera along its view axis, past the head.
+HEAD_CLEARANCE = 0.06
 #: Sample points per target geom for visibility.
 POINTS_PER_GEOM = 24
 #: Contacts penetrating less than this [m] do not count as collisions: mesh links collide as
@@ -112,6 +114,7 @@ class SimProspection(Prospection):
         self._tan_y = math.tan(math.radians(head["fovy"]) / 2.0)
         self._tan_x = self._tan_y * width / height
         self._points: dict[int, np.ndarray] = {}
+        self._target_geoms: dict[str, list[int]] = {}
         # geoms that move with the camera (the head it is mounted on): never occluders
         tilt_body = int(m.jnt_bodyid[self._head_jids[1]])
         head_bodies = {b for b in range(m.nbody) if _descends(m, b, tilt_body)}
@@ -268,15 +271,9 @@ class SimProspection(Prospection):
     def _target_points(self, target: Any, d: mujoco.MjData) -> tuple[np.ndarray, set[int]]:
         """Sample points (n x 3, map) of `target` and the geoms that belong to it."""
         if isinstance(target, str):
-            bid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, target)
-            geoms = [g for g in range(self.model.ngeom) if int(self.model.geom_bodyid[g]) == bid] if bid >= 0 else []
-            geoms = [g for g in geoms if VISIBLE_GROUPS[min(int(self.model.geom_group[g]), 5)]]
-            if not geoms:
-                known = sorted(self.model.geom(g).name for g in range(self.model.ngeom)
-                               if self.model.geom(g).name and self.model.geom_bodyid[g] > 0
-                               and self.model.body(int(self.model.geom_bodyid[g])).name == self.model.geom(g).name
-                               and not self._is_robot[g])
-                raise ValueError(f"unknown object {target!r}; known objects: {known}")
+            geoms = self._target_geoms.get(target)
+            if geoms is None:
+                geoms = self._target_geoms[target] = self._geoms_of(target)
             pts = [self._local_points(g) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g] for g in geoms]
             return np.vstack(pts), set(geoms)
         try:
@@ -286,6 +283,19 @@ class SimProspection(Prospection):
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"a visibility target is an object name or a point (x, y, z) [m]; got {target!r}")
         return p[None, :], set()
+
+    def _geoms_of(self, name: str) -> list[int]:
+        """The visible geoms of the object (body) `name`; ValueError listing the objects if none."""
+        m = self.model
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        geoms = [g for g in range(m.ngeom) if bid >= 0 and int(m.geom_bodyid[g]) == bid
+                 and VISIBLE_GROUPS[min(int(m.geom_group[g]), 5)]]
+        if not geoms:
+            known = sorted({m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)
+                            if m.geom_bodyid[g] > 0 and m.body(int(m.geom_bodyid[g])).name == m.geom(g).name
+                            and not self._is_robot[g]})
+            raise ValueError(f"unknown object {name!r}; known objects: {known}")
+        return geoms
 
     def _local_points(self, g: int) -> np.ndarray:
         pts = self._points.get(g)
@@ -362,8 +372,9 @@ class SimProspection(Prospection):
             self._prepare(d, base_pose, joint_configuration)
             points, own = self._target_points(target, d)
             self._point_head(d, points.mean(axis=0))
-            cam = d.cam_xpos[self._camera].copy()
             rot = d.cam_xmat[self._camera].reshape(3, 3)
+            # rays start a little ahead of the lens, clear of the head the camera sits in
+            cam = d.cam_xpos[self._camera] - HEAD_CLEARANCE * rot[:, 2]
             vec = points - cam
             local = vec @ rot  # camera frame: looks along -z, up +y
             depth = -local[:, 2]
