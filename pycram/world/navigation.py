@@ -14,9 +14,8 @@ How a path is planned
    headings fit cost more, so paths keep their distance from furniture where they can.
 3. The A* cell path gets headings (a uniform turn by path length, or turning at the start, or
    at the end, whichever is free; where the footprint does not fit at the profile's heading,
-   the nearest heading that fits) and is shortened greedily: from each
-   waypoint the farthest later waypoint reachable on a straight, footprint-checked segment is
-   taken. Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells
+   the nearest heading that fits) and is shortened greedily: from each waypoint a far later
+   waypoint reachable on a straight, footprint-checked segment is taken (found by bisection). Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells
    where the footprint fits at no heading are blocked and A* searches again.
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
@@ -306,34 +305,34 @@ class PathPlanner:
         gr, gcl = gc
         neighbours = ((1, 0, 1.0), (-1, 0, 1.0), (0, 1, 1.0), (0, -1, 1.0),
                       (1, 1, SQRT2), (1, -1, SQRT2), (-1, 1, SQRT2), (-1, -1, SQRT2))
-        best = {start: 0.0}
-        parent = {start: -1}
-        closed = set()
+        best = [math.inf] * (rows * cols)
+        parent = [-1] * (rows * cols)
+        best[start] = 0.0
         heap = [(0.0, 0.0, start)]
         push, pop = heapq.heappush, heapq.heappop
         while heap:
             _f, cost, node = pop(heap)
             if node == goal:
                 out = []
-                while node != -1:
+                while node != start:
                     out.append(divmod(node, cols))
                     node = parent[node]
+                out.append(sc)
                 return out[::-1]
-            if node in closed:
-                continue
-            closed.add(node)
+            if cost > best[node]:
+                continue  # a stale entry: the node was reached more cheaply since
             r, c = divmod(node, cols)
             for dr, dc, step in neighbours:
                 nr, nc = r + dr, c + dc
                 if nr < 0 or nr >= rows or nc < 0 or nc >= cols:
                     continue
                 n = nr * cols + nc
-                if not free[n] or n in closed:
+                if not free[n]:
                     continue
                 if dr and dc and not (free[r * cols + nc] and free[nr * cols + c]):
                     continue  # no corner cutting
                 ncost = cost + step * (1.0 + w * penalty[n])
-                if ncost < best.get(n, math.inf):
+                if ncost < best[n]:
                     best[n] = ncost
                     parent[n] = node
                     ddr, ddc = abs(nr - gr), abs(nc - gcl)
@@ -385,15 +384,23 @@ class PathPlanner:
         return poses, bad
 
     def _greedy(self, poses: list[BasePose], escape: Optional[BasePose]) -> list[BasePose]:
-        """From each pose, the farthest later one reachable on a free straight segment."""
+        """From each pose on, a far later pose reachable on a free straight segment: the last
+        pose if it is, else one found by bisection (free, with the next one not free from
+        there). Consecutive poses are known to be connected by free segments."""
         out: list[BasePose] = []
         i, n = 0, len(poses)
         while i < n - 1:
-            j = n - 1
-            while j > i + 1 and not self.segment_free(poses[i], poses[j], escape):
-                j -= 1
-            out.append(poses[j])
-            i = j
+            lo, hi = i + 1, n - 1
+            if self.segment_free(poses[i], poses[hi], escape):
+                lo = hi
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if self.segment_free(poses[i], poses[mid], escape):
+                    lo = mid
+                else:
+                    hi = mid
+            out.append(poses[lo])
+            i = lo
         return out
 
     def _fitting_yaw(self, x: float, y: float, yaw: float, escape: Optional[BasePose]) -> Optional[float]:
