@@ -98,6 +98,15 @@ def test_load_builds_the_robot_with_its_modules(robot):
         robots.load(other, robot.world)
 
 
+def test_reasoning_reaches_the_worlds_prospection_through_the_active_robot(robot):
+    from pycram.robot import current_prospection
+    from pycram.world.prospection import Prospection
+
+    p = current_prospection()
+    assert isinstance(p, Prospection) and p is robot.world.prospection()
+    assert not p.in_collision(robot.world.base_pose.get_value())
+
+
 def test_arm_requests_go_to_the_right_module(robot):
     """Thesis ch. 4.2.2: PR2 dispatches on the arm; TIAGo serves any arm with its only one."""
     def module_for(**properties):
