@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -83,22 +84,25 @@ def dls_ik(model: mujoco.MjModel, data: mujoco.MjData, site: int, qadr: np.ndarr
     """
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     site_quat, neg, dq_rot, e_r = np.zeros(4), np.zeros(4), np.zeros(4), np.zeros(3)
-    eye6, eye3 = np.eye(6) * damping ** 2, np.eye(3) * damping ** 2
+    rows = 6 if target_q is not None else 3
+    J = np.zeros((rows, len(dadr)))
+    e = np.zeros(rows)
+    damp = np.eye(rows) * damping ** 2
     q = np.clip(np.asarray(seed, float), lo, hi)
     pe = re = float("inf")
     history: list[float] = []
     for it in range(iterations):
         data.qpos[qadr] = q
         mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        e_p = target_p - data.site_xpos[site]
-        pe = float(np.linalg.norm(e_p))
+        np.subtract(target_p, data.site_xpos[site], out=e[:3])
+        pe = math.sqrt(float(e[:3] @ e[:3]))
         if target_q is not None:
             mujoco.mju_mat2Quat(site_quat, data.site_xmat[site])
             mujoco.mju_negQuat(neg, site_quat)
             mujoco.mju_mulQuat(dq_rot, target_q, neg)
             mujoco.mju_quat2Vel(e_r, dq_rot, 1.0)
-            re = float(np.linalg.norm(e_r))
+            re = math.sqrt(float(e_r @ e_r))
+            e[3:] = 0.5 * e_r
         else:
             re = 0.0
         if pe < position_tolerance and re < orientation_tolerance:
@@ -108,15 +112,13 @@ def dls_ik(model: mujoco.MjModel, data: mujoco.MjData, site: int, qadr: np.ndarr
             history.append(err)
             if it >= stall_window and err > 0.99 * history[it - stall_window]:
                 break
+        mujoco.mj_comPos(model, data)
         mujoco.mj_jacSite(model, data, jacp, jacr if target_q is not None else None, site)
+        J[:3] = jacp[:, dadr]
         if target_q is not None:
-            J = np.vstack([jacp[:, dadr], 0.5 * jacr[:, dadr]])
-            e = np.concatenate([e_p, 0.5 * e_r])
-            dq = J.T @ np.linalg.solve(J @ J.T + eye6, e)
-        else:
-            J = jacp[:, dadr]
-            dq = J.T @ np.linalg.solve(J @ J.T + eye3, e_p)
-        step = np.max(np.abs(dq))
+            J[3:] = 0.5 * jacr[:, dadr]
+        dq = J.T @ np.linalg.solve(J @ J.T + damp, e)
+        step = float(np.abs(dq).max())
         if step > 0.3:
             dq *= 0.3 / step
         q = np.clip(q + dq, lo, hi)

@@ -42,8 +42,10 @@ POINTS_PER_GEOM = 24
 #: brush surfaces this much (the thesis demo's grasps touch the counter by ~1 cm).
 COLLISION_TOLERANCE = 0.015
 #: IK: iterations per seed and the stall window (iterations without 1 % progress end a seed).
-IK_ITERATIONS = 150
-IK_STALL = 25
+IK_ITERATIONS = 100
+IK_STALL = 15
+#: IK: after this many solutions that all collide, the pose counts as "collision".
+MAX_COLLIDING_SOLUTIONS = 3
 
 
 def _descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
@@ -242,6 +244,7 @@ class SimProspection(Prospection):
                                     f"reach of {a.reach:.2f} m")
         seeds = a.seeds(current, previous)
         collided: Optional[list[tuple[str, str]]] = None
+        colliding = 0
         for seed in seeds:
             sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, a.lo, a.hi, target_p, target_q, seed,
                                     IK_ITERATIONS, stall_window=IK_STALL)
@@ -254,10 +257,13 @@ class SimProspection(Prospection):
             if not contacts:
                 return q
             collided = collided or contacts
+            colliding += 1
+            if colliding >= MAX_COLLIDING_SOLUTIONS:
+                break
         if collided:
             return "collision", f"every solution found touches {collided[0][1]} with {collided[0][0]}"
         free_lo, free_hi = np.full_like(a.lo, -np.inf), np.full_like(a.hi, np.inf)
-        for seed in seeds[:3]:
+        for seed in seeds[:2]:
             sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, free_lo, free_hi, target_p, target_q,
                                     seed, IK_ITERATIONS, stall_window=IK_STALL)
             if converged:

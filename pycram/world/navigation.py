@@ -32,7 +32,7 @@ import heapq
 import logging
 import math
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
+from typing import Callable, Optional
 
 import numpy as np
 
@@ -414,15 +414,3 @@ class PathPlanner:
                 if self.pose_free(x, y, candidate):
                     return candidate
         return None
-
-
-def path_length(start: BasePose, waypoints: Sequence[BasePose]) -> float:
-    """Planar length [m] of the polyline from ``start`` through ``waypoints``."""
-    total, prev = 0.0, start
-    for p in waypoints:
-        total += math.hypot(p.x - prev.x, p.y - prev.y)
-        prev = p
-    return total
-
-
-PoseCheck = Callable[[float, float, float], bool]
