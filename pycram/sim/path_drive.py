@@ -31,6 +31,9 @@ _log = logging.getLogger(__name__)
 
 #: Tolerances [m], [rad] at intermediate waypoints (the goal keeps BaseDrive's own).
 WAYPOINT_TOLERANCE = (0.03, 0.05)
+#: A movable part of the environment counts as moved when a coordinate of its pose or joint
+#: changed by more than this [m, rad or quaternion component] (less than a grid cell).
+MOVED = 0.01
 #: The base counts as stopped below this planar speed [m/s] (and a tenth of it in [rad/s]).
 STOPPED_SPEED = 0.02
 
@@ -46,9 +49,12 @@ class Navigation:
         self._planner: Optional[PathPlanner] = None
 
     def planner(self, eng: Engine) -> tuple[PathPlanner, bool]:
-        """The planner of the current state, and whether it is new (something moved)."""
+        """The planner of the current state, and whether it is new (something moved by more
+        than `MOVED` since the planner was built; smaller motions, e.g. a door settling, do not
+        rebuild it)."""
         state = self.floor.movable_state(eng.data)
-        if self._planner is not None and self._state is not None and np.array_equal(state, self._state):
+        if (self._planner is not None and self._state is not None
+                and (state.size == 0 or float(np.abs(state - self._state).max()) <= MOVED)):
             return self._planner, False
         self._state = state
         self._planner = PathPlanner(self.floor.grid(eng.model, eng.data), self.footprint)

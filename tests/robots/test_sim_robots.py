@@ -338,12 +338,17 @@ class _PoseTrack(Fluent):
         super().pulse()
 
 
+def _obstacle_ahead(robot, distance: float) -> str:
+    """Test set-up: the robot at START, an obstacle box `distance` [m] ahead; its name."""
+    go_to_start(robot)
+    outcome = robot.world.place_obstacle(START[0] + distance, START[1]).wait(T)
+    assert outcome is not None and outcome.succeeded
+    return outcome.value
+
+
 def test_moving_goes_around_an_obstacle_on_the_straight_line(robot):
     world = robot.world
-    go_to_start(robot)
-    outcome = world.place_obstacle(START[0] + 1.0, START[1]).wait(T)  # test set-up
-    assert outcome is not None and outcome.succeeded
-    obstacle = outcome.value
+    obstacle = _obstacle_ahead(robot, 1.0)
     watcher = _PoseTrack(world.base_pose)
     samples = watcher.samples
     try:
@@ -362,10 +367,7 @@ def test_moving_to_an_occupied_goal_fails_with_a_navigation_failure(robot):
     from pycram.world.navigation import NavigationFailure
 
     world = robot.world
-    go_to_start(robot)
-    outcome = world.place_obstacle(START[0] + 2.0, START[1]).wait(T)  # test set-up
-    assert outcome is not None and outcome.succeeded
-    obstacle = outcome.value
+    obstacle = _obstacle_ahead(robot, 2.0)
     before = world.base_pose.get_value()
     try:
         with pytest.raises(ProcessModuleFailure) as info:
