@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from pycram.world.navigation import Footprint, OccupancyGrid
+from pycram.world.navigation import Footprint, OccupancyGrid, dilate
 
 from .scene import Scene
 
@@ -26,22 +26,41 @@ MIN_HEIGHT = 0.01
 #: Grid cell size [m] and the margin [m] of the grid around the environment.
 RESOLUTION = 0.05
 MAP_MARGIN = 2.0
+#: Directions along which outlines of many points are sampled (see `planar_extremes`).
+EXTREME_DIRECTIONS = 64
 
 _UNIT_BOX = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
 
 
-def geom_vertices(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> np.ndarray:
-    """Points (n x 3, map frame [m]) whose convex hull contains `geom` at its current pose."""
+def local_vertices(model: mujoco.MjModel, geom: int, directions: int = 0) -> np.ndarray:
+    """Points (n x 3, geom frame [m]) whose convex hull is `geom`; with `directions` > 0, only
+    the mesh vertices farthest along that many directions spread over the sphere (a polytope
+    inscribed in the hull, for speed)."""
     gtype = model.geom_type[geom]
     if gtype == mujoco.mjtGeom.mjGEOM_MESH and model.geom_dataid[geom] >= 0:
         mesh = int(model.geom_dataid[geom])
         adr, num = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
         local = np.asarray(model.mesh_vert[adr:adr + num], float)
-    elif gtype == mujoco.mjtGeom.mjGEOM_BOX:
-        local = _UNIT_BOX * model.geom_size[geom]
-    else:  # the geom's bounding box in its own frame
-        center, half = model.geom_aabb[geom, :3], model.geom_aabb[geom, 3:]
-        local = center + _UNIT_BOX * half
+        if directions and num > directions:
+            k = np.arange(directions) + 0.5  # a Fibonacci sphere
+            z = 1.0 - 2.0 * k / directions
+            phi = np.pi * (1.0 + 5 ** 0.5) * k
+            r = np.sqrt(1.0 - z * z)
+            dirs = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+            local = local[np.unique(np.argmax(local @ dirs.T, axis=0))]
+        return local
+    if gtype == mujoco.mjtGeom.mjGEOM_BOX:
+        return _UNIT_BOX * model.geom_size[geom]
+    center, half = model.geom_aabb[geom, :3], model.geom_aabb[geom, 3:]  # the bounding box
+    return center + _UNIT_BOX * half
+
+
+def geom_vertices(model: mujoco.MjModel, data: mujoco.MjData, geom: int,
+                  local: np.ndarray | None = None) -> np.ndarray:
+    """Points (n x 3, map frame [m]) whose convex hull contains `geom` at its current pose
+    (`local`: its points in the geom frame, when already known)."""
+    if local is None:
+        local = local_vertices(model, geom)
     rot = data.geom_xmat[geom].reshape(3, 3)
     return local @ rot.T + data.geom_xpos[geom]
 
@@ -99,10 +118,23 @@ class FloorMap:
 
     def grid(self, model: mujoco.MjModel, data: mujoco.MjData) -> OccupancyGrid:
         """The occupancy grid of the state in `data` (kinematics computed): static + movable."""
-        mask = self.static.copy()
+        return OccupancyGrid(self.origin, self.resolution, self.static | self.movable(model, data))
+
+    def static_grid(self) -> OccupancyGrid:
+        return OccupancyGrid(self.origin, self.resolution, self.static)
+
+    def movable(self, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+        """The cells under movable parts in the state of `data` (kinematics computed)."""
+        mask = np.zeros_like(self.static)
         for g in self.movable_geoms:
             _rasterize(mask, self.origin, self.resolution, model, data, g)
-        return OccupancyGrid(self.origin, self.resolution, mask)
+        return mask
+
+    def movable_top(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
+        """Height [m] of the highest movable part that can block the base (0 if none)."""
+        tops = [geom_vertices(model, data, g)[:, 2] for g in self.movable_geoms]
+        tops = [t.max() for t in tops if t.max() >= MIN_HEIGHT and t.min() <= MAX_HEIGHT]
+        return float(max(tops, default=0.0))
 
     def movable_state(self, data: mujoco.MjData) -> np.ndarray:
         """The part of the state that moves movable geoms (to notice changes cheaply)."""
@@ -165,4 +197,38 @@ def base_footprint(scene: Scene, data: mujoco.MjData) -> Footprint:
     rot, pos = data.xmat[mount].reshape(3, 3), data.xpos[mount]
     pts = np.vstack([(geom_vertices(model, data, g) - pos) @ rot for g in sorted(scene.base_geoms)])
     hull = convex_hull(pts[:, :2])
+    return Footprint(tuple((float(x), float(y)) for x, y in hull))
+
+
+def planar_extremes(points: np.ndarray, directions: int = EXTREME_DIRECTIONS) -> np.ndarray:
+    """The points of `points` (n x 2) farthest along each of `directions` evenly spread
+    directions: the corners of a polygon inscribed in their convex hull, off by at most
+    r (1 - cos(pi / directions)) at distance r (0.1 % with 64 directions)."""
+    angles = np.arange(directions) * (2.0 * np.pi / directions)
+    dirs = np.column_stack([np.cos(angles), np.sin(angles)])
+    return points[np.unique(np.argmax(points @ dirs.T, axis=0))]
+
+
+def robot_vertices(scene: Scene, directions: int = 500) -> dict[int, np.ndarray]:
+    """Local points of each collision geom of the robot (see `local_vertices`), for
+    `body_footprint`; computed once per scene."""
+    return {g: local_vertices(scene.model, g, directions) for g in sorted(scene.robot_geoms | scene.base_geoms)}
+
+
+def body_footprint(scene: Scene, data: mujoco.MjData, below: float = MAX_HEIGHT,
+                   vertices: dict[int, np.ndarray] | None = None) -> Footprint:
+    """The outline on the floor, in the base frame, of the whole robot as it stands in `data`
+    (arms included), counting only the parts of its collision geoms below `below` [m].
+    `vertices`: `robot_vertices(scene)`, to save recomputing it."""
+    model = scene.model
+    mount = scene.body(scene.description.ROOT_LINK)
+    rot, pos = data.xmat[mount].reshape(3, 3), data.xpos[mount]
+    pts = []
+    vertices = vertices if vertices is not None else robot_vertices(scene)
+    for g, local in vertices.items():
+        verts = geom_vertices(model, data, g, local)
+        verts = verts[verts[:, 2] <= below]
+        if len(verts):
+            pts.append(planar_extremes(((verts - pos) @ rot)[:, :2]))
+    hull = convex_hull(planar_extremes(np.vstack(pts)))
     return Footprint(tuple((float(x), float(y)) for x, y in hull))

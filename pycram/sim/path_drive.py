@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Optional
+from typing import Callable, Optional
 
 import numpy as np
 
@@ -23,7 +23,9 @@ from pycram.world.prospection import BasePose
 
 from .controllers import BaseDrive, Controller, fail
 from .engine import Engine
-from .occupancy import FloorMap, base_footprint, build_floor_map
+from .occupancy import FloorMap, base_footprint, body_footprint, build_floor_map, robot_vertices
+from .prospection import SimProspection
+from .recording import StateSnapshot
 from .robot_model import BASE_JOINTS
 from .types import Outcome, Pose2D
 
@@ -46,18 +48,41 @@ class Navigation:
         self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
         self.footprint: Footprint = base_footprint(eng.scene, eng.data)
         self._state: Optional[np.ndarray] = None
+        self._outline = np.zeros(0)
+        self._robot_vertices = robot_vertices(eng.scene)
         self._planner: Optional[PathPlanner] = None
+        self._robot_state = StateSnapshot.of(eng.data)
+        self._prospection = SimProspection(eng.scene, lambda: self._robot_state)
 
-    def planner(self, eng: Engine) -> tuple[PathPlanner, bool]:
+    def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
+        """Whether the whole robot, in its configuration now, touches nothing of the environment
+        at a base pose (x, y, yaw): the 3D check behind the planner's footprint."""
+        self._robot_state = StateSnapshot.of(eng.data)
+        prospection = self._prospection
+        return lambda x, y, yaw: not prospection.in_collision((x, y, yaw))
+
+    def planner(self, eng: Engine, refresh_outline: bool = True) -> tuple[PathPlanner, bool]:
         """The planner of the current state, and whether it is new (something moved by more
         than `MOVED` since the planner was built; smaller motions, e.g. a door settling, do not
-        rebuild it)."""
+        rebuild it). The robot's outline is taken anew only with `refresh_outline` (or when
+        something moved): drives take it when they plan.
+
+        The base's footprint keeps off the static furniture (the arms work over counters);
+        the outline of the whole robot as it stands (arms included, up to the height of the
+        highest movable part) keeps off movable obstacles (boxes, open doors)."""
         state = self.floor.movable_state(eng.data)
-        if (self._planner is not None and self._state is not None
-                and (state.size == 0 or float(np.abs(state - self._state).max()) <= MOVED)):
+        moved = self._state is None or float(np.abs(state - self._state).max(initial=0.0)) > MOVED
+        if self._planner is not None and not moved and not refresh_outline:
             return self._planner, False
-        self._state = state
-        self._planner = PathPlanner(self.floor.grid(eng.model, eng.data), self.footprint)
+        top = self.floor.movable_top(eng.model, eng.data)
+        body = body_footprint(eng.scene, eng.data, top + 0.02, self._robot_vertices) if top > 0.0 else self.footprint
+        outline = np.round(np.asarray(body.vertices).ravel(), 2)  # the arms' pose, to the cm
+        if (self._planner is not None and not moved and len(outline) == len(self._outline)
+                and float(np.abs(outline - self._outline).max()) <= MOVED):
+            return self._planner, False
+        self._state, self._outline = state, outline
+        self._planner = PathPlanner(self.floor.static_grid(), self.footprint,
+                                    layers=[(self.floor.movable(eng.model, eng.data), body)])
         return self._planner, True
 
 
@@ -90,10 +115,11 @@ class PlannedDrive(Controller):
         self.replans = 0
 
     def _plan(self, eng: Engine) -> Optional[Outcome]:
-        planner, _ = navigation_of(eng).planner(eng)
+        nav = navigation_of(eng)
+        planner, _ = nav.planner(eng)
         here = eng.base_pose()
         try:
-            self.waypoints = planner.plan(_pose(here), _pose(self.goal))
+            self.waypoints = planner.plan(_pose(here), _pose(self.goal), nav.exact_check(eng))
         except NoPathError as exc:
             return fail("no_path", str(exc), here)
         if len(self.waypoints) > 1:
@@ -113,15 +139,9 @@ class PlannedDrive(Controller):
         return self._plan(eng)
 
     def _remaining_free(self, eng: Engine, planner: PathPlanner) -> bool:
-        here = _pose(eng.base_pose())
         rest = ([BasePose(self.segment.goal.x, self.segment.goal.y, self.segment.goal.yaw)]
                 if self.segment is not None else []) + self.waypoints
-        prev, escape = here, None if planner.pose_free(here.x, here.y, here.yaw) else here
-        for w in rest:
-            if not planner.segment_free(prev, w, escape):
-                return False
-            prev = w
-        return True
+        return planner.path_free(_pose(eng.base_pose()), rest, navigation_of(eng).exact_check(eng))
 
     def update(self, eng: Engine, t: float) -> Optional[Outcome]:
         if self.stopping:
@@ -131,7 +151,7 @@ class PlannedDrive(Controller):
             self.stopping = False
             self.replans += 1
             return self._plan(eng)
-        planner, changed = navigation_of(eng).planner(eng)
+        planner, changed = navigation_of(eng).planner(eng, refresh_outline=False)
         if changed and not self._remaining_free(eng, planner):
             _log.info("drive to (%.2f, %.2f): the path is blocked; stopping to re-plan", self.goal.x, self.goal.y)
             eng.hold(list(BASE_JOINTS))

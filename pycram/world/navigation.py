@@ -32,7 +32,7 @@ import heapq
 import logging
 import math
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
@@ -55,6 +55,12 @@ SQRT2 = math.sqrt(2.0)
 ESCAPE_RADIUS = 0.15
 #: A* searches per plan: after each, cells where the footprint fits at no heading are blocked.
 MAX_SEARCHES = 8
+#: Spacing [m] of the backend's exact checks along a path, and the half width [cells] of the
+#: square blocked around a spot where one failed.
+EXACT_STEP = 0.05
+EXACT_BLOCK_CELLS = 3
+
+PoseCheck = Callable[[float, float, float], bool]
 
 
 class NavigationFailure(Exception):
@@ -177,33 +183,77 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+class _Layer:
+    """Occupied cells that one footprint must keep off (e.g. furniture: the base; movable
+    obstacles: the whole robot as it stands)."""
+
+    def __init__(self, mask: np.ndarray, footprint: Footprint, grid: OccupancyGrid, margin: float) -> None:
+        self.mask, self.footprint = mask, footprint
+        self.normals, self.offsets = footprint._edges()
+        rows, cols = np.nonzero(mask)
+        res = grid.resolution
+        self.occ_xy = np.column_stack([grid.origin[0] + (cols + 0.5) * res, grid.origin[1] + (rows + 0.5) * res])
+        self.reach = footprint.circumscribed_radius + margin
+
+    def free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float) -> bool:
+        """Whether the footprint, grown by `margin`, at every pose misses every occupied cell."""
+        reach, occ = self.reach, self.occ_xy
+        near = ((occ[:, 0] >= xs.min() - reach) & (occ[:, 0] <= xs.max() + reach)
+                & (occ[:, 1] >= ys.min() - reach) & (occ[:, 1] <= ys.max() + reach))
+        occ = occ[near]
+        if occ.size == 0:
+            return True
+        dx = occ[None, :, 0] - xs[:, None]  # poses x occupied cells
+        dy = occ[None, :, 1] - ys[:, None]
+        pose, cell = np.nonzero(dx * dx + dy * dy <= reach * reach)
+        if pose.size == 0:
+            return True
+        c, s = np.cos(yaws[pose]), np.sin(yaws[pose])
+        px, py = dx[pose, cell], dy[pose, cell]
+        bx, by = c * px + s * py, -s * px + c * py  # into the base frame
+        d = np.outer(bx, self.normals[:, 0]) + np.outer(by, self.normals[:, 1]) - self.offsets
+        return not bool(np.any(np.all(d <= margin, axis=1)))
+
+
 class PathPlanner:
     """Plans base paths on ``grid`` for a robot with ``footprint``, keeping ``clearance`` [m].
 
-    Construction inflates the grid (a few ms); :meth:`plan` is then a pure function of its
+    ``layers``: more occupied masks (same shape as the grid), each with the footprint that must
+    keep off it -- e.g. movable obstacles that the whole robot, arms included, must pass, while
+    the base alone must keep off the furniture the arms reach over. ``grid`` (attribute) is the
+    union of all. Construction inflates the grid (a few ms); :meth:`plan` is then a pure function of its
     arguments (thread-safe, deterministic). ``cost_weight`` is the extra cost per cell [m/m]
     of passing where the footprint fits only at some headings.
     """
 
     def __init__(self, grid: OccupancyGrid, footprint: Footprint, clearance: float = 0.03,
-                 cost_weight: float = 2.0) -> None:
-        self.grid, self.footprint, self.clearance = grid, footprint, clearance
+                 cost_weight: float = 2.0,
+                 layers: Sequence[tuple[np.ndarray, Footprint]] = ()) -> None:
         res = grid.resolution
         # a cell is marked when its centre is under an obstacle: the obstacle may reach half a
         # cell diagonal further, so checks add that to the clearance
         self._margin = clearance + res * SQRT2 / 2.0
-        self.lethal = dilate(grid.occupied, (footprint.inscribed_radius + self._margin) / res)
-        self.caution = dilate(grid.occupied, (footprint.circumscribed_radius + self._margin) / res)
-        # for single poses anywhere in a cell (up to half a diagonal from its centre)
+        self._layers = [_Layer(grid.occupied, footprint, grid, self._margin)]
+        self._layers += [_Layer(mask, fp, grid, self._margin) for mask, fp in layers if mask.any()]
+        occupied = grid.occupied.copy()
+        for mask, _ in layers:
+            occupied |= mask
+        self.grid = OccupancyGrid(grid.origin, res, occupied)
+        self.footprint, self.clearance, self.cost_weight = footprint, clearance, cost_weight
         half = res * SQRT2 / 2.0
-        self._sure_hit = dilate(grid.occupied, (footprint.inscribed_radius + self._margin - half) / res)
-        self._sure_free = ~dilate(grid.occupied, (footprint.circumscribed_radius + self._margin + half) / res)
-        self._normals, self._offsets = footprint._edges()
-        occ_rows, occ_cols = np.nonzero(grid.occupied)
-        self._occ_xy = np.column_stack([grid.origin[0] + (occ_cols + 0.5) * res,
-                                        grid.origin[1] + (occ_rows + 0.5) * res])
-        self.cost_weight = cost_weight
-        self._reach = footprint.circumscribed_radius + self._margin
+        self.lethal = np.zeros_like(occupied)
+        self.caution = np.zeros_like(occupied)
+        self._sure_hit = np.zeros_like(occupied)
+        sure_not_free = np.zeros_like(occupied)
+        for layer in self._layers:
+            fp, m = layer.footprint, layer.mask
+            self.lethal |= dilate(m, (fp.inscribed_radius + self._margin) / res)
+            self.caution |= dilate(m, (fp.circumscribed_radius + self._margin) / res)
+            # for single poses anywhere in a cell (up to half a diagonal from its centre)
+            self._sure_hit |= dilate(m, (fp.inscribed_radius + self._margin - half) / res)
+            sure_not_free |= dilate(m, (fp.circumscribed_radius + self._margin + half) / res)
+        self._sure_free = ~sure_not_free
+        self._turn_radius = max(layer.footprint.circumscribed_radius for layer in self._layers)
 
     # ------------------------------------------------------------------ checks
     def pose_free(self, x: float, y: float, yaw: float) -> bool:
@@ -224,23 +274,7 @@ class PathPlanner:
         if unsure.size == 0:
             return True
         xs, ys, yaws = xs[unsure], ys[unsure], yaws[unsure]
-        reach = self._reach
-        occ = self._occ_xy
-        near = ((occ[:, 0] >= xs.min() - reach) & (occ[:, 0] <= xs.max() + reach)
-                & (occ[:, 1] >= ys.min() - reach) & (occ[:, 1] <= ys.max() + reach))
-        occ = occ[near]
-        if occ.size == 0:
-            return True
-        dx = occ[None, :, 0] - xs[:, None]  # poses x occupied cells
-        dy = occ[None, :, 1] - ys[:, None]
-        pose, cell = np.nonzero(dx * dx + dy * dy <= reach * reach)
-        if pose.size == 0:
-            return True
-        c, s = np.cos(yaws[pose]), np.sin(yaws[pose])
-        px, py = dx[pose, cell], dy[pose, cell]
-        bx, by = c * px + s * py, -s * px + c * py  # into the base frame
-        d = np.outer(bx, self._normals[:, 0]) + np.outer(by, self._normals[:, 1]) - self._offsets
-        return not bool(np.any(np.all(d <= self._margin, axis=1)))
+        return all(layer.free(xs, ys, yaws, self._margin) for layer in self._layers)
 
     def segment_free(self, a: BasePose, b: BasePose, escape: Optional[BasePose] = None) -> bool:
         """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?
@@ -248,7 +282,7 @@ class PathPlanner:
         dist = math.hypot(b.x - a.x, b.y - a.y)
         dyaw = _wrap(b.yaw - a.yaw)
         # sample so that neither the centre nor a corner moves more than half a cell per step
-        n = max(1, int(math.ceil(max(dist, abs(dyaw) * self.footprint.circumscribed_radius)
+        n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius)
                                  / (0.5 * self.grid.resolution))))
         s = np.linspace(0.0, 1.0, n + 1)
         xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
@@ -258,16 +292,21 @@ class PathPlanner:
         return self._free(xs, ys, yaws)
 
     # ------------------------------------------------------------------ planning
-    def plan(self, start: object, goal: object) -> list[BasePose]:
+    def plan(self, start: object, goal: object, exact_check: Optional[PoseCheck] = None) -> list[BasePose]:
         """Waypoints from ``start`` to ``goal`` (start excluded, goal last), each reached by a
-        straight, footprint-checked drive from the one before. Raises :class:`NoPathError`."""
+        straight, footprint-checked drive from the one before. Raises :class:`NoPathError`.
+
+        ``exact_check(x, y, yaw) -> bool`` (optional, from the backend: e.g. the whole robot in
+        its current configuration against the 3D environment) must also hold at the goal and
+        every `EXACT_STEP` along the path; where it fails, A* searches again around that spot.
+        """
         a, b = as_base_pose(start), as_base_pose(goal)
         g = self.grid
-        if not self.pose_free(b.x, b.y, b.yaw):
+        if not self.pose_free(b.x, b.y, b.yaw) or (exact_check is not None and not exact_check(b.x, b.y, b.yaw)):
             raise NoPathError("goal_in_collision", f"the robot does not fit at the goal "
                               f"(x={b.x:.2f}, y={b.y:.2f}, yaw={b.yaw:.2f})", a, b)
         escape = None if self.pose_free(a.x, a.y, a.yaw) else a
-        if self.segment_free(a, b, escape):
+        if self.path_free(a, [b], exact_check):
             return [b]
         sc, gc = g.cell(a.x, a.y), g.cell(b.x, b.y)
         for name, cell, pose in (("start", sc, a), ("goal", gc, b)):
@@ -282,9 +321,46 @@ class PathPlanner:
                                   f"(x={b.x:.2f}, y={b.y:.2f})", a, b)
             path, misfits = self._shorten(a, b, cells, escape)
             if not misfits:
-                return path
+                hit = self._exact_hit(a, path, escape, exact_check)
+                if hit is None:
+                    return path
+                r, c = g.cell(*hit)  # the robot touches something there: keep its centre away
+                k = EXACT_BLOCK_CELLS
+                misfits = {(rr, cc) for rr in range(r - k, r + k + 1) for cc in range(c - k, c + k + 1)
+                           if g.inside(rr, cc) and (rr, cc) not in (sc, gc)}
             bad |= misfits  # the footprint fits there at no heading (or cannot turn there)
-        raise NoPathError("no_path", "no path where the footprint fits at the headings it needs", a, b)
+        raise NoPathError("no_path", "no path where the robot fits at the headings it needs", a, b)
+
+    def path_free(self, start: BasePose, waypoints: list[BasePose],
+                  exact_check: Optional[PoseCheck] = None) -> bool:
+        """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?"""
+        escape = None if self.pose_free(start.x, start.y, start.yaw) else start
+        prev = start
+        for w in waypoints:
+            if not self.segment_free(prev, w, escape):
+                return False
+            prev = w
+        return self._exact_hit(start, waypoints, escape, exact_check) is None
+
+    def _exact_hit(self, start: BasePose, waypoints: list[BasePose], escape: Optional[BasePose],
+                   exact_check: Optional[PoseCheck]) -> Optional[tuple[float, float]]:
+        """The first (x, y) along the path where ``exact_check`` fails, or None."""
+        if exact_check is None:
+            return None
+        prev = start
+        for w in waypoints:
+            dist = math.hypot(w.x - prev.x, w.y - prev.y)
+            dyaw = _wrap(w.yaw - prev.yaw)
+            n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius) / EXACT_STEP)))
+            for i in range(1, n + 1):
+                s = i / n
+                x, y = prev.x + s * (w.x - prev.x), prev.y + s * (w.y - prev.y)
+                if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+                    continue
+                if not exact_check(x, y, prev.yaw + s * dyaw):
+                    return (x, y)
+            prev = w
+        return None
 
     def _astar(self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]],
                start_free: bool) -> Optional[list[tuple[int, int]]]:
