@@ -26,6 +26,8 @@ MIN_HEIGHT = 0.01
 #: Grid cell size [m] and the margin [m] of the grid around the environment.
 RESOLUTION = 0.05
 MAP_MARGIN = 2.0
+#: Height bands [m] of obstacles (see `FloorMap`).
+BAND = 0.1
 #: Directions along which outlines of many points are sampled (see `planar_extremes`).
 EXTREME_DIRECTIONS = 64
 
@@ -106,35 +108,37 @@ def _fill_polygon(mask: np.ndarray, origin: tuple[float, float], res: float, hul
 
 @dataclass(frozen=True)
 class FloorMap:
-    """A scene's floor: the grid geometry, the static occupancy and the movable geoms."""
+    """A scene's floor: the grid geometry, the static occupancy by height band and the movable
+    geoms.
+
+    Occupancy comes in bands by the height of the obstacles' tops (`BAND` steps): the part of
+    the robot below an obstacle's top must keep off it, so a counter keeps the base away while
+    the arms reach over it, and a wall keeps the whole robot away.
+    """
 
     origin: tuple[float, float]
     resolution: float
-    static: np.ndarray
+    static: dict[float, np.ndarray]  # band top [m] -> cells under static geoms of that band
     movable_geoms: tuple[int, ...]
     #: what to compare to notice that a movable geom moved: mocap ids and joint qpos addresses
     mocap_ids: tuple[int, ...]
     qpos_addresses: tuple[int, ...]
+    shape: tuple[int, int] = (0, 0)
+
+    def bands(self, model: mujoco.MjModel, data: mujoco.MjData) -> dict[float, np.ndarray]:
+        """Band top [m] -> occupied cells, static and movable (in the state of `data`,
+        kinematics computed), lowest band first."""
+        out = {top: mask.copy() for top, mask in self.static.items()}
+        for g in self.movable_geoms:
+            _add(out, self, model, data, g)
+        return dict(sorted(out.items()))
 
     def grid(self, model: mujoco.MjModel, data: mujoco.MjData) -> OccupancyGrid:
-        """The occupancy grid of the state in `data` (kinematics computed): static + movable."""
-        return OccupancyGrid(self.origin, self.resolution, self.static | self.movable(model, data))
-
-    def static_grid(self) -> OccupancyGrid:
-        return OccupancyGrid(self.origin, self.resolution, self.static)
-
-    def movable(self, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-        """The cells under movable parts in the state of `data` (kinematics computed)."""
-        mask = np.zeros_like(self.static)
-        for g in self.movable_geoms:
-            _rasterize(mask, self.origin, self.resolution, model, data, g)
-        return mask
-
-    def movable_top(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
-        """Height [m] of the highest movable part that can block the base (0 if none)."""
-        tops = [geom_vertices(model, data, g)[:, 2] for g in self.movable_geoms]
-        tops = [t.max() for t in tops if t.max() >= MIN_HEIGHT and t.min() <= MAX_HEIGHT]
-        return float(max(tops, default=0.0))
+        """The occupancy grid of the state in `data` (kinematics computed): all bands."""
+        mask = np.zeros(self.shape, bool)
+        for band in self.bands(model, data).values():
+            mask |= band
+        return OccupancyGrid(self.origin, self.resolution, mask)
 
     def movable_state(self, data: mujoco.MjData) -> np.ndarray:
         """The part of the state that moves movable geoms (to notice changes cheaply)."""
@@ -143,12 +147,19 @@ class FloorMap:
                                data.qpos[list(self.qpos_addresses)]])
 
 
-def _rasterize(mask: np.ndarray, origin: tuple[float, float], res: float, model: mujoco.MjModel,
-               data: mujoco.MjData, geom: int) -> None:
+def band_top(z: float) -> float:
+    """The top [m] of the height band of an obstacle whose top is at `z` [m]."""
+    return min(MAX_HEIGHT, math.ceil(z / BAND - 1e-9) * BAND)
+
+
+def _add(bands: dict[float, np.ndarray], floor: "FloorMap", model: mujoco.MjModel,
+         data: mujoco.MjData, geom: int) -> None:
+    """Rasterize `geom` into the band of its top (if it can touch the robot at all)."""
     verts = geom_vertices(model, data, geom)
     if verts[:, 2].max() < MIN_HEIGHT or verts[:, 2].min() > MAX_HEIGHT:
         return
-    _fill_polygon(mask, origin, res, convex_hull(verts[:, :2]))
+    mask = bands.setdefault(band_top(float(verts[:, 2].max())), np.zeros(floor.shape, bool))
+    _fill_polygon(mask, floor.origin, floor.resolution, convex_hull(verts[:, :2]))
 
 
 def _moves(model: mujoco.MjModel, body: int) -> bool:
@@ -173,9 +184,9 @@ def build_floor_map(scene: Scene, data: mujoco.MjData, resolution: float = RESOL
     lo, hi = allp[:, :2].min(axis=0) - margin, allp[:, :2].max(axis=0) + margin
     origin = (float(lo[0]), float(lo[1]))
     shape = (int(math.ceil((hi[1] - lo[1]) / resolution)), int(math.ceil((hi[0] - lo[0]) / resolution)))
-    mask = np.zeros(shape, bool)
+    floor = FloorMap(origin, resolution, {}, (), (), (), shape)
     for g in static:
-        _rasterize(mask, origin, resolution, model, data, g)
+        _add(floor.static, floor, model, data, g)
     mocaps, qadr = set(), set()
     for g in movable:
         b = int(model.geom_bodyid[g])
@@ -186,7 +197,8 @@ def build_floor_map(scene: Scene, data: mujoco.MjData, resolution: float = RESOL
                 qadr.update(range(int(model.jnt_qposadr[j]),
                                   int(model.jnt_qposadr[j]) + (7 if model.jnt_type[j] == 0 else 4 if model.jnt_type[j] == 1 else 1)))
             b = int(model.body_parentid[b])
-    return FloorMap(origin, resolution, mask, movable, tuple(sorted(mocaps)), tuple(sorted(qadr)))
+    return FloorMap(origin, resolution, dict(sorted(floor.static.items())), movable, tuple(sorted(mocaps)),
+                    tuple(sorted(qadr)), shape)
 
 
 def base_footprint(scene: Scene, data: mujoco.MjData) -> Footprint:
@@ -218,13 +230,14 @@ def robot_vertices(scene: Scene, directions: int = 500) -> dict[int, np.ndarray]
 def body_footprint(scene: Scene, data: mujoco.MjData, below: float = MAX_HEIGHT,
                    vertices: dict[int, np.ndarray] | None = None) -> Footprint:
     """The outline on the floor, in the base frame, of the whole robot as it stands in `data`
-    (arms included), counting only the parts of its collision geoms below `below` [m].
+    (arms included), counting only the parts of its collision geoms below `below` [m] (the
+    base always).
     `vertices`: `robot_vertices(scene)`, to save recomputing it."""
     model = scene.model
     mount = scene.body(scene.description.ROOT_LINK)
     rot, pos = data.xmat[mount].reshape(3, 3), data.xpos[mount]
-    pts = []
     vertices = vertices if vertices is not None else robot_vertices(scene)
+    pts = [planar_extremes(((geom_vertices(model, data, g) - pos) @ rot)[:, :2]) for g in scene.base_geoms]
     for g, local in vertices.items():
         verts = geom_vertices(model, data, g, local)
         verts = verts[verts[:, 2] <= below]

@@ -18,7 +18,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from pycram.world.navigation import Footprint, NoPathError, PathPlanner
+from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
 from pycram.world.prospection import BasePose
 
 from .controllers import BaseDrive, Controller, fail
@@ -67,22 +67,24 @@ class Navigation:
         rebuild it). The robot's outline is taken anew only with `refresh_outline` (or when
         something moved): drives take it when they plan.
 
-        The base's footprint keeps off the static furniture (the arms work over counters);
-        the outline of the whole robot as it stands (arms included, up to the height of the
-        highest movable part) keeps off movable obstacles (boxes, open doors)."""
+        Each height band of obstacles is kept off by the outline of the robot as it stands
+        (arms included) below that band's top: the base alone keeps off a counter whose top
+        the arms reach over, the whole robot keeps off walls and tall boxes."""
         state = self.floor.movable_state(eng.data)
         moved = self._state is None or float(np.abs(state - self._state).max(initial=0.0)) > MOVED
         if self._planner is not None and not moved and not refresh_outline:
             return self._planner, False
-        top = self.floor.movable_top(eng.model, eng.data)
-        body = body_footprint(eng.scene, eng.data, top + 0.02, self._robot_vertices) if top > 0.0 else self.footprint
-        outline = np.round(np.asarray(body.vertices).ravel(), 2)  # the arms' pose, to the cm
-        if (self._planner is not None and not moved and len(outline) == len(self._outline)
-                and float(np.abs(outline - self._outline).max()) <= MOVED):
+        bands = self.floor.bands(eng.model, eng.data)
+        outlines = {top: body_footprint(eng.scene, eng.data, top + 0.02, self._robot_vertices) for top in bands}
+        # the robot's pose, to the cm
+        key = np.round(np.concatenate([np.asarray(o.vertices).ravel() for o in outlines.values()]), 2)
+        if (self._planner is not None and not moved and key.shape == self._outline.shape
+                and float(np.abs(key - self._outline).max(initial=0.0)) <= MOVED):
             return self._planner, False
-        self._state, self._outline = state, outline
-        self._planner = PathPlanner(self.floor.static_grid(), self.footprint,
-                                    layers=[(self.floor.movable(eng.model, eng.data), body)])
+        self._state, self._outline = state, key
+        layers = [(mask, outlines[top]) for top, mask in bands.items()]
+        nothing = OccupancyGrid(self.floor.origin, self.floor.resolution, np.zeros(self.floor.shape, bool))
+        self._planner = PathPlanner(nothing, self.footprint, layers=layers)
         return self._planner, True
 
 

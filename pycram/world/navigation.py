@@ -57,7 +57,7 @@ ESCAPE_RADIUS = 0.15
 MAX_SEARCHES = 8
 #: Spacing [m] of the backend's exact checks along a path, and the half width [cells] of the
 #: square blocked around a spot where one failed.
-EXACT_STEP = 0.05
+EXACT_STEP = 0.1
 EXACT_BLOCK_CELLS = 3
 
 PoseCheck = Callable[[float, float, float], bool]
