@@ -221,27 +221,50 @@ def planar_extremes(points: np.ndarray, directions: int = EXTREME_DIRECTIONS) ->
     return points[np.unique(np.argmax(points @ dirs.T, axis=0))]
 
 
-def robot_vertices(scene: Scene, directions: int = 500) -> dict[int, np.ndarray]:
-    """Local points of each collision geom of the robot (see `local_vertices`), for
-    `body_footprint`; computed once per scene."""
-    return {g: local_vertices(scene.model, g, directions) for g in sorted(scene.robot_geoms | scene.base_geoms)}
+def robot_parts(scene: Scene, directions: int = 500) -> list[dict[int, np.ndarray]]:
+    """The robot's collision geoms in parts whose outlines are taken separately -- the base
+    with torso and head first, then each arm (the geoms below its first joint) -- each as
+    geom -> local points (see `local_vertices`); computed once per scene."""
+    model = scene.model
+    arm_bodies = []
+    for arm in scene.description.ARMS.values():
+        root = int(model.jnt_bodyid[scene.joint_id(arm["joints"][0])])
+        arm_bodies.append({b for b in range(model.nbody) if _descends(model, b, root)})
+    parts: list[dict[int, np.ndarray]] = [{} for _ in range(len(arm_bodies) + 1)]
+    for g in sorted(scene.robot_geoms | scene.base_geoms):
+        body = int(model.geom_bodyid[g])
+        k = next((i + 1 for i, bodies in enumerate(arm_bodies) if body in bodies), 0)
+        parts[k][g] = local_vertices(model, g, directions)
+    return parts
 
 
-def body_footprint(scene: Scene, data: mujoco.MjData, below: float = MAX_HEIGHT,
-                   vertices: dict[int, np.ndarray] | None = None) -> Footprint:
-    """The outline on the floor, in the base frame, of the whole robot as it stands in `data`
-    (arms included), counting only the parts of its collision geoms below `below` [m] (the
-    base always).
-    `vertices`: `robot_vertices(scene)`, to save recomputing it."""
+def _descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
+    while body > 0:
+        if body == ancestor:
+            return True
+        body = int(model.body_parentid[body])
+    return False
+
+
+def body_outline(scene: Scene, data: mujoco.MjData, below: float, parts: list[dict[int, np.ndarray]]
+                 ) -> list[Footprint]:
+    """The outline on the floor, in the base frame, of the robot as it stands in `data`: one
+    convex footprint per part of `robot_parts` (the base's first, always including the base
+    geoms), counting only the parts of the geoms below `below` [m]."""
     model = scene.model
     mount = scene.body(scene.description.ROOT_LINK)
     rot, pos = data.xmat[mount].reshape(3, 3), data.xpos[mount]
-    vertices = vertices if vertices is not None else robot_vertices(scene)
-    pts = [planar_extremes(((geom_vertices(model, data, g) - pos) @ rot)[:, :2]) for g in scene.base_geoms]
-    for g, local in vertices.items():
-        verts = geom_vertices(model, data, g, local)
-        verts = verts[verts[:, 2] <= below]
-        if len(verts):
-            pts.append(planar_extremes(((verts - pos) @ rot)[:, :2]))
-    hull = convex_hull(planar_extremes(np.vstack(pts)))
-    return Footprint(tuple((float(x), float(y)) for x, y in hull))
+    out = []
+    for k, part in enumerate(parts):
+        pts = []
+        for g, local in part.items():
+            verts = geom_vertices(model, data, g, local)
+            if not (k == 0 and g in scene.base_geoms):
+                verts = verts[verts[:, 2] <= below]
+            if len(verts):
+                pts.append(planar_extremes(((verts - pos) @ rot)[:, :2]))
+        if pts:
+            hull = convex_hull(planar_extremes(np.vstack(pts)))
+            if len(hull) >= 3:
+                out.append(Footprint(tuple((float(x), float(y)) for x, y in hull)))
+    return out

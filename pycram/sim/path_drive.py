@@ -23,7 +23,7 @@ from pycram.world.prospection import BasePose
 
 from .controllers import BaseDrive, Controller, fail
 from .engine import Engine
-from .occupancy import FloorMap, base_footprint, body_footprint, build_floor_map, robot_vertices
+from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, robot_parts
 from .prospection import SimProspection
 from .recording import StateSnapshot
 from .robot_model import BASE_JOINTS
@@ -49,10 +49,11 @@ class Navigation:
         self.footprint: Footprint = base_footprint(eng.scene, eng.data)
         self._state: Optional[np.ndarray] = None
         self._outline = np.zeros(0)
-        self._robot_vertices = robot_vertices(eng.scene)
+        self._robot_parts = robot_parts(eng.scene)
         self._planner: Optional[PathPlanner] = None
         self._robot_state = StateSnapshot.of(eng.data)
-        self._prospection = SimProspection(eng.scene, lambda: self._robot_state)
+        # no tolerance: a drive fails on any contact
+        self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=0.0)
 
     def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
         """Whether the whole robot, in its configuration now, touches nothing of the environment
@@ -75,9 +76,9 @@ class Navigation:
         if self._planner is not None and not moved and not refresh_outline:
             return self._planner, False
         bands = self.floor.bands(eng.model, eng.data)
-        outlines = {top: body_footprint(eng.scene, eng.data, top + 0.02, self._robot_vertices) for top in bands}
+        outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, self._robot_parts) for top in bands}
         # the robot's pose, to the cm
-        key = np.round(np.concatenate([np.asarray(o.vertices).ravel() for o in outlines.values()]), 2)
+        key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
         if (self._planner is not None and not moved and key.shape == self._outline.shape
                 and float(np.abs(key - self._outline).max(initial=0.0)) <= MOVED):
             return self._planner, False

@@ -85,14 +85,17 @@ class _Arm:
 
 
 class SimProspection(Prospection):
-    """Prospection for the robot of `scene`, on the states returned by `snapshot()`.
+    """Prospection for the robot of `scene`, on the states returned by `snapshot()`;
+    contacts penetrating less than `tolerance` [m] are not collisions.
 
     `snapshot` must return the latest `StateSnapshot` published by the simulation thread (a
     reference read is enough: snapshots are immutable once published).
     """
 
-    def __init__(self, scene: Scene, snapshot: Callable[[], StateSnapshot]) -> None:
+    def __init__(self, scene: Scene, snapshot: Callable[[], StateSnapshot],
+                 tolerance: float = COLLISION_TOLERANCE) -> None:
         self.scene = scene
+        self.tolerance = tolerance
         self.model = scene.model
         self._snapshot = snapshot
         self._pool: "queue.SimpleQueue[mujoco.MjData]" = queue.SimpleQueue()
@@ -170,7 +173,7 @@ class SimProspection(Prospection):
         g1, g2 = geoms[:, 0], geoms[:, 1]
         hit1 = self._is_robot[g1] & self._is_env[g2]
         hit2 = self._is_robot[g2] & self._is_env[g1]
-        sel = (hit1 | hit2) & (dist < -COLLISION_TOLERANCE)
+        sel = (hit1 | hit2) & (dist < -self.tolerance)
         out: dict[tuple[str, str], None] = {}
         for i in np.nonzero(sel)[0]:
             a, b = (int(g1[i]), int(g2[i])) if hit1[i] else (int(g2[i]), int(g1[i]))

@@ -184,43 +184,63 @@ def _wrap(a: float) -> float:
 
 
 class _Layer:
-    """Occupied cells that one footprint must keep off (e.g. furniture: the base; movable
-    obstacles: the whole robot as it stands)."""
+    """Occupied cells that one outline must keep off (e.g. counters: the base; walls and boxes:
+    the whole robot as it stands). The outline is one convex footprint or several (their
+    union, e.g. the base and each arm); the first contains the base origin."""
 
-    def __init__(self, mask: np.ndarray, footprint: Footprint, grid: OccupancyGrid, margin: float) -> None:
-        self.mask, self.footprint = mask, footprint
-        self.normals, self.offsets = footprint._edges()
+    def __init__(self, mask: np.ndarray, outline: "Footprint | Sequence[Footprint]", grid: OccupancyGrid,
+                 margin: float) -> None:
+        parts = [outline] if isinstance(outline, Footprint) else list(outline)
+        self.mask = mask
+        self.edges = [part._edges() for part in parts]
+        self.inscribed = parts[0].inscribed_radius
+        self.circumscribed = max(part.circumscribed_radius for part in parts)
         rows, cols = np.nonzero(mask)
         res = grid.resolution
         self.occ_xy = np.column_stack([grid.origin[0] + (cols + 0.5) * res, grid.origin[1] + (rows + 0.5) * res])
-        self.reach = footprint.circumscribed_radius + margin
+        self.reach = self.circumscribed + margin
 
-    def free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float) -> bool:
-        """Whether the footprint, grown by `margin`, at every pose misses every occupied cell."""
+    def hits(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+        """Per pose: does the outline's first part (around the base), grown by `margin`, cover
+        an occupied cell; does another part?"""
+        base, other = np.zeros(len(xs), bool), np.zeros(len(xs), bool)
         reach, occ = self.reach, self.occ_xy
         near = ((occ[:, 0] >= xs.min() - reach) & (occ[:, 0] <= xs.max() + reach)
                 & (occ[:, 1] >= ys.min() - reach) & (occ[:, 1] <= ys.max() + reach))
         occ = occ[near]
         if occ.size == 0:
-            return True
+            return base, other
         dx = occ[None, :, 0] - xs[:, None]  # poses x occupied cells
         dy = occ[None, :, 1] - ys[:, None]
         pose, cell = np.nonzero(dx * dx + dy * dy <= reach * reach)
         if pose.size == 0:
-            return True
+            return base, other
         c, s = np.cos(yaws[pose]), np.sin(yaws[pose])
         px, py = dx[pose, cell], dy[pose, cell]
         bx, by = c * px + s * py, -s * px + c * py  # into the base frame
-        d = np.outer(bx, self.normals[:, 0]) + np.outer(by, self.normals[:, 1]) - self.offsets
-        return not bool(np.any(np.all(d <= margin, axis=1)))
+        for k, (normals, offsets) in enumerate(self.edges):
+            d = np.outer(bx, normals[:, 0]) + np.outer(by, normals[:, 1]) - offsets
+            (base if k == 0 else other)[pose[np.all(d <= margin, axis=1)]] = True
+        return base, other
+
+
+@dataclass(frozen=True)
+class _Query:
+    """What one `PathPlanner.plan` call checks with: the start to move off unchecked (or None)
+    and the backend's exact check (or None)."""
+
+    escape: Optional[BasePose]
+    exact: Optional["PoseCheck"]
 
 
 class PathPlanner:
     """Plans base paths on ``grid`` for a robot with ``footprint``, keeping ``clearance`` [m].
 
-    ``layers``: more occupied masks (same shape as the grid), each with the footprint that must
-    keep off it -- e.g. movable obstacles that the whole robot, arms included, must pass, while
-    the base alone must keep off the furniture the arms reach over. ``grid`` (attribute) is the
+    ``layers``: more occupied masks (same shape as the grid), each with the outline that must
+    keep off it (a footprint, or several whose union it is, the first around the base origin)
+    -- e.g. walls that the whole robot, arms included, must pass, while the base alone must
+    keep off the counters the arms reach over. ``grid`` (attribute) is the
     union of all. Construction inflates the grid (a few ms); :meth:`plan` is then a pure function of its
     arguments (thread-safe, deterministic). ``cost_weight`` is the extra cost per cell [m/m]
     of passing where the footprint fits only at some headings.
@@ -228,7 +248,7 @@ class PathPlanner:
 
     def __init__(self, grid: OccupancyGrid, footprint: Footprint, clearance: float = 0.03,
                  cost_weight: float = 2.0,
-                 layers: Sequence[tuple[np.ndarray, Footprint]] = ()) -> None:
+                 layers: Sequence[tuple[np.ndarray, "Footprint | Sequence[Footprint]"]] = ()) -> None:
         res = grid.resolution
         # a cell is marked when its centre is under an obstacle: the obstacle may reach half a
         # cell diagonal further, so checks add that to the clearance
@@ -246,22 +266,23 @@ class PathPlanner:
         self._sure_hit = np.zeros_like(occupied)
         sure_not_free = np.zeros_like(occupied)
         for layer in self._layers:
-            fp, m = layer.footprint, layer.mask
-            self.lethal |= dilate(m, (fp.inscribed_radius + self._margin) / res)
-            self.caution |= dilate(m, (fp.circumscribed_radius + self._margin) / res)
+            m = layer.mask
+            self.lethal |= dilate(m, (layer.inscribed + self._margin) / res)
+            self.caution |= dilate(m, (layer.circumscribed + self._margin) / res)
             # for single poses anywhere in a cell (up to half a diagonal from its centre)
-            self._sure_hit |= dilate(m, (fp.inscribed_radius + self._margin - half) / res)
-            sure_not_free |= dilate(m, (fp.circumscribed_radius + self._margin + half) / res)
+            self._sure_hit |= dilate(m, (layer.inscribed + self._margin - half) / res)
+            sure_not_free |= dilate(m, (layer.circumscribed + self._margin + half) / res)
         self._sure_free = ~sure_not_free
-        self._turn_radius = max(layer.footprint.circumscribed_radius for layer in self._layers)
+        self._turn_radius = max(layer.circumscribed for layer in self._layers)
 
     # ------------------------------------------------------------------ checks
-    def pose_free(self, x: float, y: float, yaw: float) -> bool:
+    def pose_free(self, x: float, y: float, yaw: float, exact_check: Optional["PoseCheck"] = None) -> bool:
         """Does the footprint at (x, y, yaw), grown by the clearance, stay off occupied cells?
         Off-map poses count as free (nothing is known there)."""
-        return self._free(np.array([x], float), np.array([y], float), np.array([yaw], float))
+        return self._free(np.array([x], float), np.array([y], float), np.array([yaw], float), exact_check)
 
-    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray) -> bool:
+    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray,
+              exact_check: Optional["PoseCheck"] = None) -> bool:
         """Whether every pose (xs[i], ys[i], yaws[i]) is free (see `pose_free`)."""
         g = self.grid
         rows = np.floor((ys - g.origin[1]) / g.resolution).astype(int)
@@ -274,9 +295,20 @@ class PathPlanner:
         if unsure.size == 0:
             return True
         xs, ys, yaws = xs[unsure], ys[unsure], yaws[unsure]
-        return all(layer.free(xs, ys, yaws, self._margin) for layer in self._layers)
+        hit = np.zeros(len(xs), bool)
+        for layer in self._layers:
+            base, other = layer.hits(xs, ys, yaws, self._margin)
+            if base.any():
+                return False
+            hit |= other
+        if exact_check is None:
+            return not hit.any()
+        # the outlines of the other parts (arms) are convex hulls, larger than the arms: where
+        # only they are in the way, the backend's exact check decides
+        return all(exact_check(float(xs[i]), float(ys[i]), float(yaws[i])) for i in np.nonzero(hit)[0])
 
-    def segment_free(self, a: BasePose, b: BasePose, escape: Optional[BasePose] = None) -> bool:
+    def segment_free(self, a: BasePose, b: BasePose, escape: Optional[BasePose] = None,
+                     exact_check: Optional["PoseCheck"] = None) -> bool:
         """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?
         Poses within `ESCAPE_RADIUS` of ``escape`` are not checked."""
         dist = math.hypot(b.x - a.x, b.y - a.y)
@@ -289,7 +321,7 @@ class PathPlanner:
         if escape is not None:
             keep = np.hypot(xs - escape.x, ys - escape.y) >= ESCAPE_RADIUS
             xs, ys, yaws = xs[keep], ys[keep], yaws[keep]
-        return self._free(xs, ys, yaws)
+        return self._free(xs, ys, yaws, exact_check)
 
     # ------------------------------------------------------------------ planning
     def plan(self, start: object, goal: object, exact_check: Optional[PoseCheck] = None) -> list[BasePose]:
@@ -302,10 +334,11 @@ class PathPlanner:
         """
         a, b = as_base_pose(start), as_base_pose(goal)
         g = self.grid
-        if not self.pose_free(b.x, b.y, b.yaw) or (exact_check is not None and not exact_check(b.x, b.y, b.yaw)):
+        if not self.pose_free(b.x, b.y, b.yaw, exact_check):
             raise NoPathError("goal_in_collision", f"the robot does not fit at the goal "
                               f"(x={b.x:.2f}, y={b.y:.2f}, yaw={b.yaw:.2f})", a, b)
-        escape = None if self.pose_free(a.x, a.y, a.yaw) else a
+        escape = None if self.pose_free(a.x, a.y, a.yaw, exact_check) else a
+        ctx = _Query(escape, exact_check)
         if self.path_free(a, [b], exact_check):
             return [b]
         sc, gc = g.cell(a.x, a.y), g.cell(b.x, b.y)
@@ -319,7 +352,7 @@ class PathPlanner:
             if cells is None:
                 raise NoPathError("no_path", f"no collision-free path from (x={a.x:.2f}, y={a.y:.2f}) to "
                                   f"(x={b.x:.2f}, y={b.y:.2f})", a, b)
-            path, misfits = self._shorten(a, b, cells, escape)
+            path, misfits = self._shorten(a, b, cells, ctx)
             if not misfits:
                 hit = self._exact_hit(a, path, escape, exact_check)
                 if hit is None:
@@ -334,10 +367,10 @@ class PathPlanner:
     def path_free(self, start: BasePose, waypoints: list[BasePose],
                   exact_check: Optional[PoseCheck] = None) -> bool:
         """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?"""
-        escape = None if self.pose_free(start.x, start.y, start.yaw) else start
+        escape = None if self.pose_free(start.x, start.y, start.yaw, exact_check) else start
         prev = start
         for w in waypoints:
-            if not self.segment_free(prev, w, escape):
+            if not self.segment_free(prev, w, escape, exact_check):
                 return False
             prev = w
         return self._exact_hit(start, waypoints, escape, exact_check) is None
@@ -417,7 +450,7 @@ class PathPlanner:
         return None
 
     def _shorten(self, a: BasePose, b: BasePose, cells: list[tuple[int, int]],
-                 escape: Optional[BasePose]) -> tuple[list[BasePose], set[tuple[int, int]]]:
+                 ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
         """Poses along the cell path, shortened greedily, or the cells to block and search again.
 
         Headings: the first of these profiles in which every step of the cell path is free --
@@ -434,32 +467,32 @@ class PathPlanner:
         profiles = (lambda s: a.yaw + dyaw * s, lambda s: a.yaw + dyaw, lambda s: a.yaw)
         fewest: Optional[set[tuple[int, int]]] = None
         for profile in profiles:
-            poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, escape)
+            poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, ctx)
             if not bad:
-                return self._greedy(poses, escape), bad
+                return self._greedy(poses, ctx), bad
             if fewest is None or len(bad) < len(fewest):
                 fewest = bad
         return [], fewest or set()
 
     def _headed(self, a: BasePose, b: BasePose, pts: list[tuple[float, float]], lengths: list[float],
                 total: float, cells: list[tuple[int, int]], profile: Callable[[float], float],
-                escape: Optional[BasePose]) -> tuple[list[BasePose], set[tuple[int, int]]]:
+                ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
         poses = [a]
         bad: set[tuple[int, int]] = set()
         for i in range(1, len(pts) - 1):
             (x, y), yaw = pts[i], profile(lengths[i] / total)
-            fitting = self._fitting_yaw(x, y, yaw, escape)
+            fitting = self._fitting_yaw(x, y, yaw, ctx)
             if fitting is None:
                 bad.add(cells[i])
             poses.append(BasePose(x, y, yaw if fitting is None else fitting))
         poses.append(b)
         if not bad:
             for i in range(len(poses) - 1):  # every raw step must be free (turns included)
-                if not self.segment_free(poses[i], poses[i + 1], escape):
+                if not self.segment_free(poses[i], poses[i + 1], ctx.escape, ctx.exact):
                     bad.update(cells[j] for j in (i, i + 1) if 0 < j < len(cells) - 1)
         return poses, bad
 
-    def _greedy(self, poses: list[BasePose], escape: Optional[BasePose]) -> list[BasePose]:
+    def _greedy(self, poses: list[BasePose], ctx: "_Query") -> list[BasePose]:
         """From each pose on, a far later pose reachable on a free straight segment: the last
         pose if it is, else one found by bisection (free, with the next one not free from
         there). Consecutive poses are known to be connected by free segments."""
@@ -467,11 +500,11 @@ class PathPlanner:
         i, n = 0, len(poses)
         while i < n - 1:
             lo, hi = i + 1, n - 1
-            if self.segment_free(poses[i], poses[hi], escape):
+            if self.segment_free(poses[i], poses[hi], ctx.escape, ctx.exact):
                 lo = hi
             while hi - lo > 1:
                 mid = (lo + hi) // 2
-                if self.segment_free(poses[i], poses[mid], escape):
+                if self.segment_free(poses[i], poses[mid], ctx.escape, ctx.exact):
                     lo = mid
                 else:
                     hi = mid
@@ -479,14 +512,15 @@ class PathPlanner:
             i = lo
         return out
 
-    def _fitting_yaw(self, x: float, y: float, yaw: float, escape: Optional[BasePose]) -> Optional[float]:
+    def _fitting_yaw(self, x: float, y: float, yaw: float, ctx: "_Query") -> Optional[float]:
         """`yaw` if the footprint fits there at it, else the nearest heading (in steps of
         pi/16) that fits, else None."""
+        escape = ctx.escape
         if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
             return yaw
         for k in range(17):
             for sign in ((1,) if k == 0 else (1, -1)):
                 candidate = yaw + sign * k * math.pi / 16
-                if self.pose_free(x, y, candidate):
+                if self.pose_free(x, y, candidate, ctx.exact):
                     return candidate
         return None
