@@ -229,7 +229,7 @@ def robot_parts(scene: Scene, directions: int = 500) -> list[dict[int, np.ndarra
     arm_bodies = []
     for arm in scene.description.ARMS.values():
         root = int(model.jnt_bodyid[scene.joint_id(arm["joints"][0])])
-        arm_bodies.append({b for b in range(model.nbody) if _descends(model, b, root)})
+        arm_bodies.append({b for b in range(model.nbody) if descends(model, b, root)})
     parts: list[dict[int, np.ndarray]] = [{} for _ in range(len(arm_bodies) + 1)]
     for g in sorted(scene.robot_geoms | scene.base_geoms):
         body = int(model.geom_bodyid[g])
@@ -238,7 +238,8 @@ def robot_parts(scene: Scene, directions: int = 500) -> list[dict[int, np.ndarra
     return parts
 
 
-def _descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
+def descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
+    """Whether `body` is `ancestor` or below it in the kinematic tree."""
     while body > 0:
         if body == ancestor:
             return True

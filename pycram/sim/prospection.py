@@ -8,8 +8,9 @@ from a pool (one per concurrently asking thread, created on demand, reused after
 it never touches the simulation thread's `MjData` and never copies the world. The model is
 shared read-only (MuJoCo only reads it in kinematics, collision detection and ray casts).
 
-Costs on this machine (PR2 in the thesis kitchen, one thread): a collision check ~0.05 ms, a
-reachability check of 3 poses ~1-5 ms, a visibility check ~0.2 ms (see
+Costs on this machine (PR2 in the thesis kitchen, one thread, simulation paused): a collision
+check ~0.1 ms, a reachability check of 3 poses ~1-5 ms (more when it fails), a visibility
+check ~0.5 ms; with the simulation running beside it, about half as many per second (see
 `benchmarks/prospection.py`).
 """
 
@@ -27,6 +28,7 @@ from pycram.world.prospection import (Prospection, Reachability, ToolPose, Visib
                                       as_tool_pose)
 
 from .ik import dls_ik
+from .occupancy import descends
 from .recording import StateSnapshot
 from .robot_model import BASE_JOINTS, HEAD_CAMERA, tool_site
 from .scene import Scene
@@ -46,14 +48,6 @@ IK_ITERATIONS = 100
 IK_STALL = 15
 #: IK: after this many solutions that all collide, the pose counts as "collision".
 MAX_COLLIDING_SOLUTIONS = 3
-
-
-def _descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
-    while body > 0:
-        if body == ancestor:
-            return True
-        body = int(model.body_parentid[body])
-    return False
 
 
 class _Arm:
@@ -122,7 +116,7 @@ class SimProspection(Prospection):
         self._target_geoms: dict[str, list[int]] = {}
         # geoms that move with the camera (the head it is mounted on): never occluders
         tilt_body = int(m.jnt_bodyid[self._head_jids[1]])
-        head_bodies = {b for b in range(m.nbody) if _descends(m, b, tilt_body)}
+        head_bodies = {b for b in range(m.nbody) if descends(m, b, tilt_body)}
         self._is_head = np.array([int(m.geom_bodyid[g]) in head_bodies for g in range(m.ngeom)], bool)
         with self._data() as d:
             self._measure_reach(d)

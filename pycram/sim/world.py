@@ -260,6 +260,7 @@ class World:
 
     def _publish(self) -> None:
         eng = self._engine
+        self._state = StateSnapshot.of(eng.data)  # first: whoever a fluent wakes sees this state
         self.sim_time.set_value(eng.time)
         self.base_pose.set_value(eng.base_pose())
         self.joint_states.set_value(eng.joint_states())
@@ -269,7 +270,6 @@ class World:
             self.gripper_openings[g].set_value(state.opening)
         self.tool_poses.set_value(self._tool_poses())
         self.item_poses.set_value(self._item_poses())
-        self._state = StateSnapshot.of(eng.data)
 
     # ------------------------------------------------------------------ submitting
     def submit(self, ctrl: Controller, name: str) -> CommandHandle:

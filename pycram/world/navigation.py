@@ -15,8 +15,16 @@ How a path is planned
 3. The A* cell path gets headings (a uniform turn by path length, or turning at the start, or
    at the end, whichever is free; where the footprint does not fit at the profile's heading,
    the nearest heading that fits) and is shortened greedily: from each waypoint a far later
-   waypoint reachable on a straight, footprint-checked segment is taken (found by bisection). Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells
-   where the footprint fits at no heading are blocked and A* searches again.
+   waypoint reachable on a straight, footprint-checked segment is taken (found by bisection).
+   Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells where
+   the footprint fits at no heading are blocked and A* searches again.
+
+Obstacles may come in layers, each kept off by its own outline of the robot (the sim backend
+uses height bands: the base alone keeps off a counter the arms reach over, the robot with its
+arms keeps off walls and tall boxes). A backend may add an exact check of poses
+(``exact_check``): where only the convex outline of an arm is in the way it decides, and it
+validates the final path every `EXACT_STEP`.
+
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
 question gives the same path, which tests and traces rely on), and "no path exists" is a
