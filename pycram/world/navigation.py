@@ -37,7 +37,6 @@ Failures: :class:`NoPathError` (a :class:`NavigationFailure`) with ``reason`` ``
 from __future__ import annotations
 
 import heapq
-import logging
 import math
 from dataclasses import dataclass
 from typing import Callable, Optional, Sequence
@@ -54,8 +53,6 @@ __all__ = [
     "PathPlanner",
     "dilate",
 ]
-
-_log = logging.getLogger(__name__)
 
 SQRT2 = math.sqrt(2.0)
 #: A robot that already touches something may move this far [m] from its start unchecked, to
@@ -116,10 +113,6 @@ class OccupancyGrid:
 
     def inside(self, row: int, col: int) -> bool:
         return 0 <= row < self.occupied.shape[0] and 0 <= col < self.occupied.shape[1]
-
-    def union(self, other: np.ndarray) -> "OccupancyGrid":
-        """A grid occupied where this one or the mask ``other`` (same shape) is."""
-        return OccupancyGrid(self.origin, self.resolution, self.occupied | other)
 
 
 @dataclass(frozen=True)
