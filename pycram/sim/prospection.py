@@ -156,18 +156,20 @@ class SimProspection(Prospection):
                 d.qpos[adr] = float(value)
         mujoco.mj_kinematics(self.model, d)
 
-    def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
-        """Distinct (robot part, environment part) pairs that touch in `d` (kinematics computed)."""
+    def _touching(self, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Collision detection on `d` (kinematics computed): contact geoms (g1, g2), whether g1
+        is the robot's one, and which contacts are robot-environment collisions."""
         mujoco.mj_collision(self.model, d)
         n = d.ncon
-        if n == 0:
-            return []
         geoms = d.contact.geom[:n]
-        dist = d.contact.dist[:n]
         g1, g2 = geoms[:, 0], geoms[:, 1]
         hit1 = self._is_robot[g1] & self._is_env[g2]
         hit2 = self._is_robot[g2] & self._is_env[g1]
-        sel = (hit1 | hit2) & (dist < -self.tolerance)
+        return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -self.tolerance)
+
+    def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
+        """Distinct (robot part, environment part) pairs that touch in `d` (kinematics computed)."""
+        g1, g2, hit1, sel = self._touching(d)
         out: dict[tuple[str, str], None] = {}
         for i in np.nonzero(sel)[0]:
             a, b = (int(g1[i]), int(g2[i])) if hit1[i] else (int(g2[i]), int(g1[i]))
@@ -187,7 +189,9 @@ class SimProspection(Prospection):
 
     def in_collision(self, base_pose: Any,
                      joint_configuration: Optional[Mapping[str, float]] = None) -> bool:
-        return bool(self.collisions(base_pose, joint_configuration))
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            return bool(self._touching(d)[3].any())
 
     # ------------------------------------------------------------------ reachability
     def _measure_reach(self, d: mujoco.MjData) -> None:
