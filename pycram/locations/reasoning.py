@@ -64,10 +64,6 @@ VOCABULARY = frozenset({"to_reach", "to_see", "to_open", "on", "in", "arm", "gra
 #: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
 #: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
 BASE_CLEARANCE = 0.1
-#: The arm must reach this much [m] below the grasp pose too, without touching anything: the
-#: executed motion passes through configurations IK did not check (prospection allows contacts
-#: of a little over 1 cm).
-CONTACT_MARGIN = 0.015
 #: Candidates checked with prospection per designator before giving up.
 MAX_CANDIDATES = 100
 #: Distance [m] between two solutions of one designator (base poses or spots).
@@ -238,9 +234,10 @@ class LocationReasoner:
                 point = self._grasp_point(target, grasp)
                 poses = grasp_sequence(self.geometry, point, yaw if grasp.approach != "top" else heading,
                                        grasp.approach, action)
-                if action == "grasp" and CONTACT_MARGIN:  # room to spare below the grasp
+                margin = self.geometry.contact_margin
+                if action == "grasp" and margin:  # room to spare below the grasp
                     (gx, gy, gz), q = poses[1]
-                    poses.insert(2, ((gx, gy, gz - CONTACT_MARGIN), q))
+                    poses.insert(2, ((gx, gy, gz - margin), q))
                 answer = prosp.reachable(arm, poses, (x, y, yaw), raised)
                 if answer:
                     return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=answer.solutions), None

@@ -26,7 +26,9 @@ class RobotGeometry:
     frame where a point to reach lies comfortably. `approach_offsets`: phase -> (back along the
     approach [m], up [m]). `tucked`: joint name -> position of every arm's park configuration.
     `ready` per arm: the configuration the arm is raised to before it approaches (``carry``: over
-    the furniture), joint name -> position.
+    the furniture), joint name -> position. `contact_margin` [m]: how far below a grasp pose the
+    arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
+    pass through configurations IK did not check).
     """
 
     name: str
@@ -40,6 +42,7 @@ class RobotGeometry:
     tucked: Mapping[str, float]
     arm_joints: Mapping[str, tuple[str, ...]]
     ready: Mapping[str, Mapping[str, float]] = None  # type: ignore[assignment]
+    contact_margin: float = 0.0
 
     @classmethod
     def from_description(cls, d: Any) -> "RobotGeometry":
@@ -58,7 +61,8 @@ class RobotGeometry:
                    approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
                    tucked=tucked, arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()},
                    ready={a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry"]))
-                          for a, s in d.ARMS.items() if "carry" in d.ARM_CONFIGURATIONS[a]})
+                          for a, s in d.ARMS.items() if "carry" in d.ARM_CONFIGURATIONS[a]},
+                   contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)))
 
     def arm(self, name: Any) -> str:
         """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""
