@@ -69,7 +69,7 @@ MAX_CANDIDATES = 100
 #: Distance [m] between two solutions of one designator (base poses or spots).
 SPACING = 0.1
 #: Cells closer than this [m] to a candidate that failed for the same arm are not checked (the
-#: grid's neighbours, diagonals included: their answer is almost always the same).
+#: cells around it: their answer is almost always the same).
 FAILED_SPACING = 0.075
 #: Spots on surfaces: grid cell [m], free space [m] to other objects and to the surface's edge.
 SPOT_RESOLUTION = 0.02
