@@ -203,3 +203,25 @@ def test_a_full_surface_says_it_is_occupied():
     with rs, pytest.raises(NoSolutionError, match=r"no free spot for a plate .* on cooker #1: \d+ candidates: "
                                                    r"\d+ too close to the edge$"):
         LocationDesignator([("on", "cooker #1"), ("for", "plate")]).reference()
+
+
+def test_to_open_stands_clear_of_the_opening_and_follows_the_handle():
+    asked = []
+
+    class Recording(ScriptedProspection):
+        def reachable(self, arm, poses, pose, configuration=None):
+            asked.append([p[0] for p in poses])
+            return Answer()
+
+    rs, _ = resolver_set(prospection=Recording())
+    fridge = APARTMENT.container("fridge")
+    with rs:
+        door = LocationDesignator([("to_open", "fridge")]).reference()
+        drawer = LocationDesignator([("to_open", "drawer 3"), ("opening", 0.2)]).reference()
+    hx, hy = fridge.hinge
+    assert math.hypot(door.x - hx, door.y - hy) > 0.7 + 0.335  # outside the door's swing
+    assert door.grasp == "handle"
+    handle_path = asked[0][1:]
+    assert handle_path[0] == pytest.approx(fridge.handle) and handle_path[-1] == pytest.approx(fridge.handle_position(1.2))
+    assert drawer.x > 0.6 + 0.2 + 0.335  # in front of the drawer pulled out 0.2 m
+    assert asked[-1][-1] == pytest.approx(APARTMENT.container("drawer 3").handle_position(0.2))
