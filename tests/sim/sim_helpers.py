@@ -17,6 +17,18 @@ from pycram.sim.controllers import Controller
 T = 60.0  # generous simulated-time limit for a single command [s]
 
 
+def settle(world: Any, seconds: float) -> None:
+    """Wait until `seconds` of simulated time have passed (physics settles)."""
+    t = world.sim_time.get_value() + seconds
+    assert (world.sim_time >= t).wait_for(seconds + 10.0)
+
+
+def tilt(orientation: Any) -> float:
+    """Angle [rad] between the z axis of a body with `orientation` (w, x, y, z) and the vertical."""
+    w, x, y, z = orientation
+    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
+
+
 def ok(handle: Any, timeout: float = T) -> Any:
     """Wait for a command handle; assert it succeeded; return its value."""
     out = handle.wait(timeout)

@@ -11,19 +11,9 @@ import pytest
 from pycram.sim import ItemSpec, World
 from pycram.world.objects import object_type
 from pycram.world.scenes import random_scene
-from sim_helpers import ok
+from sim_helpers import ok, settle, tilt
 
 BREAKFAST = ["cup", "bowl", "spoon", "cereal", "milk", "plate"]
-
-
-def _wait(world, seconds):
-    t = world.sim_time.get_value() + seconds
-    assert (world.sim_time >= t).wait_for(seconds + 5.0)
-
-
-def _tilt(q):
-    w, x, y, z = q
-    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
@@ -31,12 +21,12 @@ def test_objects_of_a_random_scene_settle_where_they_were_placed(seed):
     with World("tiago", environment="apartment", seed=seed, objects=BREAKFAST + ["cup", "bowl"]) as world:
         assert [p.name for p in world.placements] == BREAKFAST + ["cup 2", "bowl 2"]
         assert {it.name for it in world.scene.items} == {p.name for p in world.placements}
-        _wait(world, 2.0)
+        settle(world, 2.0)
         poses = world.item_poses.get_value()
         for p in world.placements:
             pose = poses[p.name]
             assert math.dist(pose.position, p.position) < 0.01, (seed, p, pose)
-            assert _tilt(pose.orientation) < math.radians(3), (seed, p)
+            assert tilt(pose.orientation) < math.radians(3), (seed, p)
 
 
 def test_the_same_seed_builds_the_same_world():
@@ -60,17 +50,17 @@ def test_objects_in_a_drawer_ride_out_with_it():
     scene = random_scene(apartment, ["cup", "spoon", "bowl"], seed=4, supports=["drawer 2 inside"])
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in scene]
     with World("pr2", items, environment="apartment") as world:
-        _wait(world, 1.0)
+        settle(world, 1.0)
         before = world.item_poses.get_value()
         ok(world.push_container("drawer 2", (40.0, 0.0, 0.0), 0.4))
-        _wait(world, 1.0)
+        settle(world, 1.0)
         opened = world.container_states.get_value()["drawer 2"]
         assert opened > 0.08
         after = world.item_poses.get_value()
         for p in scene:  # carried along by friction, still upright in the drawer
             dx = after[p.name].position[0] - before[p.name].position[0]
             assert dx == pytest.approx(opened, abs=0.02), p.name
-            assert _tilt(after[p.name].orientation) < math.radians(5), p.name
+            assert tilt(after[p.name].orientation) < math.radians(5), p.name
 
 
 def test_the_head_camera_sees_a_bowl_made_of_several_parts():

@@ -28,6 +28,7 @@ from pycram.designators.core import NoSolutionError  # noqa: E402
 from pycram.locations import KnownObject, Spot  # noqa: E402
 from pycram.sim import World  # noqa: E402
 from pycram.world.objects import object_type  # noqa: E402
+from sim_helpers import settle, tilt  # noqa: E402
 
 T = 60.0
 #: (robot, seed, object): scenes of `random_scene(apartment, ["cup", "milk", "bowl"], seed)` with
@@ -47,17 +48,6 @@ def believed(world, name):
     yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     item = world.scene.item(name)
     return KnownObject(name, item.type, tuple(pose.position), yaw)
-
-
-def settle(world, seconds):
-    t = world.sim_time.get_value() + seconds
-    assert (world.sim_time >= t).wait_for(seconds + 10.0)
-
-
-def tilt(orientation):
-    """Angle [rad] between the object's z axis and the vertical."""
-    w, x, y, z = orientation
-    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
 
 
 @pytest.fixture(params=["pr2", "tiago"])
