@@ -113,15 +113,13 @@ def main() -> int:
                     if error is not None:
                         fails["to_reach"] += 1
                     else:
-                        dt, nxt, error = timed(lambda: designator.next_solution())
+                        dt, nxt, error = timed(designator.next_solution)
                         stats["next"].append(dt)
                         fails["next"] += nxt is None
-                    otype = world.scene.item(name)
                     point = (pose.position[0], pose.position[1], pose.position[2])
                     dt, works = analytic_works(world, robot.description, prospection, target, point)
                     stats["analytic"].append(dt)
                     fails["analytic"] += not works
-                    del otype
                     for kind, props in (("to_see", [("to_see", target)]),
                                         ("to_open", [("to_open", world.environment.containers[seed % 4].name)]),
                                         ("on", [("on", placement.support), ("for", "cup")])):

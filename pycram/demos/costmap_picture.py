@@ -10,8 +10,9 @@ location is not found.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -46,9 +47,9 @@ def write_costmap_picture(world: Any, robot: Any, properties: Sequence[tuple[str
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from pycram.demos.scene_picture import _render
     from pycram.designators.core import DesignatorError
     from pycram.designators.location import LocationDesignator
-    from pycram.demos.scene_picture import _render
     from pycram.sim.environment_builder import PLAN_CAMERA, plan_view
 
     generator = next((g for g in robot.location_generators if hasattr(g, "reasoner")), None)

@@ -17,8 +17,8 @@ numpy; a layer over a 6.5 x 5 m room takes well under a millisecond.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Iterator, Sequence
 
 import numpy as np
 
@@ -60,7 +60,7 @@ class FloorGrid:
         object.__setattr__(self, "y", gy)
 
     @classmethod
-    def of(cls, environment: Environment, resolution: float = RESOLUTION) -> "FloorGrid":
+    def of(cls, environment: Environment, resolution: float = RESOLUTION) -> FloorGrid:
         """The grid over the environment's floor."""
         fx0 = min(r[0] for r in environment.floor)
         fy0 = min(r[1] for r in environment.floor)
@@ -146,7 +146,7 @@ class Costmap:
         self.grid = grid
         self.layers: dict[str, np.ndarray] = dict(layers or {})
 
-    def add(self, name: str, layer: np.ndarray) -> "Costmap":
+    def add(self, name: str, layer: np.ndarray) -> Costmap:
         if layer.shape != self.grid.shape:
             raise ValueError(f"layer {name!r} has shape {layer.shape}, the grid {self.grid.shape}")
         self.layers[name] = layer

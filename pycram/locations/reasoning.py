@@ -41,7 +41,8 @@ import heapq
 import logging
 import math
 from collections import Counter
-from typing import Any, Callable, Iterator, Optional, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -49,7 +50,7 @@ from pycram.designators.core import NoSolutionError
 from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Surface
 from pycram.world.objects import Grasp, ObjectType, object_type
 
-from .costmap import (Costmap, FloorGrid, angle_difference, distance_layer, occupancy_layer, ring_layer)
+from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, ring_layer
 from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation, Spot
 from .targets import KnownObject, Target, as_target
@@ -131,7 +132,7 @@ class _Tally:
         self.reasons: Counter[str] = Counter()
         self.details: dict[str, Counter[str]] = {}
 
-    def fail(self, reason: str, detail: Optional[str] = None) -> None:
+    def fail(self, reason: str, detail: str | None = None) -> None:
         self.reasons[reason] += 1
         if detail:
             self.details.setdefault(reason, Counter())[detail] += 1
@@ -172,7 +173,7 @@ class LocationReasoner:
         return self.geometry.inscribed_radius + BASE_CLEARANCE
 
     # ------------------------------------------------------------------ entry point
-    def generator(self, desig: Any) -> Optional[Iterator[Any]]:
+    def generator(self, desig: Any) -> Iterator[Any] | None:
         """The location generator: an iterator of solutions, or None when `desig` is not ours."""
         keys = [k for k, _ in desig.properties]
         if not keys or any(k not in VOCABULARY for k in keys):
@@ -216,7 +217,7 @@ class LocationReasoner:
             streams.append(_ranked(costmap, arms.index(arm), arm))
         self.last_costmaps = maps
 
-        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
             natural = _wrap(math.atan2(target.position[1] - y, target.position[0] - x)
@@ -270,7 +271,7 @@ class LocationReasoner:
         return (x, y, z - target.type.half_height + grasp.height)
 
     @staticmethod
-    def _grasp_heading(grasp: Grasp, target: Target) -> Optional[float]:
+    def _grasp_heading(grasp: Grasp, target: Target) -> float | None:
         """Tool heading [rad] a directional grasp requires (None: any horizontal heading)."""
         side = _SIDE_ANGLE.get(grasp.approach)
         return None if side is None else target.yaw + side + math.pi
@@ -327,7 +328,7 @@ class LocationReasoner:
         self.last_costmaps = {"view": costmap}
         what = target.name if target.kind == "object" and target.name else target.position
 
-        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             cost, _, _, r, c = cell
             x, y = costmap.xy(r, c)
             yaw = math.atan2(target.position[1] - y, target.position[0] - x)
@@ -380,7 +381,7 @@ class LocationReasoner:
             streams.append(_ranked(costmap, i, arm))
         self.last_costmaps = maps
 
-        def validate(cell: tuple) -> tuple[Optional[BaseLocation], Optional[tuple[str, Optional[str]]]]:
+        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
             yaw = _wrap(math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm))
@@ -433,7 +434,7 @@ class LocationReasoner:
             raise self._fail(desig, f"{container.name!r} has no surfaces inside")
         return self._spots(desig, list(container.interior), container.name)
 
-    def _object_size(self, value: Any, known: Sequence[KnownObject]) -> tuple[float, float, str, Optional[str]]:
+    def _object_size(self, value: Any, known: Sequence[KnownObject]) -> tuple[float, float, str, str | None]:
         """(footprint radius [m], half height [m], description, name) of the object to put down."""
         if value is None:
             return DEFAULT_OBJECT[0], DEFAULT_OBJECT[1], "an object", None
@@ -450,7 +451,7 @@ class LocationReasoner:
             raise ValueError(f"('for', {value!r}): need an object type, a known object or an object with a type")
         return target.type.footprint_radius, target.type.half_height, target.describe(), target.name
 
-    def _spots(self, desig: Any, surfaces: list[Surface], container: Optional[str]) -> Iterator[Spot]:
+    def _spots(self, desig: Any, surfaces: list[Surface], container: str | None) -> Iterator[Spot]:
         known = list(self.known_objects())
         radius, half, what, own = self._object_size(desig.prop_value("for"), known)
         near = desig.prop_value("near")
@@ -528,7 +529,7 @@ class LocationReasoner:
         up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
         tally = _Tally()
         given: list[BaseLocation] = []
-        failed: list[tuple[Optional[str], float, float]] = []
+        failed: list[tuple[str | None, float, float]] = []
         for cell in cells:
             if tally.tried >= self.max_candidates:
                 break
@@ -560,7 +561,7 @@ def _layer_summary(maps: dict[str, Costmap]) -> str:
     return "; ".join(out)
 
 
-def _ranked(costmap: Costmap, tie: int, arm: Optional[str]) -> Iterator[tuple]:
+def _ranked(costmap: Costmap, tie: int, arm: str | None) -> Iterator[tuple]:
     """The cells of `costmap` cheapest first as (cost, tie, arm, row, column)."""
     for r, c, cost in costmap.cells():
         yield cost, tie, arm, r, c
@@ -576,7 +577,7 @@ def _corners(rect: Sequence[float]) -> list[tuple[float, float]]:
     return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
 
 
-def _type_name(value: Any) -> Optional[str]:
+def _type_name(value: Any) -> str | None:
     if isinstance(value, ObjectType):
         return value.name
     return value if isinstance(value, str) else None

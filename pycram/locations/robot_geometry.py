@@ -10,8 +10,9 @@ number comes from the description module (``pycram.robots.<name>.description``):
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 __all__ = ["RobotGeometry"]
 
@@ -45,7 +46,7 @@ class RobotGeometry:
     contact_margin: float = 0.0
 
     @classmethod
-    def from_description(cls, d: Any) -> "RobotGeometry":
+    def from_description(cls, d: Any) -> RobotGeometry:
         """The geometry of the robot described by module `d` (see the module docstring)."""
         tucked: dict[str, float] = {}
         for arm, spec in d.ARMS.items():

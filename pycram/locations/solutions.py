@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Any
 
 __all__ = ["BaseLocation", "Spot"]
 
@@ -22,10 +22,10 @@ class BaseLocation:
     x: float
     y: float
     yaw: float
-    arm: Optional[str] = None
-    grasp: Optional[str] = None
+    arm: str | None = None
+    grasp: str | None = None
     cost: float = 0.0
-    visible: Optional[float] = None
+    visible: float | None = None
     joints: tuple = field(default=(), repr=False, compare=False)
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
@@ -40,12 +40,12 @@ class Spot(tuple):
     """
 
     surface: str
-    container: Optional[str]
-    type: Optional[str]
+    container: str | None
+    type: str | None
     cost: float
 
-    def __new__(cls, x: float, y: float, z: float, surface: str, container: Optional[str] = None,
-                type: Optional[str] = None, cost: float = 0.0) -> "Spot":
+    def __new__(cls, x: float, y: float, z: float, surface: str, container: str | None = None,
+                type: str | None = None, cost: float = 0.0) -> Spot:
         spot = super().__new__(cls, (float(x), float(y), float(z)))
         spot.surface, spot.container, spot.type, spot.cost = surface, container, type, cost
         return spot

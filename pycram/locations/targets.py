@@ -9,8 +9,9 @@ turns each into a `Target`; nothing else is accepted (a ``ValueError`` says what
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence
+from typing import Any
 
 from pycram.world.environment import Container, Environment, Surface
 from pycram.world.objects import ObjectType, object_type
@@ -30,8 +31,8 @@ class Target:
 
     position: tuple[float, float, float]
     kind: str
-    name: Optional[str] = None
-    type: Optional[ObjectType] = None
+    name: str | None = None
+    type: ObjectType | None = None
     yaw: float = 0.0
     thing: Any = None
 
@@ -52,8 +53,8 @@ class KnownObject:
     type: str
     position: tuple[float, float, float]
     yaw: float = 0.0
-    radius: Optional[float] = None
-    half_height: Optional[float] = None
+    radius: float | None = None
+    half_height: float | None = None
 
     def __post_init__(self) -> None:
         if self.radius is None or self.half_height is None:
@@ -72,7 +73,7 @@ def _yaw_of(orientation: Any) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
-def _point(value: Any) -> Optional[tuple[float, float, float]]:
+def _point(value: Any) -> tuple[float, float, float] | None:
     try:
         p = tuple(float(v) for v in value)
     except (TypeError, ValueError):
@@ -80,7 +81,7 @@ def _point(value: Any) -> Optional[tuple[float, float, float]]:
     return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None  # type: ignore[return-value]
 
 
-def _object_like(value: Any) -> Optional[Target]:
+def _object_like(value: Any) -> Target | None:
     otype = getattr(value, "type", None)
     pose = getattr(value, "pose", None)
     holder = pose if pose is not None and hasattr(pose, "position") else value
@@ -100,7 +101,7 @@ def _object_like(value: Any) -> Optional[Target]:
     return Target(position, "object", getattr(value, "name", None), otype, float(yaw))
 
 
-def as_target(value: Any, environment: Optional[Environment] = None,
+def as_target(value: Any, environment: Environment | None = None,
               known_objects: Sequence[KnownObject] = ()) -> Target:
     """`value` as a `Target` (see the module docstring).
 

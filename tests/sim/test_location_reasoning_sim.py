@@ -21,6 +21,7 @@ pytest.importorskip("mujoco")
 prospection = pytest.importorskip("pycram.world.prospection")
 
 import mujoco  # noqa: E402
+from sim_helpers import settle, tilt  # noqa: E402
 
 from pycram import robots  # noqa: E402
 from pycram.designator import LocationDesignator, MotionDesignator, perform  # noqa: E402
@@ -28,7 +29,6 @@ from pycram.designators.core import NoSolutionError  # noqa: E402
 from pycram.locations import KnownObject, Spot  # noqa: E402
 from pycram.sim import World  # noqa: E402
 from pycram.world.objects import object_type  # noqa: E402
-from sim_helpers import settle, tilt  # noqa: E402
 
 T = 60.0
 #: (robot, seed, object): scenes of `random_scene(apartment, ["cup", "milk", "bowl"], seed)` with
