@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
+import signal
 import sys
 from pathlib import Path
 from typing import Any, Optional
@@ -178,8 +179,15 @@ def run_command(
     plan: Optional[str] = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
     robot: Optional[str] = typer.Option(None, "--robot", help="Robot name recorded for the run."),
 ) -> None:
-    """Run a plan script; arguments after FILE go to the script (in sys.argv)."""
+    """Run a plan script; arguments after FILE go to the script (in sys.argv).
+
+    SIGINT (Ctrl-C) and SIGTERM stop the script (as KeyboardInterrupt, so its clean-up runs):
+    the run is recorded as "interrupted" and the exit code is 130 / 143; a second signal while
+    stopping exits at once.
+    """
+    from pycram.interrupts import StopSignals
     from pycram.macros import run_script
+    from pycram.runtime import end_thread_root
 
     recorder = None
     if _record_flag(record):
@@ -188,23 +196,28 @@ def run_command(
         recorder = _trace_errors(lambda: Recorder(db, plan=plan or file.name, robot=robot,
                                                   command=" ".join(["pycram run", str(file), *ctx.args])).start())
     outcome, error, code = "succeeded", None, 0
-    try:
-        run_script(file, list(ctx.args))
-    except SystemExit as e:
-        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
-        outcome = "succeeded" if code == 0 else "failed"
-        error = None if code == 0 else f"SystemExit: {e.code}"
-    except KeyboardInterrupt as e:
-        outcome, error, code = "interrupted", e, 130
-        raise
-    except BaseException as e:
-        outcome, error, code = "failed", e, 1
-        raise
-    finally:
-        if recorder is not None:
-            _robot_from_active(recorder)
-            run_id = recorder.finish(outcome, error)
-            err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+    ended: BaseException | None = None  # what ended the main thread's root task
+    with StopSignals(raise_in_main=True) as stop:
+        try:
+            run_script(file, list(ctx.args))
+        except SystemExit as e:
+            code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+            outcome = "succeeded" if code == 0 else "failed"
+            error = None if code == 0 else f"SystemExit: {e.code}"
+            ended = None if code == 0 else e
+        except KeyboardInterrupt as e:  # SIGINT / SIGTERM (`Interrupted`), or raised by the script
+            stop.request(getattr(e, "signum", signal.SIGINT))
+            outcome, error, code, ended = "interrupted", stop.reason, stop.exit_code, e
+            err.print(f"[bold yellow]pycram run:[/bold yellow] {stop.reason}; the script was stopped")
+        except BaseException as e:
+            outcome, error, code, ended = "failed", e, 1, e
+            raise
+        finally:
+            end_thread_root(ended)
+            if recorder is not None:
+                _robot_from_active(recorder)
+                run_id = recorder.finish(outcome, error)
+                err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
     raise typer.Exit(code)
 
 
@@ -224,7 +237,8 @@ def _robot_from_active(recorder: Any) -> None:
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
-    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
+    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: the run's "
+                                         "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded)."),
     item_at: int = typer.Option(1, "--item-at", help="Where the item starts: position 1, 2 or 3 (0: no item)."),
     steal: int = typer.Option(0, "--steal", help="How many times the item is taken from the gripper while the robot carries it."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
@@ -234,6 +248,8 @@ def demo_command(
                                           help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
     db: Optional[str] = DbOption,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
+    animation: bool = typer.Option(True, "--animation/--no-animation",
+                                   help="Record the animation run.gif (--no-animation: a faster run)."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     try:
@@ -244,7 +260,7 @@ def demo_command(
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
                          realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet)
+                         quiet=quiet, animation=animation)
     raise typer.Exit(int(code or 0))
 
 

@@ -18,18 +18,22 @@ recorder catches up afterwards (`finish` waits for it).
 
 from __future__ import annotations
 
+import atexit
 import collections
 import copy
+import functools
 import logging
+import weakref
 import os
 import threading
 import time
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Callable, Iterable
 
 import mujoco
 import numpy as np
 
+from .camera import FollowView
 from .errors import SimulationError
 from .gif import GifEncoder
 
@@ -39,6 +43,17 @@ _log = logging.getLogger(__name__)
 RECORDER_NICE = 5
 #: Default bound of snapshots waiting to be rendered; more are dropped (counted, logged).
 DEFAULT_MAX_PENDING = 512
+#: Recorders whose thread may still run: ended at interpreter exit, so that no recorder thread
+#: is inside MuJoCo or the GL driver while the interpreter and its libraries shut down.
+_LIVE_RECORDERS: "weakref.WeakSet[FrameRecorder]" = weakref.WeakSet()
+
+
+@atexit.register
+def _close_live_recorders() -> None:
+    for recorder in list(_LIVE_RECORDERS):
+        recorder.abort()
+    for recorder in list(_LIVE_RECORDERS):
+        recorder.close(timeout=5.0)
 
 
 @dataclass(frozen=True)
@@ -53,11 +68,12 @@ class StateSnapshot:
     qpos: np.ndarray
     mocap_pos: np.ndarray
     mocap_quat: np.ndarray
+    caption: str = ""  #: what the frame's caption says besides the time (e.g. the plan's phase)
 
     @classmethod
-    def of(cls, data: mujoco.MjData) -> "StateSnapshot":
+    def of(cls, data: mujoco.MjData, caption: str = "") -> "StateSnapshot":
         """Copy the state of `data` (call from the thread that owns `data`; a few microseconds)."""
-        return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+        return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy(), caption)
 
     def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """Set `data` to this state and compute what rendering reads (body, geom, camera and
@@ -94,6 +110,11 @@ class RecordedFrames(list):
 class FrameRecorder:
     """Renders frames of `camera` at `fps` [frames per s of simulated time] in its own thread.
 
+    `camera` is a camera name of the model or a `FollowView` (a free camera that follows some
+    bodies, smoothed from frame to frame). With `caption`, a function called in the simulation
+    thread at each frame time (it must be quick and must not block: e.g. read a fluent), every
+    frame carries a caption line: its text and the simulated time.
+
     The owner of the simulation calls `due(t)` and `capture(data)` from its thread; neither ever
     blocks for rendering. At most `max_pending` snapshots wait for rendering: a snapshot offered
     while that many wait is dropped (counted in `dropped`). `finish` renders the rest and ends
@@ -102,8 +123,9 @@ class FrameRecorder:
     must not block (`abort` never blocks).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str, fps: float, width: int, height: int,
-                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder") -> None:
+    def __init__(self, model: mujoco.MjModel, camera: str | FollowView, fps: float, width: int, height: int,
+                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder",
+                 caption: Callable[[], str] | None = None) -> None:
         if fps <= 0:
             raise ValueError(f"fps must be positive, got {fps}")
         if width <= 0 or height <= 0:
@@ -112,6 +134,8 @@ class FrameRecorder:
             raise ValueError(f"max_pending must be at least 1, got {max_pending}")
         self.camera, self.fps, self.size = camera, float(fps), (int(width), int(height))
         self.max_pending = max_pending
+        self.caption = caption
+        self._caption_failed = False
         self._model = model
         self._period = 1.0 / self.fps
         self._next: float | None = None  # simulated time of the next frame [s]; None: not started
@@ -126,6 +150,7 @@ class FrameRecorder:
         self.render_time = 0.0  #: wall time the thread spent on rendering and encoding [s]
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
+        _LIVE_RECORDERS.add(self)
 
     # ------------------------------------------------------------------ simulation side
     def start_at(self, sim_time: float) -> None:
@@ -146,7 +171,7 @@ class FrameRecorder:
         self._next += self._period
         if self._next <= data.time:  # far behind (e.g. stepped in big chunks): no burst of frames
             self._next = float(data.time) + self._period
-        snapshot = StateSnapshot.of(data)
+        snapshot = StateSnapshot.of(data, self._caption_text())
         with self._cond:
             if self._finishing or self._aborted:
                 return False
@@ -156,6 +181,16 @@ class FrameRecorder:
             self._pending.append(snapshot)
             self._cond.notify_all()
         return True
+
+    def _caption_text(self) -> str:
+        if self.caption is None or self._caption_failed:
+            return ""
+        try:
+            return str(self.caption())
+        except Exception:  # noqa: BLE001 - a broken caption must not stop the simulation
+            self._caption_failed = True
+            _log.exception("recording: the caption function failed; frames get no caption text from now on")
+            return ""
 
     # ------------------------------------------------------------------ ending
     @property
@@ -223,11 +258,18 @@ class FrameRecorder:
             model.vis.global_.offwidth, model.vis.global_.offheight = self.size
             data = mujoco.MjData(model)
             renderer = mujoco.Renderer(model, height=self.size[1], width=self.size[0])
+            view = None  # the free camera of the previous frame (FollowView)
             while (snapshot := self._take()) is not None:
                 t0 = time.perf_counter()
                 snapshot.apply(model, data)
-                renderer.update_scene(data, camera=self.camera)
+                if isinstance(self.camera, FollowView):
+                    view = self.camera.view(model, data, view)
+                    renderer.update_scene(data, camera=view)
+                else:
+                    renderer.update_scene(data, camera=self.camera)
                 rgb = renderer.render()
+                if self.caption is not None:
+                    rgb = draw_caption(rgb, snapshot.caption, snapshot.time)
                 self._frames.append(rgb)
                 self._gif.add(rgb)
                 self.render_time += time.perf_counter() - t0
@@ -243,6 +285,32 @@ class FrameRecorder:
                 renderer.close()
 
 
+def draw_caption(rgb: np.ndarray, text: str, sim_time: float) -> np.ndarray:
+    """`rgb` with a caption band along its bottom edge: `text` on the left, the simulated time
+    `sim_time` [s] on the right (white on a dark band; a new array, `rgb` is not changed)."""
+    from PIL import Image, ImageDraw
+
+    image = Image.fromarray(rgb)
+    width, height = image.size
+    font = _caption_font(max(10, height // 24))
+    band = max(14, height // 14)
+    draw = ImageDraw.Draw(image)
+    draw.rectangle((0, height - band, width, height), fill=(20, 20, 24))
+    clock = f"t = {sim_time:5.1f} s"
+    clock_width = draw.textlength(clock, font=font)
+    y = height - band / 2
+    draw.text((6, y), text, fill=(255, 255, 255), font=font, anchor="lm")
+    draw.text((width - 6 - clock_width, y), clock, fill=(255, 255, 255), font=font, anchor="lm")
+    return np.asarray(image)
+
+
+@functools.cache
+def _caption_font(size: int):  # noqa: ANN202 - a PIL font
+    from PIL import ImageFont
+
+    return ImageFont.load_default(size=size)
+
+
 def _lower_priority() -> None:
     """Lower this thread's scheduling priority by `RECORDER_NICE` (Linux: nice is per thread)."""
     try:
@@ -252,4 +320,4 @@ def _lower_priority() -> None:
         _log.debug("could not lower the recorder's priority", exc_info=True)
 
 
-__all__ = ["FrameRecorder", "RecordedFrames", "StateSnapshot", "RECORDER_NICE", "DEFAULT_MAX_PENDING"]
+__all__ = ["FrameRecorder", "RecordedFrames", "StateSnapshot", "draw_caption", "RECORDER_NICE", "DEFAULT_MAX_PENDING"]
