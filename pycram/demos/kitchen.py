@@ -81,6 +81,7 @@ class DemoResult:
     item_on_cooker_1: bool = False
     interrupted: bool = False  # stopped by SIGINT/SIGTERM (exit code 130/143)
     files: list[Path] = field(default_factory=list)
+    captions: list[tuple[float, str]] = field(default_factory=list)  # the animation's (sim time [s], caption)
     tree_text: str = ""  # the plan's task tree as plain text, one line per task
     plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
 
@@ -295,6 +296,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         if thief is not None:
             thief.stop()
         world.close()
+    result.captions = list(getattr(frames, "captions", []))
     if frames:  # encoded after the simulation stopped, so the two do not compete for the CPU
         result.files.append(write_animation(output / "run.gif", frames, ANIMATION_SPEED_UP * ANIMATION_FPS))
 
@@ -427,7 +429,7 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
 class _Story:
     """What the animation's captions say: the plan's phase in words, with the failed grasps
     (counted as `grab_item` tasks fail: a task listener, O(1) per task end), the thefts and the
-    recovery. `caption` is called by the simulation thread at each frame time: it only reads."""
+    recovery (read from the simulated gripper: this is for people watching, not for the plan). `caption` is called by the simulation thread at each frame time: it only reads."""
 
     GRASP_POSITIONS = 3
 
@@ -452,8 +454,8 @@ class _Story:
                 return f"fetching: grasp {failed} of {self.GRASP_POSITIONS} failed, trying position {failed + 1}"
             return f"fetching: grasp 1 of {self.GRASP_POSITIONS}"
         if phase == "transporting":
-            if stolen and self.plan.item_lost.get_value():
-                return f"item taken ({stolen}x): recovering"
+            if stolen and self.thief.world.gripper_states[self.thief.gripper].get_value().holding is None:
+                return f"item taken ({stolen}x): recovering"  # until the gripper holds it again
             return f"transporting (recovered {stolen}x)" if stolen else "transporting"
         if phase == "failed" and failed >= self.GRASP_POSITIONS:
             return f"failed: all {self.GRASP_POSITIONS} grasps failed"

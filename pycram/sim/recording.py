@@ -90,16 +90,18 @@ class RecordedFrames(list):
     """RGB frames (height x width x 3, uint8), oldest first, as recorded by a `FrameRecorder`.
 
     A plain list of arrays to its users; it also carries the recording's `fps` [frames per s of
-    simulated time], how many frames were `dropped`, and their GIF encoding (`gif`), which
-    `pycram.sim.render.write_animation` uses to write a GIF at once.
+    simulated time], how many frames were `dropped`, their GIF encoding (`gif`), which
+    `pycram.sim.render.write_animation` uses to write a GIF at once, and each frame's simulated
+    time [s] and caption text (`captions`, "" without a caption function).
     """
 
     def __init__(self, frames: Iterable[np.ndarray] = (), fps: float = 1.0, dropped: int = 0,
-                 gif: GifEncoder | None = None) -> None:
+                 gif: GifEncoder | None = None, captions: Iterable[tuple[float, str]] = ()) -> None:
         super().__init__(frames)
         self.fps = fps
         self.dropped = dropped
         self.gif = gif
+        self.captions = list(captions)
 
     def encoded_gif(self) -> GifEncoder | None:
         """The GIF encoding of exactly these frames, or None (e.g. after the list was changed)."""
@@ -144,6 +146,7 @@ class FrameRecorder:
         self._finishing = False  # render what is pending, then end
         self._aborted = False  # end now
         self._frames: list[np.ndarray] = []
+        self._captions: list[tuple[float, str]] = []
         self._gif = GifEncoder()
         self.dropped = 0  #: snapshots dropped because `max_pending` were waiting, or not rendered
         self.error: BaseException | None = None  #: why the recorder thread failed, if it did
@@ -225,7 +228,7 @@ class FrameRecorder:
         level = logging.WARNING if self.dropped else logging.INFO
         _log.log(level, "recorded %d frames of %r at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
                  len(self._frames), self.camera, self.fps, *self.size, self.dropped, self.render_time)
-        return RecordedFrames(self._frames, self.fps, self.dropped, self._gif)
+        return RecordedFrames(self._frames, self.fps, self.dropped, self._gif, self._captions)
 
     def close(self, timeout: float = 10.0) -> None:
         """`abort` and wait up to `timeout` [s of wall time] for the thread to end; idempotent."""
@@ -271,6 +274,7 @@ class FrameRecorder:
                 if self.caption is not None:
                     rgb = draw_caption(rgb, snapshot.caption, snapshot.time)
                 self._frames.append(rgb)
+                self._captions.append((snapshot.time, snapshot.caption))
                 self._gif.add(rgb)
                 self.render_time += time.perf_counter() - t0
         except BaseException as exc:  # noqa: BLE001 - reported by finish()
