@@ -197,7 +197,7 @@ def run_command(
                                                   command=" ".join(["pycram run", str(file), *ctx.args])).start())
     outcome, error, code = "succeeded", None, 0
     ended: BaseException | None = None  # what ended the main thread's root task
-    with StopSignals(raise_in_main=True) as stop:
+    with StopSignals(stop_main=True) as stop:
         try:
             run_script(file, list(ctx.args))
         except SystemExit as e:
@@ -205,13 +205,15 @@ def run_command(
             outcome = "succeeded" if code == 0 else "failed"
             error = None if code == 0 else f"SystemExit: {e.code}"
             ended = None if code == 0 else e
-        except KeyboardInterrupt as e:  # SIGINT / SIGTERM (`Interrupted`), or raised by the script
+        except BaseException as e:
+            if not (stop.requested or isinstance(e, KeyboardInterrupt)):
+                outcome, error, code, ended = "failed", e, 1, e
+                raise
+            # SIGINT / SIGTERM (as `Interrupted`, or as `Evaporated` of the script's tasks), or a
+            # KeyboardInterrupt raised by the script itself
             stop.request(getattr(e, "signum", signal.SIGINT))
             outcome, error, code, ended = "interrupted", stop.reason, stop.exit_code, e
             err.print(f"[bold yellow]pycram run:[/bold yellow] {stop.reason}; the script was stopped")
-        except BaseException as e:
-            outcome, error, code, ended = "failed", e, 1, e
-            raise
         finally:
             end_thread_root(ended)
             if recorder is not None:

@@ -4,9 +4,12 @@ Inside `with StopSignals() as stop:` (main thread only; elsewhere it does nothin
 
 - the first SIGINT or SIGTERM is recorded in `stop` (`stop.signum`, `stop.reason`,
   `stop.exit_code`: 130 for SIGINT, 143 for SIGTERM, as a shell reports them) and sets
-  `stop.event`; with `raise_in_main=True` it also raises `Interrupted` (a `KeyboardInterrupt`)
-  in the main thread, as Ctrl-C does by default, so that a script stops where it is and its
-  `finally` blocks and PyCRAM's clean-up run;
+  `stop.event`; with `stop_main=True` it also stops what the main thread runs, so that a script
+  stops where it is and its `finally` blocks and PyCRAM's clean-up run: in plain Python code it
+  raises `Interrupted` (a `KeyboardInterrupt`) there, as Ctrl-C does by default; inside PyCRAM
+  (waiting in an expression, or in the runtime's own bookkeeping, where an exception landing at
+  an arbitrary point could leave a branch behind) it evaporates the main thread's task tree
+  instead, which PyCRAM delivers as `Evaporated` at a safe point, after stopping every branch;
 - a second one while the run is stopping ends the process at once with the first signal's exit
   code, after one line on stderr (`os._exit`: no clean-up, no traceback — and no thread that could
   crash while the interpreter shuts down).
@@ -58,12 +61,15 @@ class StopSignals:
     on a second signal, e.g. to restore the terminal; it must be quick.
     """
 
-    def __init__(self, raise_in_main: bool = False, on_second: Callable[[], Any] | None = None) -> None:
-        self.raise_in_main = raise_in_main
+    def __init__(self, stop_main: bool = False, on_second: Callable[[], Any] | None = None) -> None:
+        self.stop_main = stop_main
         self.on_second = on_second
         self.event = threading.Event()
         self.signum: int | None = None
         self._previous: dict[int, Any] = {}
+        self._main_runner: Any = None
+        self._evaporate_main = threading.Event()
+        self._stopper: threading.Thread | None = None
 
     @property
     def requested(self) -> bool:
@@ -87,15 +93,46 @@ class StopSignals:
         self.event.set()
 
     def __enter__(self) -> StopSignals:
-        if threading.current_thread() is threading.main_thread():
-            for signum in _DESCRIPTIONS:
-                self._previous[signum] = signal.signal(signum, self._handle)
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        if self.stop_main:
+            from pycram.runtime.evaporation import current_runner
+
+            self._main_runner = current_runner()
+            # Started now, not from the handler: a handler must not start threads (the main
+            # thread may be inside `Thread.start` itself, holding the lock that needs).
+            self._stopper = threading.Thread(target=self._stop_main_tasks, name="pycram-stop-signals", daemon=True)
+            self._stopper.start()
+        for signum in _DESCRIPTIONS:
+            self._previous[signum] = signal.signal(signum, self._handle)
         return self
 
     def __exit__(self, *exc: object) -> None:
         previous, self._previous = self._previous, {}
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        if self._stopper is not None:
+            self._evaporate_main.set()  # ends the stopper (it evaporates nothing once we left)
+            self._stopper.join()
+            self._stopper = None
+
+    def _stop_main_tasks(self) -> None:
+        """The stopper thread: once asked, evaporate the main thread's task tree (from its root)."""
+        self._evaporate_main.wait()
+        if self._previous:  # still inside the block: a signal asked for it
+            task = self._main_runner.task
+            while task is not None and task.parent is not None:
+                task = task.parent
+            if task is not None:
+                task.evaporate()
+
+    def _in_plain_code(self) -> bool:
+        """True when the main thread (running this handler) is in neither PyCRAM's waits nor
+        its bookkeeping, nor protected from evaporation: an exception may land here."""
+        from pycram.runtime.evaporation import _USER
+
+        runner = self._main_runner
+        return runner is None or runner.task is None or (runner._mode == _USER and not runner._protected)
 
     def _handle(self, signum: int, frame: FrameType | None) -> None:
         if self.signum is not None:  # a second signal while stopping: leave at once
@@ -109,5 +146,7 @@ class StopSignals:
             finally:
                 os._exit(self.exit_code)
         self.request(signum)
-        if self.raise_in_main:
-            raise Interrupted(signum)
+        if self.stop_main:
+            if self._in_plain_code():
+                raise Interrupted(signum)
+            self._evaporate_main.set()

@@ -470,14 +470,20 @@ class TaskGroup:
                 task.evaporate()
 
     def wait_all(self) -> None:
-        """Block until every child has ended (see the class doc for evaporation)."""
+        """Block until every child has ended (see the class doc for evaporation). If the wait is
+        cut short — by evaporation, or by `KeyboardInterrupt` (Ctrl-C, or SIGTERM under `pycram
+        run`) — every child is evaporated and waited for before the exception propagates."""
         try:
             wait_until(self._cv, self._all_ended)
-        except Evaporated:
-            self.evaporate()
-            with shielded():
-                wait_until(self._cv, self._all_ended)
+        except BaseException:
+            self.stop_all()
             raise
+
+    def stop_all(self) -> None:
+        """Evaporate every child and block until all have ended (not interruptible by evaporation)."""
+        with shielded():
+            self.evaporate()
+            wait_until(self._cv, self._all_ended)
 
     def _all_ended(self) -> bool:
         return self._running == 0
