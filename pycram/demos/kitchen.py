@@ -429,7 +429,8 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
 class _Story:
     """What the animation's captions say: the plan's phase in words, with the failed grasps
     (counted as `grab_item` tasks fail: a task listener, O(1) per task end), the thefts and the
-    recovery (read from the simulated gripper: this is for people watching, not for the plan). `caption` is called by the simulation thread at each frame time: it only reads."""
+    recovery (read from the simulated gripper: this is for people watching, not for the plan).
+    `caption` is called by the simulation thread at each frame time: it only reads."""
 
     GRASP_POSITIONS = 3
 

@@ -23,10 +23,10 @@ import collections
 import copy
 import functools
 import logging
-import weakref
 import os
 import threading
 import time
+import weakref
 from dataclasses import dataclass
 from typing import Callable, Iterable
 

@@ -280,3 +280,39 @@ def test_an_interrupted_stop_recording_leaves_no_thread_after_close(tmp_path):
     points = done.stdout.count("interrupted at ")
     assert points >= 10, done.stdout
     assert "of finish" in done.stdout and "of stop_recording" in done.stdout
+
+
+def test_captions_are_taken_when_the_frame_is_due_and_drawn_on_it(world, tmp_path):
+    """The caption function runs in the simulation thread at each frame time; each frame keeps
+    its text and simulated time, and carries a dark caption band with light text."""
+    from pycram.sim import FollowView
+
+    callers: set[int] = set()
+    count = iter(range(10_000))
+
+    def caption() -> str:
+        callers.add(threading.get_ident())
+        return f"frame {next(count)}"
+
+    view = FollowView((world.description.ROOT_LINK,), min_distance=2.5)
+    ok(world.start_recording(view, fps=20, width=160, height=120, caption=caption))
+    base = world.base_pose.get_value()
+    ok(world.drive_to(base.x + 0.2, base.y, base.yaw))
+    frames = world.stop_recording()
+
+    assert callers == {world._thread.ident}
+    assert len(frames.captions) == len(frames) >= 5
+    assert [text for _, text in frames.captions] == [f"frame {i}" for i in range(len(frames))]
+    times = [t for t, _ in frames.captions]
+    assert all(0 < b - a < 0.1 for a, b in zip(times, times[1:]))
+    band = frames[0][-12:]
+    assert band.mean() < 80 and (band.min(axis=2) > 200).any()
+
+
+def test_a_follow_view_of_an_unknown_body_is_refused(world):
+    from pycram.sim import FollowView
+
+    with pytest.raises(ValueError, match="no body 'teapot'"):
+        world.start_recording(FollowView(("teapot",)))
+    with pytest.raises(ValueError, match="no body 'teapot'"):
+        world.request_image(FollowView(("teapot",)))
