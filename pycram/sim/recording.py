@@ -294,18 +294,18 @@ def draw_caption(rgb: np.ndarray, text: str, sim_time: float) -> np.ndarray:
     `sim_time` [s] on the right (white on a dark band; a new array, `rgb` is not changed)."""
     from PIL import Image, ImageDraw
 
-    image = Image.fromarray(rgb)
-    width, height = image.size
+    height, width = rgb.shape[:2]
     font = _caption_font(max(10, height // 24))
-    band = max(14, height // 14)
-    draw = ImageDraw.Draw(image)
-    draw.rectangle((0, height - band, width, height), fill=(20, 20, 24))
+    band = min(height, max(14, height // 14))
+    strip = Image.new("RGB", (width, band), (20, 20, 24))  # only the band is drawn: ~4x cheaper
+    draw = ImageDraw.Draw(strip)
     clock = f"t = {sim_time:5.1f} s"
-    clock_width = draw.textlength(clock, font=font)
-    y = height - band / 2
-    draw.text((6, y), text, fill=(255, 255, 255), font=font, anchor="lm")
-    draw.text((width - 6 - clock_width, y), clock, fill=(255, 255, 255), font=font, anchor="lm")
-    return np.asarray(image)
+    draw.text((6, band / 2), text, fill=(255, 255, 255), font=font, anchor="lm")
+    draw.text((width - 6 - draw.textlength(clock, font=font), band / 2), clock, fill=(255, 255, 255), font=font,
+              anchor="lm")
+    captioned = rgb.copy()
+    captioned[height - band:] = np.asarray(strip)
+    return captioned
 
 
 @functools.cache
