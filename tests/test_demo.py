@@ -133,7 +133,8 @@ def test_the_pictures_show_the_item_and_each_frame_says_what_happens(tmp_path):
     story = ["resetting the robot", "fetching: grasp 1 of 3", "fetching: grasp 1 of 3 failed, trying position 2",
              "fetching: grasp 2 of 3 failed, trying position 3", "transporting", "item taken (1x): recovering",
              "transporting (recovered 1x)", "placing", "done"]
-    assert all(part in texts for part in story), sorted(set(texts))
+    missing = [part for part in story if part not in texts]
+    assert not missing, f"no frame says {missing}; the captions: {sorted(set(texts))}"
     assert [texts.index(part) for part in story] == sorted(texts.index(part) for part in story)
 
     band = max(14, animation.size[1] // 14)

@@ -141,6 +141,7 @@ class FrameRecorder:
         self._model = model
         self._period = 1.0 / self.fps
         self._next: float | None = None  # simulated time of the next frame [s]; None: not started
+        self._last: float | None = None  # simulated time of the last frame captured [s]
         self._pending: collections.deque[StateSnapshot] = collections.deque()
         self._cond = threading.Condition()
         self._finishing = False  # render what is pending, then end
@@ -174,6 +175,7 @@ class FrameRecorder:
         self._next += self._period
         if self._next <= data.time:  # far behind (e.g. stepped in big chunks): no burst of frames
             self._next = float(data.time) + self._period
+        self._last = float(data.time)
         snapshot = StateSnapshot.of(data, self._caption_text())
         with self._cond:
             if self._finishing or self._aborted:
@@ -184,6 +186,13 @@ class FrameRecorder:
             self._pending.append(snapshot)
             self._cond.notify_all()
         return True
+
+    def capture_last(self, data: mujoco.MjData) -> bool:
+        """Capture the state of `data` as the recording's last frame, unless the last frame
+        captured already shows this simulated time (simulation thread; as `capture`)."""
+        if self._next is None or self._last == float(data.time):
+            return False
+        return self.capture(data)
 
     def _caption_text(self) -> str:
         if self.caption is None or self._caption_failed:

@@ -511,6 +511,7 @@ class World:
 
     def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
         """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
+        The last frame shows the state at the simulated time the recording stopped.
 
         Waits for the recorder thread to render the frames still pending and ends it. Blocks up
         to `timeout` [s of wall time]; frames not rendered by then are dropped (logged). Returns
@@ -523,6 +524,8 @@ class World:
 
         def fn(eng: Engine) -> FrameRecorder | None:
             recorder, self._recorder = self._recorder, None
+            if recorder is not None:
+                recorder.capture_last(eng.data)  # the animation ends with the state it stopped in
             return recorder
 
         handle = self._call("stop_recording", fn)
