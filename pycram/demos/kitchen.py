@@ -37,6 +37,9 @@ WALL_TIME_LIMIT = 600.0
 #: The animation: frames per second of simulated time, and how much faster it plays.
 ANIMATION_FPS = 8.0
 ANIMATION_SPEED_UP = 2.0
+#: How long [s of wall time] the animation's recorder may take to render the frames still
+#: pending when the plan ended (a few seconds normally; much more on a heavily loaded machine).
+RENDER_CATCH_UP = 300.0
 #: Size of the animation's frames [px]; snapshots are 640 x 480.
 ANIMATION_SIZE = (480, 360)
 #: The item's colour (RGBA): a yellow that stands out against the grey counters, the dark stoves
@@ -285,7 +288,8 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, COUNTER_HEIGHT) if items else False
         world.snapshot(output / "end.png", camera=camera)
         result.files.append(output / "end.png")
-        frames = world.stop_recording() if options.animation else []
+        # the recorder may lag behind on a busy machine: let it finish rather than lose the end
+        frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation else []
         if result.item_on_cooker_1:
             result.exit_code, result.message = 0, "the item rests on cooker #1"
         elif not result.message:

@@ -54,6 +54,9 @@ class FollowView:
         if not 0.0 < self.smoothing <= 1.0:
             raise ValueError(f"smoothing must be in (0, 1], got {self.smoothing}")
 
+    def __str__(self) -> str:
+        return f"a view following {', '.join(self.bodies)}"
+
     def check(self, model: mujoco.MjModel) -> None:
         """Raise ValueError naming a body of `bodies` that `model` does not have."""
         names = [model.body(i).name for i in range(model.nbody)]

@@ -235,8 +235,9 @@ class FrameRecorder:
         if self.error is not None:
             raise SimulationError(f"recording failed: {type(self.error).__name__}: {self.error}") from self.error
         level = logging.WARNING if self.dropped else logging.INFO
-        _log.log(level, "recorded %d frames of %r at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
-                 len(self._frames), self.camera, self.fps, *self.size, self.dropped, self.render_time)
+        _log.log(level, "recorded %d frames of %s at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
+                 len(self._frames), self.camera if isinstance(self.camera, FollowView) else repr(self.camera),
+                 self.fps, *self.size, self.dropped, self.render_time)
         return RecordedFrames(self._frames, self.fps, self.dropped, self._gif, self._captions)
 
     def close(self, timeout: float = 10.0) -> None:
