@@ -181,9 +181,10 @@ def run_command(
 ) -> None:
     """Run a plan script; arguments after FILE go to the script (in sys.argv).
 
-    SIGINT (Ctrl-C) and SIGTERM stop the script (as KeyboardInterrupt, so its clean-up runs):
-    the run is recorded as "interrupted" and the exit code is 130 / 143; a second signal while
-    stopping exits at once.
+    SIGINT (Ctrl-C) and SIGTERM stop the script so that its clean-up runs (in plain Python code
+    as a KeyboardInterrupt, inside PyCRAM by evaporating the script's tasks): the run is recorded
+    as "interrupted" with the reason, the exit code is 130 / 143; a second signal while stopping
+    exits at once.
     """
     from pycram.interrupts import StopSignals
     from pycram.macros import run_script

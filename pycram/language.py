@@ -38,7 +38,7 @@ from typing import Any, Callable, Sequence
 
 from pycram.block_forms import BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
-from pycram.runtime.evaporation import Evaporated, check_evaporation, shielded, wait_until
+from pycram.runtime.evaporation import check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
 
 __all__ = [
