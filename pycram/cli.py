@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
+import signal
 import sys
 from pathlib import Path
 from typing import Any, Optional
@@ -266,9 +267,14 @@ def run_command(
 
     The script owns logging (`logging.basicConfig` in it works as under `python FILE.py`);
     an exception it raises is reported with a traceback that starts at the script's code, and
-    the exit code is 1.
+    the exit code is 1. SIGINT (Ctrl-C) and SIGTERM stop the script so that its clean-up runs
+    (in plain Python code as a KeyboardInterrupt, inside PyCRAM by evaporating the script's
+    tasks): the run is recorded as "interrupted" with the reason, the exit code is 130 / 143; a
+    second signal while stopping exits at once.
     """
+    from pycram.interrupts import StopSignals
     from pycram.macros import format_script_error, run_script
+    from pycram.runtime import end_thread_root
 
     recorder = None
     if _record_flag(record):
@@ -277,29 +283,36 @@ def run_command(
         recorder = _trace_errors(lambda: Recorder(db, plan=plan or file.name, robot=robot,
                                                   command=" ".join(["pycram run", str(file), *ctx.args])).start())
     outcome, error, code = "succeeded", None, 0
-    try:
-        run_script(file, list(ctx.args))
-    except SystemExit as e:
-        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
-        outcome = "succeeded" if code == 0 else "failed"
-        error = None if code == 0 else f"SystemExit: {e.code}"
-    except KeyboardInterrupt as e:
-        outcome, error, code = "interrupted", e, 130
-        raise
-    except Exception as e:
-        outcome, error, code = "failed", e, 1
-        sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
-    except BaseException as e:
-        outcome, error, code = "failed", e, 1
-        raise
-    finally:
-        if recorder is not None:
-            _robot_from_active(recorder)
-            run_id = recorder.finish(outcome, error)
-            err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
-            if recorder.lost_records:
-                err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
-                          soft_wrap=True)
+    ended: BaseException | None = None  # what ended the main thread's root task
+    with StopSignals(stop_main=True) as stop:
+        try:
+            run_script(file, list(ctx.args))
+        except SystemExit as e:
+            code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+            outcome = "succeeded" if code == 0 else "failed"
+            error = None if code == 0 else f"SystemExit: {e.code}"
+            ended = None if code == 0 else e
+        except BaseException as e:
+            if not (stop.requested or isinstance(e, KeyboardInterrupt)):
+                outcome, error, code, ended = "failed", e, 1, e
+                if not isinstance(e, Exception):
+                    raise
+                sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
+            else:
+                # SIGINT / SIGTERM (as `Interrupted`, or as `Evaporated` of the script's tasks), or a
+                # KeyboardInterrupt raised by the script itself
+                stop.request(getattr(e, "signum", signal.SIGINT))
+                outcome, error, code, ended = "interrupted", stop.reason, stop.exit_code, e
+                err.print(f"[bold yellow]pycram run:[/bold yellow] {stop.reason}; the script was stopped")
+        finally:
+            end_thread_root(ended)
+            if recorder is not None:
+                _robot_from_active(recorder)
+                run_id = recorder.finish(outcome, error)
+                err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+                if recorder.lost_records:
+                    err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
+                              soft_wrap=True)
     raise typer.Exit(code)
 
 
@@ -343,7 +356,8 @@ def _check_output_folder(output: str) -> None:
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
-    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
+    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: the run's "
+                                         "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded)."),
     item_at: int = typer.Option(1, "--item-at", min=0, max=3,
                                 help="Where the item starts: position 1, 2 or 3 (0: no item)."),
     steal: int = typer.Option(0, "--steal", min=0, max=_MAX_STEALS,
@@ -355,6 +369,8 @@ def demo_command(
                                           help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
     db: Optional[str] = DbOption,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
+    animation: bool = typer.Option(True, "--animation/--no-animation",
+                                   help="Record the animation run.gif (--no-animation: a faster run)."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     if output is not None:
@@ -367,7 +383,7 @@ def demo_command(
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
                          realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet)
+                         quiet=quiet, animation=animation)
     raise typer.Exit(int(code or 0))
 
 

@@ -14,6 +14,8 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
+from .camera import FollowView
+
 _log = logging.getLogger(__name__)
 
 
@@ -32,11 +34,11 @@ class Renderers:
             self._renderers[key] = r
         return r
 
-    def rgb(self, data: mujoco.MjData, camera: int | str, width: int, height: int) -> np.ndarray:
-        """An RGB image (height x width x 3, uint8) from `camera`."""
+    def rgb(self, data: mujoco.MjData, camera: int | str | FollowView, width: int, height: int) -> np.ndarray:
+        """An RGB image (height x width x 3, uint8) from `camera` (id, name or `FollowView`)."""
         r = self.get(width, height)
         r.disable_segmentation_rendering()
-        r.update_scene(data, camera=camera)
+        r.update_scene(data, camera=camera.view(self.model, data) if isinstance(camera, FollowView) else camera)
         return r.render().copy()
 
     def segmentation(self, data: mujoco.MjData, camera: int | str, width: int, height: int) -> np.ndarray:

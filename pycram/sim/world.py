@@ -19,6 +19,7 @@ and never races afterwards to catch up.
 
 from __future__ import annotations
 
+import atexit
 import logging
 import queue
 import threading
@@ -36,6 +37,7 @@ from pycram.world.objects import object_type
 from pycram.world.scenes import random_scene
 
 from ._runtime import Fluent, ManualClock, current_clock, set_clock
+from .camera import FollowView
 from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
                           JointTrajectory, Reach)
 from .engine import Engine
@@ -64,6 +66,18 @@ _CLOCK_LOCK = threading.Lock()
 #: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
 #: trying to catch up (it then paces from where it is).
 REALTIME_SLACK = 0.05
+#: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
+#: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
+_LIVE_WORLDS: "weakref.WeakSet[World]" = weakref.WeakSet()
+
+
+@atexit.register
+def _close_live_worlds() -> None:
+    for world in list(_LIVE_WORLDS):
+        try:
+            world.close()
+        except BaseException:  # noqa: BLE001 - exiting anyway; never mask the exit
+            _log.debug("closing a world at exit failed", exc_info=True)
 
 
 class World:
@@ -138,6 +152,7 @@ class World:
         self._clock_active = activate_clock
         self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
         self._thread.start()
+        _LIVE_WORLDS.add(self)
 
     # ------------------------------------------------------------------ lifecycle
     def __enter__(self) -> "World":
@@ -157,19 +172,40 @@ class World:
         Commands still running end with reason "closed"; a recording still running is ended
         without writing anything (its recorder thread is joined too); the clock that was active
         before this world is re-activated if this world's clock is still the active one.
+
+        Guarantee: on return no thread of this world (simulation, recorders) runs any more
+        (unless one hangs in a driver for longer than `timeout`: logged). A `KeyboardInterrupt`
+        arriving while it closes does not cut the closing short: it is re-raised afterwards.
         """
+        interrupted: BaseException | None = None
+        for step in (self._stop_simulation, self._close_recorders, self._deactivate_clock):
+            while True:  # each step is idempotent: an interrupted one is simply run again
+                try:
+                    step(timeout)
+                    break
+                except KeyboardInterrupt as exc:
+                    interrupted = exc
+        _LIVE_WORLDS.discard(self)
+        if interrupted is not None:
+            raise interrupted
+
+    def _stop_simulation(self, timeout: float) -> None:
         self._stop.set()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
                 _log.error("simulation thread did not stop within %.1f s", timeout)
+
+    def _close_recorders(self, timeout: float) -> None:
+        """End every recorder thread this world started; a recorder is forgotten only once its
+        thread has ended (so an interrupted call leaves the rest for the next one)."""
         with self._lock:
-            recorders, self._recorders = self._recorders, []
+            recorders = list(self._recorders)
         for recorder in recorders:
             recorder.close(timeout)
-        self._deactivate_clock()
+            self._forget_recorder(recorder, abort=False)
 
-    def _deactivate_clock(self) -> None:
+    def _deactivate_clock(self, timeout: float = 0.0) -> None:
         """Hand the active clock back (once). Worlds may be closed in any order: the clock of a
         world closed earlier is never re-activated; a later world's active clock stays active."""
         with _CLOCK_LOCK:
@@ -428,9 +464,11 @@ class World:
             self._renderers = Renderers(self.scene.model)
         return self._renderers
 
-    def request_image(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
-        """Render an RGB image (height x width x 3, uint8) from `camera`; also set `camera_image`."""
-        self.scene.camera(camera)
+    def request_image(self, camera: str | FollowView = HEAD_CAMERA, width: int = 320,
+                      height: int = 240) -> CommandHandle:
+        """Render an RGB image (height x width x 3, uint8) from `camera` (a camera name or a
+        `FollowView`); also set `camera_image`."""
+        self._check_camera(camera)
 
         def fn(eng: Engine) -> np.ndarray:
             img = self._get_renderers().rgb(eng.data, camera, width, height)
@@ -439,9 +477,17 @@ class World:
 
         return self._call(f"image:{camera}", fn)
 
-    def snapshot(self, path: str | Path, camera: str = "overview", width: int = 640, height: int = 480,
-                 timeout: float = 30.0) -> Path:
-        """Render `camera` and write a PNG to `path` (blocks up to `timeout` [s of wall time])."""
+    def _check_camera(self, camera: str | FollowView) -> None:
+        """Raise for a camera name the scene does not have, or a `FollowView` of unknown bodies."""
+        if isinstance(camera, FollowView):
+            camera.check(self.scene.model)
+        else:
+            self.scene.camera(camera)
+
+    def snapshot(self, path: str | Path, camera: str | FollowView = "overview", width: int = 640,
+                 height: int = 480, timeout: float = 30.0) -> Path:
+        """Render `camera` (a camera name or a `FollowView`) and write a PNG to `path` (blocks up
+        to `timeout` [s of wall time])."""
         handle = self.request_image(camera, width, height)
         _wait_wall(handle, timeout)
         out = handle.outcome
@@ -472,8 +518,9 @@ class World:
         return self._call(f"segmentation:{camera}",
                           lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height))
 
-    def start_recording(self, camera: str = "overview", fps: float = 10.0, width: int = 320,
-                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING) -> CommandHandle:
+    def start_recording(self, camera: str | FollowView = "overview", fps: float = 10.0, width: int = 320,
+                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING,
+                        caption: Callable[[], str] | None = None) -> CommandHandle:
         """Start recording frames of `camera` (width x height [px]) every 1/`fps` s of simulated
         time, from the simulated time at which the command runs; a recording already running is
         discarded.
@@ -483,10 +530,15 @@ class World:
         simulation never waits for rendering. If `max_pending` frames wait to be rendered, a new
         one is dropped (counted and logged when the recording stops). Frames are not limited by
         the world's `offscreen_size`, and are rendered without multisampling.
+
+        `camera` is a camera name or a `FollowView` (a free camera that keeps bodies in view).
+        With `caption` (called in the simulation thread at each frame time; it must be quick and
+        never block, e.g. read a fluent), each frame carries a caption: its text and the
+        simulated time.
         """
-        self.scene.camera(camera)
+        self._check_camera(camera)
         recorder = FrameRecorder(self.scene.model, camera, fps, width, height, max_pending,
-                                 name=f"pycram-recorder-{self.robot}")
+                                 name=f"pycram-recorder-{self.robot}", caption=caption)
         with self._lock:
             self._recorders.append(recorder)
 
@@ -504,14 +556,19 @@ class World:
             raise
 
     def _forget_recorder(self, recorder: FrameRecorder, abort: bool) -> None:
+        """Stop tracking `recorder` for `close()`; with `abort`, end its thread first. A recorder
+        whose thread still runs is never forgotten (`close()` must end it)."""
+        if abort:
+            recorder.close()
+        if recorder.running:
+            return
         with self._lock:
             if recorder in self._recorders:
                 self._recorders.remove(recorder)
-        if abort:
-            recorder.close()
 
     def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
         """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
+        The last frame shows the state at the simulated time the recording stopped.
 
         Waits for the recorder thread to render the frames still pending and ends it. Blocks up
         to `timeout` [s of wall time]; frames not rendered by then are dropped (logged). Returns
@@ -524,6 +581,8 @@ class World:
 
         def fn(eng: Engine) -> FrameRecorder | None:
             recorder, self._recorder = self._recorder, None
+            if recorder is not None:
+                recorder.capture_last(eng.data)  # the animation ends with the state it stopped in
             return recorder
 
         handle = self._call("stop_recording", fn)
@@ -537,7 +596,7 @@ class World:
         else:
             try:
                 frames = recorder.finish(max(0.0, deadline - time.monotonic()))
-            finally:
+            finally:  # if `finish` was interrupted (Ctrl-C), its thread runs on until close()
                 self._forget_recorder(recorder, abort=False)
         if path is not None:
             write_animation(path, frames, frames.fps)
