@@ -155,7 +155,8 @@ class LocationReasoner:
     `environment()` returns the environment's description, `prospection()` the robot's
     `Prospection` in the current world, `known_objects()` the objects believed to be around
     (`KnownObject`s; used for free spots and to look up targets by name). All are called at
-    resolution time, so answers reflect the world as it is then.
+    resolution time, so answers reflect the world as it is then. `last_costmaps` holds the
+    costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
     """
 
     def __init__(self, geometry: RobotGeometry, environment: Callable[[], Environment],
@@ -235,13 +236,14 @@ class LocationReasoner:
                 point = self._grasp_point(target, grasp)
                 poses = grasp_sequence(self.geometry, point, yaw if grasp.approach != "top" else heading,
                                        grasp.approach, action)
-                margin = self.geometry.contact_margin
-                if action == "grasp" and margin:  # room to spare below the grasp
+                margin = self.geometry.contact_margin if action == "grasp" else 0.0
+                if margin:  # room to spare below the grasp
                     (gx, gy, gz), q = poses[1]
                     poses.insert(2, ((gx, gy, gz - margin), q))
                 answer = prosp.reachable(arm, poses, (x, y, yaw), raised)
                 if answer:
-                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=answer.solutions), None
+                    joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
+                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints), None
                 failure = (f"unreachable for arm {arm!r}", answer.reason)
             return None, failure or ("no fitting grasp", None)
 
