@@ -44,3 +44,24 @@ def test_scene_command_names_bad_input(tmp_path, args, message):
     assert result.exit_code == 1
     assert message in " ".join(result.output.split())
     assert not (tmp_path / "x.png").exists()
+
+
+def test_costmap_command_draws_layers_and_chosen_poses(tmp_path):
+    import imageio.v3 as iio
+
+    out = tmp_path / "costmap.png"
+    result = runner.invoke(app, ["costmap", "to_reach cup", "--seed", "3", "--objects", "cup,bowl", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "BaseLocation(" in result.output and "arm=" in result.output  # the poses chosen
+    assert np.asarray(iio.imread(out)).std() > 20
+
+
+def test_costmap_of_an_impossible_location_says_why(tmp_path):
+    out = tmp_path / "none.png"
+    result = runner.invoke(app, ["scene", "--seed", "3", "--objects", "cup", "-o", str(out),
+                                 "--costmap", "in drawer 1, for cereal"])
+    assert result.exit_code == 0, result.output
+    assert "cereal (0.28 m tall) fits on none of" in " ".join(result.output.split())
+    assert out.exists()
+    bad = runner.invoke(app, ["costmap", "to_reach", "-o", str(out)])
+    assert bad.exit_code != 0 and "a location property is 'key value'" in bad.output
