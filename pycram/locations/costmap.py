@@ -7,8 +7,7 @@ array of costs over the grid (>= 0; ``inf`` forbids a cell). Layers built here:
   surely hits the walls or the furniture (from the environment's description, inflated by the
   robot's footprint); extra boxes (an opened drawer, a door's swing) may be added;
 - `ring_layer`: a Gaussian ring around a point, e.g. the distances from which an arm reaches it,
-  or from which the head camera sees it well (``inf`` outside the ring's limits);
-- `distance_layer`: cost growing with the distance from a point (for spots "near" something).
+  or from which the head camera sees it well (``inf`` outside the ring's limits).
 
 A `Costmap` sums its layers and yields cells cheapest first, lazily (`cells`). Everything is
 numpy; a layer over a 6.5 x 5 m room takes well under a millisecond.
@@ -24,7 +23,7 @@ import numpy as np
 
 from pycram.world.environment import Environment, Rect
 
-__all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer", "distance_layer",
+__all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer",
            "rect_distance", "floor_obstacles"]
 
 #: Cell size [m] of the floor grids.
@@ -127,11 +126,6 @@ def ring_layer(grid: FloorGrid, center: Sequence[float], preferred: float, sigma
     cost = ((d - preferred) / sigma) ** 2
     cost[(d < low) | (d > high)] = np.inf
     return cost
-
-
-def distance_layer(grid: FloorGrid, center: Sequence[float], scale: float = 1.0) -> np.ndarray:
-    """Distance [m] of each cell from `center` (x, y), times `scale`."""
-    return scale * np.hypot(grid.x - center[0], grid.y - center[1])
 
 
 class Costmap:
