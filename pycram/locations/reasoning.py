@@ -394,7 +394,9 @@ class LocationReasoner:
             hx, hy, hz = trajectory[0]
             c0, s0 = math.cos(headings[0]), math.sin(headings[0])
             poses = [((hx - c0 * back, hy - s0 * back, hz), _quat_yaw(headings[0]))]
-            poses += [(p, _quat_yaw(h)) for p, h in zip(trajectory, headings)]
+            # the hand grasps the handle facing it, then follows its path (position only: the
+            # wrist turns with a door as it likes)
+            poses += [(trajectory[0], _quat_yaw(headings[0]))] + [(p, None) for p in trajectory[1:]]
             answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
             if answer:
                 return BaseLocation(x, y, yaw, arm, "handle", cost, joints=answer.solutions), None
