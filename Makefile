@@ -1,22 +1,31 @@
 # Two commands do all the set-up on a fresh machine:
 #   make demo  - create the virtual environment, install everything, run the thesis demo headless
-#   make test  - create the virtual environment if needed and run the whole test suite
+#   make test  - create the virtual environment if needed, install ROS 1 (scripts/install_ros.sh)
+#                and run the whole test suite
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+ROS    := $(VENV)/.ros-installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench ros clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -e '.[all,dev]'
 	touch $(STAMP)
 
+# ROS 1 from Debian's packages (apt-get only when something is missing) + generated messages.
+$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/ros/interfaces/*/*) pycram/ros/interfaces/generate.py
+	scripts/install_ros.sh $(VENV)
+	touch $(ROS)
+
+ros: $(ROS)
+
 demo: $(STAMP)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(VENV)/bin/pycram demo
 
-test: $(STAMP)
+test: $(STAMP) $(ROS)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(PY) -m pytest
 
 bench: $(STAMP)
