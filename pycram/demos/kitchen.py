@@ -46,6 +46,7 @@ class DemoOptions:
     record: bool = True
     quiet: bool = False
     animation: bool = True  # record run.gif from the overview camera
+    backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
 
 
 @dataclass
@@ -139,6 +140,8 @@ def run_demo(options: DemoOptions) -> DemoResult:
     """Run the demo once; never raises for plan failures (they are in the result)."""
     if options.item_at not in (0, 1, 2, 3):
         raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {options.item_at}")
+    if options.backend not in ("sim", "ros"):
+        raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in ("pr2", "tiago"):
         raise ValueError(f"--robot must be 'pr2' or 'tiago', not {options.robot!r}")
     output = Path(options.output) if options.output else default_output(options.robot)
@@ -164,28 +167,33 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
     from pycram.demos import kitchen_plan as plan
     from pycram.demos.kitchen_world import (
         ITEM_NAME,
-        SLOTS,
         START_POSE,
         Helper,
         KitchenFacts,
         Operator,
         Thief,
+        demo_items,
         operator_resolver,
     )
     from pycram.runtime import format_task_tree
-    from pycram.sim import COUNTER_HEIGHT, ItemSpec, Pose2D, World
+    from pycram.sim import COUNTER_HEIGHT, Pose2D, World
     from pycram.sim.render import write_animation
 
     output = result.output
     rng = random.Random(options.seed)
-    mug = ItemSpec(ITEM_NAME, "mug", "cylinder", (0.03, 0.05), 0.25,
-                   (*SLOTS[options.item_at], None) if options.item_at else (5.0, 5.0, None), (0.85, 0.2, 0.15, 1))
-    items = [mug] if options.item_at else []
-    world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+    items = demo_items(options.item_at)
+    mug = demo_items(1)[0]  # the mug's size, also when it is not in the kitchen
+    if options.backend == "ros":  # plan -> ROS process modules -> roscore -> sim-ros-bridge -> MuJoCo
+        from pycram.ros.sim_environment import open_ros_world
+
+        world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
+    else:
+        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+        robot = None
     thief = None
     frames: list = []
     try:
-        robot = robot_packages.load(options.robot, world)
+        robot = robot or robot_packages.load(options.robot, world)
         helper = Helper(world, interactive=options.interactive)
         gripper_of = _gripper_mapper(world)
         operator = Operator(helper, gripper_of)
@@ -421,7 +429,7 @@ def _log_to_terminal() -> None:
 
 def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal: int = 0, seed: int = 0,
          realtime: bool = False, interactive: bool = False, db: str | None = None, record: bool = True,
-         quiet: bool = False) -> int:
+         quiet: bool = False, backend: str = "sim") -> int:
     """Run the demo, print the task tree and a summary; return the process exit code."""
     from rich.console import Console
 
@@ -431,7 +439,7 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     console = Console()
     options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
                           seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
-                          quiet=quiet)
+                          quiet=quiet, backend=backend)
     try:
         result = run_demo(options)
     except ValueError as error:  # an option out of range: say which, no traceback
