@@ -99,7 +99,7 @@ class SimRosBridge:
     """Serve ``world`` (a running :class:`pycram.sim.World`) over ROS under ``config``'s names.
 
     The ROS node must be initialised (``rospy.init_node``) before. :meth:`close` stops the
-    timers; the world is the caller's to close.
+    rate loops; the world is the caller's to close.
     """
 
     def __init__(self, world: Any, config: RosRobotConfig, publish_rate: float = 50.0,
@@ -151,10 +151,17 @@ class SimRosBridge:
                                       self._on_command)
         rospy.set_param("/use_sim_time", True)
         self._publish()
-        self._timers = [rospy.Timer(rospy.Duration.from_sec(1.0 / publish_rate), lambda _: self._publish())]
+        # Rate loops in wall time (not rospy.Timer: with /use_sim_time set by an earlier bridge,
+        # rospy's timers would wait for a /clock that only this bridge publishes).
+        self._stop = threading.Event()
+        self._threads = [threading.Thread(target=self._every, args=(1.0 / publish_rate, self._publish),
+                                          name="bridge-publish", daemon=True)]
         if detection_rate > 0:
-            self._timers.append(rospy.Timer(rospy.Duration.from_sec(1.0 / detection_rate),
-                                            lambda _: self._publish_detections()))
+            self._threads.append(threading.Thread(target=self._every,
+                                                  args=(1.0 / detection_rate, self._publish_detections),
+                                                  name="bridge-detections", daemon=True))
+        for thread in self._threads:
+            thread.start()
         logger.info("sim-ros-bridge for %s: serving %d actions", c.robot, len(self._servers))
 
     # -- goals → simulator commands ------------------------------------------------------------
@@ -274,9 +281,21 @@ class SimRosBridge:
         return response(success=outcome.succeeded, reason=outcome.reason, message=outcome.message,
                         value="" if outcome.value is None else str(outcome.value))
 
+    def _every(self, period: float, publish: Callable[[], None]) -> None:
+        """Call ``publish`` every ``period`` [s, wall] until :meth:`close`."""
+        while not self._stop.wait(period):
+            try:
+                publish()
+            except Exception:  # e.g. the node shutting down, the world closed
+                if self._stop.is_set() or rospy.is_shutdown():
+                    return
+                logger.exception("sim-ros-bridge: publishing failed")
+
     def close(self) -> None:
-        for timer in self._timers:
-            timer.shutdown()
+        """Stop publishing (joins the rate loops) and the service (idempotent)."""
+        self._stop.set()
+        for thread in self._threads:
+            thread.join(5.0)
         self._service.shutdown()
 
 

@@ -152,14 +152,42 @@ class Ros1ActionChannel(ActionChannel):
         self._client.cancel_all_goals()
 
 
+class _Topic:
+    """One rospy subscriber per topic (one connection per publisher), fanning its messages out
+    to every callback of this process; a closed subscription only removes its callback."""
+
+    def __init__(self, topic: str, msg_type: str) -> None:
+        self.msg_type = msg_type
+        self.callbacks: list[Callable[[Any], None]] = []
+        self._lock = threading.Lock()
+        self._subscriber = rospy.Subscriber(topic, message_class(msg_type), self._deliver, queue_size=1)
+
+    def _deliver(self, message: Any) -> None:
+        with self._lock:
+            callbacks = list(self.callbacks)
+        for callback in callbacks:
+            try:
+                callback(message)
+            except Exception:
+                logger.exception("callback %r failed on a %s message", callback, self.msg_type)
+
+    def add(self, callback: Callable[[Any], None]) -> None:
+        with self._lock:
+            self.callbacks.append(callback)
+
+    def remove(self, callback: Callable[[Any], None]) -> None:
+        with self._lock:
+            if callback in self.callbacks:
+                self.callbacks.remove(callback)
+
+
 class _Ros1Subscription(Subscription):
-    def __init__(self, subscriber: Any) -> None:
-        self._subscriber = subscriber
+    def __init__(self, topic: _Topic, callback: Callable[[Any], None]) -> None:
+        self._topic, self._callback = topic, callback
+        topic.add(callback)
 
     def close(self) -> None:
-        if self._subscriber is not None:
-            self._subscriber.unregister()
-            self._subscriber = None
+        self._topic.remove(self._callback)
 
 
 def rosgraph_master() -> str:
@@ -181,6 +209,7 @@ class Ros1Transport(Transport):
         if not rospy.core.is_initialized():
             rospy.init_node(node_name, anonymous=True, disable_signals=True)
         self._channels: dict[str, Ros1ActionChannel] = {}
+        self._topics: dict[str, _Topic] = {}
         self._subscriptions: list[_Ros1Subscription] = []
         self._watch_cond = threading.Condition()
         self._watched: dict[_Ros1GoalHandle, Ros1ActionChannel] = {}
@@ -200,8 +229,13 @@ class Ros1Transport(Transport):
         return channel
 
     def subscribe(self, topic: str, msg_type: str, callback: Callable[[Any], None]) -> Subscription:
-        subscription = _Ros1Subscription(
-            rospy.Subscriber(topic, message_class(msg_type), callback, queue_size=1))
+        with _lock:
+            shared = self._topics.get(topic)
+            if shared is None:
+                shared = self._topics[topic] = _Topic(topic, msg_type)
+        if shared.msg_type != msg_type:
+            raise ValueError(f"topic {topic!r} is subscribed as {shared.msg_type!r}, not {msg_type!r}")
+        subscription = _Ros1Subscription(shared, callback)
         self._subscriptions.append(subscription)
         return subscription
 
