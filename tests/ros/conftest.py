@@ -60,10 +60,24 @@ def transport(ros_master):
     return ros1_transport()
 
 
-def start_bridge(robot: str, master, item_at: int = 1):
+def _start_bridge(robot: str, master, item_at: int = 1):
     from pycram.ros.launch import BridgeProcess
 
     return BridgeProcess(robot, master.uri, item_at=item_at)
+
+
+@pytest.fixture
+def start_bridge(ros_master):
+    """``start_bridge(robot, item_at=1)`` -> a running bridge process, stopped after the test."""
+    bridges = []
+
+    def start(robot: str, item_at: int = 1):
+        bridges.append(_start_bridge(robot, ros_master, item_at))
+        return bridges[-1]
+
+    yield start
+    for bridge in bridges:
+        bridge.stop()
 
 
 @pytest.fixture(scope="module", params=["pr2", "tiago"])
@@ -71,7 +85,7 @@ def ros_robot(request, ros_master, transport):
     """A bridge for the robot of the parameter and the robot over ROS, active for the module."""
     from pycram.ros.robot import make_ros_robot
 
-    bridge = start_bridge(request.param, ros_master)
+    bridge = _start_bridge(request.param, ros_master)
     try:
         robot = make_ros_robot(request.param, transport)
         with robot:
