@@ -155,10 +155,11 @@ def test_demo_passes_options_through(monkeypatch, db):
     fake.main = fake_main
     monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
     result = _invoke("demo", "--robot", "tiago", "--output", "out", "--item-at", "2", "--steal", "1",
-                     "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet")
+                     "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet",
+                     "--backend", "ros")
     assert result.exit_code == 0, result.output
     assert calls == dict(robot="tiago", output="out", item_at=2, steal=1, seed=7, realtime=True,
-                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True)
+                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True, backend="ros")
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")
     assert calls["record"] is False and calls["robot"] == "pr2"
