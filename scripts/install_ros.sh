@@ -22,9 +22,16 @@ for package in $PACKAGES; do
     fi
 done
 if [ -n "$missing" ]; then
+    if ! command -v apt-get >/dev/null 2>&1; then
+        echo "install_ros: WARNING: no apt-get (not Debian/Ubuntu): ROS 1 not installed; tests/ros will be skipped" >&2
+        exit 0
+    fi
     echo "install_ros: installing$missing"
     SUDO=""
-    if [ "$(id -u)" != 0 ]; then SUDO=sudo; fi
+    if [ "$(id -u)" != 0 ]; then
+        command -v sudo >/dev/null 2>&1 || { echo "install_ros: need root (or sudo) for apt-get install$missing" >&2; exit 1; }
+        SUDO=sudo
+    fi
     $SUDO apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
 fi
