@@ -11,7 +11,8 @@ A ROS 1 node that runs a :class:`pycram.sim.World` and serves, under the names o
   outcome reason: ``collision``, ``blocked``, ``unreachable``, ``timeout``, ``invalid`` ...);
   a malformed goal (wrong frame, unknown joints) is rejected with reason ``invalid``.
 * topics, at ``publish_rate`` [Hz of wall time]: ``/clock`` (simulation time; the bridge sets
-  ``/use_sim_time``), the base pose (``/amcl_pose``), ``/joint_states`` (gripper openings as
+  ``/use_sim_time``), the base pose (``/amcl_pose``, and as the tf transform map ->
+  base_footprint on ``/tf``), ``/joint_states`` (gripper openings as
   the configured opening joints), and ``<sim_namespace>/items`` (simulator ground truth:
   where each item is and which gripper holds it -- for judging runs, never for plans).
   ``detections_topic``: the items the head camera sees, at ``detection_rate`` [Hz], only while
@@ -147,6 +148,9 @@ class SimRosBridge:
                                           queue_size=1)
         self._detections_pub = rospy.Publisher(c.detections_topic, message_class("pycram_msgs/DetectedItems"),
                                                queue_size=1)
+        import tf2_ros
+
+        self._tf = tf2_ros.TransformBroadcaster()
         self._service = rospy.Service(f"{c.sim_namespace}/command", message_class("pycram_msgs/SimCommand", "srv"),
                                       self._on_command)
         rospy.set_param("/use_sim_time", True)
@@ -227,6 +231,12 @@ class SimRosBridge:
         pose.pose.pose.position.x, pose.pose.pose.position.y = base.x, base.y
         pose.pose.pose.orientation.z, pose.pose.pose.orientation.w = math.sin(base.yaw / 2), math.cos(base.yaw / 2)
         self._pose_pub.publish(pose)
+        transform = message_class("geometry_msgs/TransformStamped")()
+        transform.header.stamp, transform.header.frame_id = stamp, c.map_frame
+        transform.child_frame_id = c.base_frame
+        transform.transform.translation.x, transform.transform.translation.y = base.x, base.y
+        transform.transform.rotation = pose.pose.pose.orientation
+        self._tf.sendTransform(transform)
         positions = dict(w.joint_states.get_value().position)
         for gripper, interface in c.grippers.items():
             opening = float(w.gripper_openings[gripper].get_value())

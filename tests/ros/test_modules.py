@@ -109,3 +109,19 @@ def test_a_goal_in_another_frame_is_rejected_naming_the_frame(ros_robot, transpo
     outcome = handle.result.get_value()
     assert outcome.status == "rejected"
     assert outcome.text.startswith("invalid:") and "'odom'" in outcome.text
+
+
+def test_tf_has_the_base_in_the_map_frame(ros_robot):
+    import rospy
+    import tf2_ros
+
+    buffer = tf2_ros.Buffer()
+    listener = tf2_ros.TransformListener(buffer)
+    try:
+        transform = buffer.lookup_transform(ros_robot.config.map_frame, ros_robot.config.base_frame,
+                                            rospy.Time(0), rospy.Duration(10.0))
+        here = ros_robot.state.base_pose.get_value()
+        assert transform.transform.translation.x == pytest.approx(here.x, abs=0.05)
+        assert transform.transform.translation.y == pytest.approx(here.y, abs=0.05)
+    finally:
+        listener.unregister()
