@@ -30,7 +30,7 @@ from typing import Any, Optional
 
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule
-from pycram.robots.sim_modules import _check_cmd, _fmt, _fmt_pose2d
+from pycram.robots.sim_modules import _check_cmd, _fmt, _fmt_pose2d, cancel_running_handle
 from pycram.ros.config import RosRobotConfig
 from pycram.ros.transport import (ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed,
                                   Transport)
@@ -153,13 +153,7 @@ class RosProcessModule(ProcessModule):
         raise error(command, reason, message, action, outcome)
 
     def _cancel(self, designator: Any) -> None:
-        current = self.current
-        if current is None or current.designator is not designator:
-            return  # evaporated while queued: the running goal belongs to another caller
-        handle, self._handle = self._handle, None
-        if handle is not None and not handle.done:
-            logger.info("%s: cancelling the goal on %s", self.name, handle.action)
-            handle.cancel()
+        cancel_running_handle(self, designator)
 
     def _point(self, x: float, y: float, z: float) -> Any:
         return self.transport.message("geometry_msgs/Point", x=float(x), y=float(y), z=float(z))

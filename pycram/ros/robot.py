@@ -11,9 +11,9 @@ from __future__ import annotations
 import importlib
 from typing import Any, Optional
 
-from pycram.process_module import ProcessModule, ProcessModuleStatus
+from pycram.process_module import ProcessModule
 from pycram.robot import Robot
-from pycram.robots.sim_modules import SensorModule
+from pycram.robots.sim_modules import SensorModule, shutdown_modules
 from pycram.robots.sim_resolvers import (make_motion_resolver, make_to_reach_generator,
                                          physical_arm, physical_gripper)
 from pycram.robots.sim_vocabulary import motion_types
@@ -35,11 +35,7 @@ class RosRobot(Robot):
         self.transport, self.config, self.state, self.description = transport, config, state, description
 
     def shutdown(self) -> None:
-        for module in self.process_modules.values():
-            if isinstance(module, SensorModule):
-                module.unsubscribe_all()
-            if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
-                module.shutdown()
+        shutdown_modules(self)
         self.state.close()
 
     def __repr__(self) -> str:

@@ -92,6 +92,10 @@ class GoalHandle:
         self._lock = threading.Lock()
 
     @property
+    def name(self) -> str:
+        return f"the goal on {self.action}"
+
+    @property
     def done(self) -> bool:
         return self.result.get_value() is not None
 
