@@ -295,6 +295,8 @@ def sim_ros_bridge_command(
 ) -> None:
     """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
     /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
+    if robot not in ("pr2", "tiago"):
+        _fail(f"--robot must be 'pr2' or 'tiago', not {robot!r}", code=2)
     try:
         from pycram.ros.launch import check_master_uri
     except ImportError as e:

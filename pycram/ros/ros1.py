@@ -114,14 +114,15 @@ class Ros1ActionChannel(ActionChannel):
     def wait_for_server(self, timeout: float) -> bool:
         """Wait at most ``timeout`` [s, wall] until the server's status arrives and it listens
         to our goals. The status wakes this wait; the publishers' connection counts are
-        re-checked every 20 ms (rospy has no event for them), within the same bound."""
+        re-checked every 20 ms (rospy has no event for them), within the same bound. Waits in
+        slices of at most 0.1 s so that an evaporation injected into this thread lands promptly."""
         deadline = time.monotonic() + timeout
         with self._cond:
             while not self._connected():
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     return False
-                self._cond.wait(min(remaining, 0.02 if self.server_alive() else remaining))
+                self._cond.wait(min(remaining, 0.02 if self.server_alive() else 0.1))
         return True
 
     def send(self, goal: Any) -> GoalHandle:

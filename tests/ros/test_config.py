@@ -76,3 +76,17 @@ def test_pycram_ros_imports_without_rospy():
     code = ("import sys; import pycram.ros, pycram.ros.transport, pycram.ros.config, pycram.ros.launch; "
             "assert 'rospy' not in sys.modules, 'rospy imported'")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_bridge_cli_refuses_an_unknown_robot_and_a_remote_master(monkeypatch, capsys):
+    from pycram.cli import main
+
+    monkeypatch.setenv("ROS_MASTER_URI", "http://127.0.0.1:11311")
+    assert main(["sim-ros-bridge", "--robot", "r2d2"]) == 2
+    assert "--robot must be 'pr2' or 'tiago', not 'r2d2'" in " ".join(capsys.readouterr())
+    monkeypatch.setenv("ROS_MASTER_URI", "http://10.1.2.3:11311")
+    assert main(["sim-ros-bridge", "--robot", "pr2"]) == 2
+    assert "not on loopback" in " ".join(capsys.readouterr())
+    monkeypatch.delenv("ROS_MASTER_URI")
+    assert main(["sim-ros-bridge"]) == 2
+    assert "ROS_MASTER_URI is not set" in " ".join(capsys.readouterr())
