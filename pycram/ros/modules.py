@@ -76,6 +76,10 @@ class RosRobotState:
         self.joint_states = Fluent(None, name="joint_states")
         self.gripper_openings = {g: Fluent(None, name=f"{g}_gripper_opening") for g in config.grippers}
         self._ready = threading.Event()
+        #: number of base-pose messages received so far
+        self.pose_updates = Fluent(0, name="base_pose updates")
+        #: number of joint-state messages received so far
+        self.joint_updates = Fluent(0, name="joint_states updates")
         self._subscriptions = [
             transport.subscribe(config.pose_topic, "geometry_msgs/PoseWithCovarianceStamped", self._on_pose),
             transport.subscribe(config.joint_states_topic, "sensor_msgs/JointState", self._on_joints),
@@ -84,7 +88,24 @@ class RosRobotState:
     def _on_pose(self, message: Any) -> None:
         pose = message.pose.pose
         self.base_pose.set_value(Pose2D(pose.position.x, pose.position.y, yaw_of(pose.orientation)))
+        self.pose_updates.set_value(self.pose_updates.get_value() + 1)
         self._check_ready()
+
+    def fresh_base_pose(self, timeout: float = 2.0) -> Optional[Pose2D]:
+        """The base pose from a message sampled after now (see :meth:`wait_fresh`)."""
+        self.wait_fresh(self.pose_updates, timeout)
+        return self.base_pose.get_value()
+
+    @staticmethod
+    def wait_fresh(updates: Fluent, timeout: float = 2.0) -> bool:
+        """Wait (evaporably, at most ``timeout`` [s, active clock]) for the second message from
+        now on the topic counted by ``updates`` (:attr:`pose_updates`, :attr:`joint_updates`):
+        the first may have been sampled before now and still be on its way. Afterwards the
+        sensor fluents show the robot as it was after now."""
+        seen = updates.get_value()
+        fresh = Fluent(lambda: True if updates.get_value() >= seen + 2 else None)
+        updates.add_child(fresh)
+        return fresh.wait_for(timeout)
 
     def _on_joints(self, message: Any) -> None:
         positions = dict(zip(message.name, message.position))
@@ -92,6 +113,7 @@ class RosRobotState:
         for name, gripper in self.config.grippers.items():
             if all(j in positions for j in gripper.opening_joints):
                 self.gripper_openings[name].set_value(sum(positions[j] for j in gripper.opening_joints))
+        self.joint_updates.set_value(self.joint_updates.get_value() + 1)
         self._check_ready()
 
     def _check_ready(self) -> None:
@@ -164,7 +186,7 @@ class RosProcessModule(ProcessModule):
 
 class RosNavigationModule(RosProcessModule):
     """``'cmd': 'navigate'`` → a ``move_base`` goal in the map frame; returns the base pose
-    reached (from the pose topic)."""
+    reached (from a pose message sampled after the goal succeeded)."""
 
     def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
                  name: str = "navigation") -> None:
@@ -189,7 +211,7 @@ class RosNavigationModule(RosProcessModule):
         except RosMotionFailed as e:
             e.args = (f"{e.args[0]} (stopped at {_fmt_pose2d(self.state.base_pose.get_value())})",)
             raise
-        return self.state.base_pose.get_value()
+        return self.state.fresh_base_pose()
 
 
 class RosBaseStopModule(RosProcessModule):
@@ -212,7 +234,7 @@ class RosBaseStopModule(RosProcessModule):
             waiter = Fluent(lambda: True if execution.done else None)
             execution.status.add_child(waiter)
             waiter.wait_for(5.0)
-        return self.state.base_pose.get_value()
+        return self.state.fresh_base_pose()
 
 
 class RosHeadModule(RosProcessModule):
@@ -324,7 +346,8 @@ class RosArmModule(RosProcessModule):
 
 class RosGripperModule(RosProcessModule):
     """``'cmd': 'set_gripper'`` → a GripperCommand goal (position = opening [m], max_effort [N],
-    0 for the gripper's default); returns the measured opening [m]."""
+    0 for the gripper's default); returns the measured opening [m] once the joint states (and
+    so the gripper-opening fluents) show the gripper after the command."""
 
     def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
                  gripper: str, name: Optional[str] = None) -> None:
@@ -341,6 +364,7 @@ class RosGripperModule(RosProcessModule):
             "control_msgs/GripperCommand", position=opening, max_effort=float(effort or 0.0)))
         result = self._run_goal(self.config.grippers[self.gripper].action, "control_msgs/GripperCommand",
                                 goal, f"set the {self.gripper} gripper to {opening:.3f} m", timeout=10.0)
+        self.state.wait_fresh(self.state.joint_updates)  # the opening fluents show the result
         return float(result.position)
 
 
