@@ -84,8 +84,8 @@ class _StatusWatchingClient(actionlib.ActionClient):
         super().__init__(ns, action_spec)
 
     def _status_cb(self, msg: Any) -> None:
-        self._on_status()
         super()._status_cb(msg)
+        self._on_status()
 
 
 class Ros1ActionChannel(ActionChannel):
@@ -107,13 +107,21 @@ class Ros1ActionChannel(ActionChannel):
         return time.monotonic() - self.last_status < self._transport.server_timeout
 
     def _connected(self) -> bool:
+        """The server is alive and connected both ways: our goal and cancel publishers reach it,
+        and its result and feedback reach us (as actionlib's own check: a goal sent before the
+        result topic is connected can succeed on the server and never be reported)."""
         client = self._client
-        return (self.server_alive() and client.pub_goal.get_num_connections() > 0
-                and client.pub_cancel.get_num_connections() > 0)
+        status = client.last_status_msg
+        if status is None or not self.server_alive():
+            return False
+        server = status._connection_header["callerid"]
+        return (client.pub_goal.impl.has_connection(server) and client.pub_cancel.impl.has_connection(server)
+                and any(c.callerid_pub == server for c in client.result_sub.impl.connections)
+                and any(c.callerid_pub == server for c in client.feedback_sub.impl.connections))
 
     def wait_for_server(self, timeout: float) -> bool:
-        """Wait at most ``timeout`` [s, wall] until the server's status arrives and it listens
-        to our goals. The status wakes this wait; the publishers' connection counts are
+        """Wait at most ``timeout`` [s, wall] until the server's status arrives and it is
+        connected both ways (see :meth:`_connected`). The status wakes this wait; the publishers' connection counts are
         re-checked every 20 ms (rospy has no event for them), within the same bound. Waits in
         slices of at most 0.1 s so that an evaporation injected into this thread lands promptly."""
         deadline = time.monotonic() + timeout
