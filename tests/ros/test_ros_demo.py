@@ -9,13 +9,15 @@ import sys
 from pycram.demos.kitchen import DemoOptions, run_demo
 
 
-def test_demo_over_ros_recovers_from_a_theft_pr2(start_bridge, transport, tmp_path):
-    """PR2, in this process, against a bridge on the session's master; the item is stolen once."""
-    start_bridge("pr2", item_at=1)
-    result = run_demo(DemoOptions(robot="pr2", backend="ros", steal=1, output=tmp_path, record=False,
-                                  quiet=True, animation=False))
+def test_demo_over_ros_recovers_from_failed_grasps_and_a_theft_pr2(start_bridge, transport, tmp_path):
+    """PR2, in this process, against a bridge on the session's master: the item is at the third
+    position (two grasps close on nothing) and is stolen once during the transport."""
+    start_bridge("pr2", item_at=3)
+    result = run_demo(DemoOptions(robot="pr2", backend="ros", item_at=3, steal=1, output=tmp_path,
+                                  record=False, quiet=True, animation=False))
     assert result.exit_code == 0, f"{result.message}\n{result.tree_text}"
     assert result.item_on_cooker_1
+    assert result.failed_grasps == 2
     assert result.recoveries == 1
     assert (tmp_path / "end.png").stat().st_size > 0  # rendered by the bridge
 
