@@ -26,6 +26,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+import time
 from typing import Any, Optional
 
 from pycram.fluent import Fluent
@@ -60,6 +61,35 @@ def yaw_of(orientation: Any) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
+class MessageCounter:
+    """Counts the messages of one topic and keeps the latest; :meth:`wait_for_count` waits for
+    a later one, bounded in wall time -- whatever clock the plan runs on (a simulation clock
+    stops with the simulator, a wall bound does not)."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.latest: Any = None
+        self._cond = threading.Condition()
+
+    def tick(self, message: Any = None) -> None:
+        with self._cond:
+            self.count += 1
+            self.latest = message
+            self._cond.notify_all()
+
+    def wait_for_count(self, count: int, timeout: float) -> bool:
+        """Wait until ``count`` messages arrived (at most ``timeout`` [s, wall], in slices of
+        0.1 s so an evaporation of the caller lands promptly). True if they did."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while self.count < count:
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return False
+                self._cond.wait(min(remaining, 0.1))
+        return True
+
+
 class RosRobotState:
     """The robot's sensors over ROS, as fluents (thesis: ``subscribe_pose``/``subscribe_gripper``).
 
@@ -76,10 +106,8 @@ class RosRobotState:
         self.joint_states = Fluent(None, name="joint_states")
         self.gripper_openings = {g: Fluent(None, name=f"{g}_gripper_opening") for g in config.grippers}
         self._ready = threading.Event()
-        #: number of base-pose messages received so far
-        self.pose_updates = Fluent(0, name="base_pose updates")
-        #: number of joint-state messages received so far
-        self.joint_updates = Fluent(0, name="joint_states updates")
+        self.pose_updates = MessageCounter()  #: base-pose messages received
+        self.joint_updates = MessageCounter()  #: joint-state messages received
         self._subscriptions = [
             transport.subscribe(config.pose_topic, "geometry_msgs/PoseWithCovarianceStamped", self._on_pose),
             transport.subscribe(config.joint_states_topic, "sensor_msgs/JointState", self._on_joints),
@@ -88,7 +116,7 @@ class RosRobotState:
     def _on_pose(self, message: Any) -> None:
         pose = message.pose.pose
         self.base_pose.set_value(Pose2D(pose.position.x, pose.position.y, yaw_of(pose.orientation)))
-        self.pose_updates.set_value(self.pose_updates.get_value() + 1)
+        self.pose_updates.tick()
         self._check_ready()
 
     def fresh_base_pose(self, timeout: float = 2.0) -> Optional[Pose2D]:
@@ -97,15 +125,12 @@ class RosRobotState:
         return self.base_pose.get_value()
 
     @staticmethod
-    def wait_fresh(updates: Fluent, timeout: float = 2.0) -> bool:
-        """Wait (evaporably, at most ``timeout`` [s, active clock]) for the second message from
-        now on the topic counted by ``updates`` (:attr:`pose_updates`, :attr:`joint_updates`):
-        the first may have been sampled before now and still be on its way. Afterwards the
-        sensor fluents show the robot as it was after now."""
-        seen = updates.get_value()
-        fresh = Fluent(lambda: True if updates.get_value() >= seen + 2 else None)
-        updates.add_child(fresh)
-        return fresh.wait_for(timeout)
+    def wait_fresh(updates: MessageCounter, timeout: float = 2.0) -> bool:
+        """Wait (at most ``timeout`` [s, wall]) for the second message from now on the topic
+        counted by ``updates`` (:attr:`pose_updates`, :attr:`joint_updates`): the first may have
+        been sampled before now and still be on its way. Afterwards the sensor fluents show the
+        robot as it was after now."""
+        return updates.wait_for_count(updates.count + 2, timeout)
 
     def _on_joints(self, message: Any) -> None:
         positions = dict(zip(message.name, message.position))
@@ -113,7 +138,7 @@ class RosRobotState:
         for name, gripper in self.config.grippers.items():
             if all(j in positions for j in gripper.opening_joints):
                 self.gripper_openings[name].set_value(sum(positions[j] for j in gripper.opening_joints))
-        self.joint_updates.set_value(self.joint_updates.get_value() + 1)
+        self.joint_updates.tick()
         self._check_ready()
 
     def _check_ready(self) -> None:
@@ -369,40 +394,31 @@ class RosGripperModule(RosProcessModule):
 
 
 class RosPerceptionModule(RosProcessModule):
-    """``'cmd': 'perceive'``: the items of the next detections message after the request (most
+    """``'cmd': 'perceive'``: the items of a detections message sampled after the request (most
     visible first), restricted to ``'object'`` (name or type) when given. Fails with reason
-    ``'timeout'`` when no detections arrive within 10 s (active clock)."""
+    ``'timeout'`` when no detections arrive within 10 s (wall time)."""
 
     def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
                  name: str = "perception") -> None:
         super().__init__(name, transport, config, state)
-        self.detections = Fluent(None, name="detections")  # (count, message)
-        self._count = 0
-        self._subscription = transport.subscribe(config.detections_topic, "pycram_msgs/DetectedItems",
-                                                 self._on_detections)
-
-    def _on_detections(self, message: Any) -> None:
-        self._count += 1
-        self.detections.set_value((self._count, message))
+        self.detections = MessageCounter()
+        self._subscription: Any = None  # subscribed on first use: the bridge renders only for subscribers
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
-        seen_before = self._count
-
-        def newer() -> Any:
-            value = self.detections.get_value()
-            return value[1] if value is not None and value[0] > seen_before else None
-
-        waiter = Fluent(newer)
-        self.detections.add_child(waiter)
-        if not waiter.wait_for(10.0):
+        if self._subscription is None:
+            self._subscription = self.transport.subscribe(self.config.detections_topic,
+                                                          "pycram_msgs/DetectedItems", self.detections.tick)
+        # the second message from now: the first may show the scene from before the request
+        if not self.detections.wait_for_count(self.detections.count + 2, 10.0):
             raise RosMotionFailed("perceive", "timeout", f"no detections on "
                                   f"{self.config.detections_topic} within 10.0 s")
+        message = self.detections.latest
         items = [VisibleItem(i.name, i.type, Pose((i.pose.position.x, i.pose.position.y, i.pose.position.z),
                                                   (i.pose.orientation.w, i.pose.orientation.x,
                                                    i.pose.orientation.y, i.pose.orientation.z)),
                              int(i.pixels), (float(i.u), float(i.v)))
-                 for i in newer().items]
+                 for i in message.items]
         wanted = solution.get("object")
         return items if wanted is None else [i for i in items if wanted in (i.name, i.type)]
