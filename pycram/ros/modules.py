@@ -19,6 +19,10 @@ Guarantees
   :class:`~pycram.ros.transport.ActionServerUnavailable` within its ``connect_timeout``.
 - Evaporating the caller cancels the goal on the server (``_cancel``): an evaporated drive
   cancels the ``move_base`` goal and the base stops.
+- When a drive or a gripper command returns, the sensor fluents (base pose, gripper openings)
+  already show the robot after it: the module waits for a message sampled after the goal ended.
+  Such waits on the robot's own messages are bounded in wall time, so a stopped simulation
+  clock (a dead bridge) cannot hang them.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from pycram.ros.transport import (ActionServerLost, GoalHandle, GoalOutcome, Ros
 from pycram.sim.types import Pose, Pose2D, VisibleItem
 
 __all__ = [
+    "MessageCounter",
     "RosRobotState",
     "RosProcessModule",
     "RosNavigationModule",
