@@ -121,9 +121,10 @@ class Ros1ActionChannel(ActionChannel):
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait at most ``timeout`` [s, wall] until the server's status arrives and it is
-        connected both ways (see :meth:`_connected`). The status wakes this wait; the publishers' connection counts are
-        re-checked every 20 ms (rospy has no event for them), within the same bound. Waits in
-        slices of at most 0.1 s so that an evaporation injected into this thread lands promptly."""
+        connected both ways (see :meth:`_connected`). The status wakes this wait; the
+        connections are re-checked every 20 ms (rospy has no event for them), within the same
+        bound. Waits in slices of at most 0.1 s so that an evaporation injected into this thread
+        lands promptly."""
         deadline = time.monotonic() + timeout
         with self._cond:
             while not self._connected():
