@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 # ROS 1 from Debian's packages (apt-get only when something is missing) + generated messages.
-$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/ros/interfaces/*/*) pycram/ros/interfaces/generate.py
+$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/ros/interfaces/*/*.msg pycram/ros/interfaces/*/*.action pycram/ros/interfaces/*/*.srv) pycram/ros/interfaces/generate.py
 	scripts/install_ros.sh $(VENV)
 	touch $(ROS)
 
