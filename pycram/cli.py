@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -371,6 +372,9 @@ def demo_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
     animation: bool = typer.Option(True, "--animation/--no-animation",
                                    help="Record the animation run.gif (--no-animation: a faster run)."),
+    backend: str = typer.Option("sim", "--backend",
+                                help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
+                                     "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set)."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     if output is not None:
@@ -383,7 +387,7 @@ def demo_command(
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
                          realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet, animation=animation)
+                         quiet=quiet, animation=animation, backend=backend)
     raise typer.Exit(int(code or 0))
 
 
@@ -421,6 +425,39 @@ def scene_command(
     finally:
         world.close()
     console.print(f"wrote {escape(str(path))}")
+
+
+@app.command("sim-ros-bridge")
+def sim_ros_bridge_command(
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
+                                help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."),
+    realtime: bool = typer.Option(False, "--realtime", help="Simulate at real-time speed (default: as fast as "
+                                  "possible; /clock carries the simulation time)."),
+    publish_rate: float = typer.Option(50.0, "--publish-rate", min=1.0, help="Sensor topics per second [Hz, wall]."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address the node binds to and advertises (ROS_IP). "
+                             "Loopback by default: nothing outside this machine can command the robot."),
+    allow_remote_master: bool = typer.Option(False, "--allow-remote-master",
+                                             help="Accept a ROS_MASTER_URI that is not on loopback."),
+) -> None:
+    """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
+    /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
+    if robot not in ("pr2", "tiago"):
+        _fail(f"--robot must be 'pr2' or 'tiago', not {robot!r}", code=2)
+    try:
+        from pycram.ros.launch import check_master_uri
+    except ImportError as e:
+        _fail(f"sim-ros-bridge needs ROS 1 (run scripts/install_ros.sh): {e}")
+    try:
+        check_master_uri(os.environ.get("ROS_MASTER_URI"), allow_remote=allow_remote_master)
+    except ValueError as e:
+        _fail(str(e), code=2)
+    os.environ["ROS_IP"] = os.environ["ROS_HOSTNAME"] = host
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from pycram.ros.bridge import run_bridge
+
+    run_bridge(robot, item_at=item_at, realtime=realtime, publish_rate=publish_rate,
+               ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True))
 
 
 def main(argv: list[str] | None = None) -> int:

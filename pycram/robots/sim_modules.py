@@ -47,6 +47,8 @@ __all__ = [
     "SensorModule",
     "PerceptionModule",
     "SimRobot",
+    "cancel_running_handle",
+    "shutdown_modules",
 ]
 
 logger = logging.getLogger(__name__)
@@ -135,13 +137,21 @@ class SimProcessModule(ProcessModule):
         return outcome.value
 
     def _cancel(self, designator: Any) -> None:
-        current = self.current
-        if current is None or current.designator is not designator:
-            return  # evaporated while queued: the running command belongs to another caller
-        handle, self._handle = self._handle, None
-        if handle is not None and not handle.done:
-            logger.info("%s: cancelling %s", self.name, handle.name)
-            handle.cancel()
+        cancel_running_handle(self, designator)
+
+
+def cancel_running_handle(module: Any, designator: Any) -> None:
+    """The cancel hook of a module that keeps its running command's handle in ``module._handle``
+    (a simulator command, a ROS goal: anything with ``name``, ``done`` and ``cancel()``): cancel
+    it -- unless ``designator`` was evaporated while still queued, when the running command
+    belongs to another caller."""
+    current = module.current
+    if current is None or current.designator is not designator:
+        return
+    handle, module._handle = module._handle, None
+    if handle is not None and not handle.done:
+        logger.info("%s: cancelling %s", module.name, handle.name)
+        handle.cancel()
 
 
 class NavigationModule(SimProcessModule):
@@ -377,6 +387,16 @@ def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
                          f"{solution!r}")
 
 
+def shutdown_modules(robot: Robot) -> None:
+    """End every subscription of ``robot``'s sensor modules and take all its process modules
+    offline (running motions finish); idempotent."""
+    for module in robot.process_modules.values():
+        if isinstance(module, SensorModule):
+            module.unsubscribe_all()
+        if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
+            module.shutdown()
+
+
 class SimRobot(Robot):
     """A :class:`pycram.robot.Robot` bound to a simulated :class:`pycram.sim.World`.
 
@@ -393,11 +413,7 @@ class SimRobot(Robot):
 
     def shutdown(self) -> None:
         """Stop subscriptions and take all process modules offline (running motions finish)."""
-        for module in self.process_modules.values():
-            if isinstance(module, SensorModule):
-                module.unsubscribe_all()
-            if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
-                module.shutdown()
+        shutdown_modules(self)
 
     def __repr__(self) -> str:
         return f"SimRobot({self.name!r}, {self.world!r})"
