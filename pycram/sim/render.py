@@ -52,6 +52,17 @@ class Renderers:
         ids[seg[:, :, 1] != int(mujoco.mjtObj.mjOBJ_GEOM)] = -1
         return ids
 
+    def depth(self, data: mujoco.MjData, camera: int | str, width: int, height: int) -> np.ndarray:
+        """Distance along the optical axis per pixel [m] (height x width, float32) from `camera`."""
+        r = self.get(width, height)
+        r.enable_depth_rendering()
+        try:
+            r.update_scene(data, camera=camera)
+            depth = r.render().copy()
+        finally:
+            r.disable_depth_rendering()
+        return depth
+
     def close(self) -> None:
         for r in self._renderers.values():
             try:

@@ -46,6 +46,7 @@ from .handle import CommandHandle
 from .items import ItemSpec
 from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames
 from .render import Renderers, write_animation, write_png
+from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
 from .robot_model import HEAD_CAMERA
 from .scene import build_scene
 from .types import Outcome, Pose, Pose2D, VisibleItem
@@ -84,8 +85,12 @@ class World:
                  objects: Sequence[str] | None = None, seed: int = 0,
                  base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
-                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
+                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True,
+                 perception_faults: PerceptionFaults | None = None) -> None:
         env = load_environment(environment)
+        #: Faults of `detect` (none by default); its random generator is seeded from them.
+        self.perception_faults = perception_faults or PerceptionFaults()
+        self._fault_rng = np.random.default_rng(self.perception_faults.seed)
         #: Where the `objects` started (a random scene from `seed`; empty without objects).
         self.placements = random_scene(env, objects, seed) if objects else []
         if self.placements:
@@ -440,6 +445,35 @@ class World:
             return sorted(seen, key=lambda v: -v.pixels)
 
         return self._call("perceive", fn)
+
+    def detect(self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS,
+               max_range: float = MAX_RANGE) -> CommandHandle:
+        """One look of the head camera's object perception: value a
+        `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
+        colour images of `width` x `height` [px], most visible first; the camera view with its
+        depth image; the containers' joint positions), stamped with the simulated time.
+
+        Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
+        not reported; `perception_faults` apply. No simulator names or poses are reported.
+        """
+        from pycram.world.belief import PerceptionReport
+
+        objects = {it.name: (it.type, self._engine.item_part_geoms[it.name]) for it in self.scene.items}
+
+        def fn(eng: Engine) -> PerceptionReport:
+            renderers = self._get_renderers()
+            ids = renderers.segmentation(eng.data, HEAD_CAMERA, width, height)
+            depth = renderers.depth(eng.data, HEAD_CAMERA, width, height)
+            rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height)
+            cam = eng.camera
+            view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]),
+                           depth, max_range)
+            states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
+            detections = measure_detections(ids, depth, rgb, view, objects, self.environment, states,
+                                            self.perception_faults, self._fault_rng, min_pixels)
+            return PerceptionReport(eng.time, tuple(detections), view, dict(states))
+
+        return self._call("detect", fn)
 
     def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
                              height: int = 240) -> CommandHandle:

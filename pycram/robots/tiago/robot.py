@@ -39,7 +39,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     gripper = robot.add_process_module(f"gripper_{gripper_name}",
                                        sm.GripperModule(world, gripper_name))
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
-    perception = robot.add_process_module("perception", sm.PerceptionModule(world))
+    perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
 
     robot.motion_resolvers.append(make_motion_resolver(world, description))
     robot.location_generators.append(make_to_reach_generator(world, description))
