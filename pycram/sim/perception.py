@@ -17,12 +17,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+
 import numpy as np
 
-from pycram.world.belief import COLOR_NAMES, CameraView, Detection, color_name, support_of
+from pycram.world.belief import (
+    COLOR_NAMES,
+    CameraView,
+    Detection,
+    color_name,
+    support_of,
+)
 from pycram.world.environment import Environment
 
-__all__ = ["PerceptionFaults", "measure_detections", "view_of", "MAX_RANGE", "MIN_PIXELS"]
+__all__ = ["MAX_RANGE", "MIN_PIXELS", "PerceptionFaults", "measure_detections", "view_of"]
 
 #: Objects farther from the camera than this [m] are not detected.
 MAX_RANGE = 4.0
@@ -95,7 +102,7 @@ def _measure(view: CameraView, type_name: str, rows: np.ndarray, cols: np.ndarra
     mean = rgb[rows, cols].reshape(-1, 3).mean(axis=0) / 255.0
     return Detection(type_name, (x, y, (top + bottom) / 2.0), (width, depth, top - bottom),
                      color_name(mean), tuple(float(c) for c in mean),
-                     None if surface is None else surface.name, container, int(len(rows)))
+                     None if surface is None else surface.name, container, len(rows))
 
 
 def measure_detections(ids: np.ndarray, depth: np.ndarray, rgb: np.ndarray, view: CameraView,

@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import math
 import threading
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Optional
+from typing import Any
 
 import numpy as np
 
@@ -40,8 +41,17 @@ from pycram.fluent import Fluent
 
 from .environment import Environment, Surface
 
-__all__ = ["Detection", "CameraView", "PerceptionReport", "PerceivedObject", "BeliefUpdate",
-           "BeliefState", "support_of", "COLOR_NAMES", "color_name"]
+__all__ = [
+    "COLOR_NAMES",
+    "BeliefState",
+    "BeliefUpdate",
+    "CameraView",
+    "Detection",
+    "PerceivedObject",
+    "PerceptionReport",
+    "color_name",
+    "support_of",
+]
 
 Vec3 = tuple[float, float, float]
 
@@ -89,8 +99,8 @@ class Detection:
     size: Vec3
     color: str
     rgb: Vec3 = (0.0, 0.0, 0.0)
-    support: Optional[str] = None
-    container: Optional[str] = None
+    support: str | None = None
+    container: str | None = None
     pixels: int = 0
 
 
@@ -115,7 +125,7 @@ class CameraView:
         """(width, height) [px]."""
         return int(self.depth.shape[1]), int(self.depth.shape[0])
 
-    def project(self, point: Iterable[float]) -> Optional[tuple[float, float, float]]:
+    def project(self, point: Iterable[float]) -> tuple[float, float, float] | None:
         """(u, v) pixel coordinates and depth [m] of a map point; None behind the camera."""
         rotation = np.asarray(self.rotation, float).reshape(3, 3)
         local = rotation.T @ (np.asarray(tuple(point), float) - np.asarray(self.position, float))
@@ -147,7 +157,7 @@ class PerceptionReport:
 
     stamp: float
     detections: tuple[Detection, ...]
-    view: Optional[CameraView] = None
+    view: CameraView | None = None
     #: Measured joint position of each container [m or rad], 0 when closed.
     container_states: dict[str, float] = field(default_factory=dict)
 
@@ -179,7 +189,7 @@ class PerceivedObject(BelievedObject):
         """
         start = self.pose
 
-        def value() -> Optional[bool]:
+        def value() -> bool | None:
             pose = self.pose_fluent.get_value()
             if pose is None or start is None:
                 return None
@@ -218,7 +228,7 @@ class BeliefState(Belief):
     `container_states` holds the containers' joint positions last measured.
     """
 
-    def __init__(self, environment: Optional[Environment] = None, gate: float = 0.3) -> None:
+    def __init__(self, environment: Environment | None = None, gate: float = 0.3) -> None:
         super().__init__()
         self.environment = environment
         self.gate = gate
@@ -241,7 +251,7 @@ class BeliefState(Belief):
         plain = [o for o in self.objects() if not isinstance(o, PerceivedObject)]
         return [*self.present(), *plain]
 
-    def container_open(self, container: str, threshold: float = 0.05) -> Optional[bool]:
+    def container_open(self, container: str, threshold: float = 0.05) -> bool | None:
         """Whether `container` was measured open (joint beyond `threshold` [m or rad]); None
         when it was never measured."""
         q = self.container_states.get(container)
@@ -301,8 +311,8 @@ class BeliefState(Belief):
 
 
 def support_of(environment: Environment, x: float, y: float, bottom: float,
-               container_states: Optional[dict[str, float]] = None,
-               tolerance: float = 0.04) -> Optional[Surface]:
+               container_states: dict[str, float] | None = None,
+               tolerance: float = 0.04) -> Surface | None:
     """The surface an object whose lowest seen point is at height `bottom` [m] rests on at
     (x, y) [m]: the highest surface under (x, y) not above `bottom` + `tolerance`, drawers'
     insides moved out by their measured opening (`container_states`). None on the floor."""
