@@ -32,7 +32,7 @@ from pycram.world.environment import Environment
 __all__ = ["MAX_RANGE", "MIN_PIXELS", "PerceptionFaults", "measure_detections", "view_of"]
 
 #: Objects farther from the camera than this [m] are not detected.
-MAX_RANGE = 4.0
+MAX_RANGE = 3.5
 #: Fewest visible pixels for a detection.
 MIN_PIXELS = 20
 
@@ -118,7 +118,8 @@ def measure_detections(ids: np.ndarray, depth: np.ndarray, rgb: np.ndarray, view
         if count < min_pixels:
             continue
         rows, cols = np.nonzero(mask)
-        if float(np.median(depth[rows, cols])) > view.max_range:
+        distances = np.linalg.norm(_back_project(view, rows, cols) - np.asarray(view.position), axis=1)
+        if float(np.median(distances)) > view.max_range:
             continue
         if faults.miss_probability and rng.random() < faults.miss_probability:
             continue

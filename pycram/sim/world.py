@@ -451,7 +451,8 @@ class World:
         """One look of the head camera's object perception: value a
         `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
         colour images of `width` x `height` [px], most visible first; the camera view with its
-        depth image; the containers' joint positions), stamped with the simulated time.
+        depth image; the joint positions of the containers whose handle is in the image),
+        stamped with the simulated time.
 
         Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
         not reported; `perception_faults` apply. No simulator names or poses are reported.
@@ -471,7 +472,10 @@ class World:
             states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
             detections = measure_detections(ids, depth, rgb, view, objects, self.environment, states,
                                             self.perception_faults, self._fault_rng, min_pixels)
-            return PerceptionReport(eng.time, tuple(detections), view, dict(states))
+            # the joint positions of the containers whose handle is in the image
+            in_view = {name: q for name, q in states.items()
+                       if view.in_image(self.environment.container(name).handle_position(q))}
+            return PerceptionReport(eng.time, tuple(detections), view, in_view)
 
         return self._call("detect", fn)
 

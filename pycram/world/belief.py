@@ -111,7 +111,7 @@ class CameraView:
     `position` [m, map]; `rotation` the camera's axes in the map frame as the columns of a 3x3
     matrix (OpenGL convention: x right, y up, the camera looks along -z); `fovy` the vertical
     field of view [deg]; `depth` the distance along the optical axis per pixel [m] (height x
-    width); objects farther than `max_range` [m] are not detected.
+    width); objects farther than `max_range` [m] from the camera are not detected.
     """
 
     position: Vec3
@@ -136,17 +136,24 @@ class CameraView:
         focal = 0.5 * height / math.tan(math.radians(self.fovy) / 2.0)
         return (width / 2.0 + focal * local[0] / depth, height / 2.0 - focal * local[1] / depth, float(depth))
 
+    def in_image(self, point: Iterable[float], border: float = 0.0) -> bool:
+        """True when the map point [m] projects into the image (`border` [px] inside its edges)
+        and lies within `max_range` of the camera, whatever stands in front of it."""
+        projected = self.project(point)
+        if projected is None:
+            return False
+        u, v, _ = projected
+        width, height = self.size
+        return (border <= u < width - border and border <= v < height - border
+                and math.dist(tuple(point), self.position) <= self.max_range)
+
     def expects_visible(self, point: Iterable[float], border: float = 4.0, tolerance: float = 0.06) -> bool:
         """True when an object at `point` [m, map] should be seen: it projects into the image
         (`border` [px] inside its edges), lies within `max_range`, and the measured depth there
         is not nearer than the point by more than `tolerance` [m] (nothing stands in front)."""
-        projected = self.project(point)
-        if projected is None:
+        if not self.in_image(point, border):
             return False
-        u, v, depth = projected
-        width, height = self.size
-        if not (border <= u < width - border and border <= v < height - border) or depth > self.max_range:
-            return False
+        u, v, depth = self.project(point)  # type: ignore[misc]
         measured = float(self.depth[int(v), int(u)])
         return measured >= depth - tolerance
 
@@ -158,7 +165,7 @@ class PerceptionReport:
     stamp: float
     detections: tuple[Detection, ...]
     view: CameraView | None = None
-    #: Measured joint position of each container [m or rad], 0 when closed.
+    #: Measured joint position of each container in view [m or rad], 0 when closed.
     container_states: dict[str, float] = field(default_factory=dict)
 
 
