@@ -44,7 +44,7 @@ from pycram.world.belief import BeliefState, PerceivedObject
 from pycram.world.environment import Environment, Surface
 from pycram.world.objects import OBJECT_TYPES
 
-__all__ = ["Lookout", "lookouts", "search_for", "LOOK_RANGE", "STANDOFF", "STAND_CLEARANCE"]
+__all__ = ["Lookout", "lookouts", "look_around", "search_for", "LOOK_RANGE", "STANDOFF", "STAND_CLEARANCE"]
 
 logger = logging.getLogger(__name__)
 
@@ -187,6 +187,50 @@ def _look(description: ObjectDesignator, target: tuple[float, float, float]) -> 
     return seen[0] if seen else None
 
 
+def _look_around(description: Optional[ObjectDesignator], places: list[Lookout], here: tuple[float, float],
+                 belief: BeliefState, look_range: float, looked: list[str], close: set[str]) -> list[PerceivedObject]:
+    """Look at each place within `look_range` of `here`; stop at the first match of a
+    `description` (None: look at every place and return everything seen)."""
+    environment = belief.environment
+    seen: list[PerceivedObject] = []
+    for lookout in places:
+        target = _target(lookout, environment, belief)
+        distance = math.dist(here, target[:2])
+        if distance > look_range or any(entry.startswith(lookout.name + " ") for entry in looked):
+            continue
+        if lookout.container is not None and belief.container_open(lookout.container) is False:
+            continue
+        try:
+            perform(MotionDesignator(type="pointing_head", coordinates=target))
+            result = perform(MotionDesignator(type="detecting", object=description))
+        except _FAILURES as failure:
+            logger.info("cannot look at %s from here: %s", lookout.name, failure)
+            continue
+        looked.append(f"{lookout.name} (from where it stood)")
+        if distance < CLOSE_LOOK:
+            close.add(lookout.name)
+        seen += [obj for obj in result if obj not in seen]
+        if description is not None and seen:
+            break
+    return seen
+
+
+@as_task(name="look_around")
+def look_around(description: Optional[ObjectDesignator] = None, *, belief: Optional[BeliefState] = None,
+                look_range: float = LOOK_RANGE) -> list[PerceivedObject]:
+    """Look at every likely place within `look_range` [m] from where the robot stands (for the
+    type of `description`, all places without one), detecting at each, without driving; stops
+    at the first object matching `description`. Returns the believed objects seen (matching
+    `description` when given). Runs as a task named "look_around"."""
+    belief = belief if belief is not None else _robot_belief()
+    if belief.environment is None:
+        raise ValueError("look_around needs a belief with an environment description")
+    here = _base_pose().get_value()
+    type_name = None if description is None else description.prop_value("type")
+    places = lookouts(belief.environment, type_name, (here.x, here.y))
+    return _look_around(description, places, (here.x, here.y), belief, look_range, [], set())
+
+
 @as_task(name="search_for")
 def search_for(description: ObjectDesignator, *, belief: Optional[BeliefState] = None,
                open_container: Optional[Callable[[str], Any]] = None, look_range: float = LOOK_RANGE,
@@ -207,30 +251,15 @@ def search_for(description: ObjectDesignator, *, belief: Optional[BeliefState] =
     known = _believed(description, belief)
     if known is not None:
         return known
-    pose = _base_pose()
-    here = pose.get_value()
+    here = _base_pose().get_value()
     places = lookouts(environment, description.prop_value("type"), (here.x, here.y), standoff)
     looked: list[str] = []
     skipped: dict[str, str] = {}
     close: set[str] = set()
     # 1. look around from where it stands
-    for lookout in places:
-        target = _target(lookout, environment, belief)
-        distance = math.dist((here.x, here.y), target[:2])
-        if distance > look_range or lookout.name in looked:
-            continue
-        if lookout.container is not None and belief.container_open(lookout.container) is False:
-            continue
-        try:
-            found = _look(description, target)
-        except _FAILURES as failure:
-            logger.info("search_for: cannot look at %s from here: %s", lookout.name, failure)
-            continue
-        looked.append(f"{lookout.name} (from where it stood)")
-        if distance < CLOSE_LOOK:
-            close.add(lookout.name)
-        if found is not None:
-            return found
+    found = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
+    if found:
+        return found[0]
     # 2. visit the likely places, nearest first
     for lookout in places:
         if lookout.name in close:

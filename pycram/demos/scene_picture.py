@@ -206,8 +206,8 @@ def _door_swing(ax: Any, arc_type: Any, door: Any) -> None:
     ax.plot([hx], [hy], "s", ms=5, color="#5d4037")
 
 
-def _render(world: Any, camera: str, width: int, height: int) -> np.ndarray:
-    outcome = world.request_image(camera, width, height).wait(60.0)
+def _render(world: Any, camera: str, width: int, height: int, hide_objects: bool = False) -> np.ndarray:
+    outcome = world.request_image(camera, width, height, hide_objects).wait(60.0)
     if outcome is None or not outcome.succeeded:
         raise RuntimeError(f"rendering camera {camera!r} failed: {outcome}")
     return outcome.value

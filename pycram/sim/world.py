@@ -409,12 +409,22 @@ class World:
             self._renderers = Renderers(self.scene.model)
         return self._renderers
 
-    def request_image(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
-        """Render an RGB image (height x width x 3, uint8) from `camera`; also set `camera_image`."""
+    def request_image(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240,
+                      hide_objects: bool = False) -> CommandHandle:
+        """Render an RGB image (height x width x 3, uint8) from `camera`; also set `camera_image`.
+
+        `hide_objects` leaves the items out of the picture (e.g. a plan to draw a belief on).
+        """
         self.scene.camera(camera)
 
         def fn(eng: Engine) -> np.ndarray:
-            img = self._get_renderers().rgb(eng.data, camera, width, height)
+            geoms = [g for gs in eng.item_part_geoms.values() for g in gs] if hide_objects else []
+            saved = eng.model.geom_rgba[geoms, 3].copy()
+            eng.model.geom_rgba[geoms, 3] = 0.0  # fully transparent geoms are not drawn
+            try:
+                img = self._get_renderers().rgb(eng.data, camera, width, height)
+            finally:
+                eng.model.geom_rgba[geoms, 3] = saved
             self.camera_image.set_value(img)
             return img
 

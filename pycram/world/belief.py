@@ -54,6 +54,8 @@ __all__ = [
 ]
 
 Vec3 = tuple[float, float, float]
+#: How many looks a `BeliefState` remembers.
+MAX_LOOKS = 100
 
 #: Colour names a recogniser reports (see `color_name`).
 COLOR_NAMES = ("red", "orange", "yellow", "green", "blue", "purple", "white", "grey", "black")
@@ -159,6 +161,18 @@ class CameraView:
 
 
 @dataclass(frozen=True)
+class Look:
+    """Where the camera looked from, for a record of the looks: time stamp [s], camera position
+    [m, map], unit viewing direction, vertical field of view [deg] and range [m]."""
+
+    stamp: float
+    position: Vec3
+    direction: Vec3
+    fovy: float
+    max_range: float
+
+
+@dataclass(frozen=True)
 class PerceptionReport:
     """What one look of the camera measured, at time `stamp` [s of the active clock]."""
 
@@ -242,6 +256,8 @@ class BeliefState(Belief):
         self.container_states: dict[str, float] = {}
         self._counts: dict[str, int] = {}
         self._update_lock = threading.Lock()
+        #: The most recent looks (at most `MAX_LOOKS`), oldest first.
+        self.looks: list[Look] = []
         #: Pulses after every update (a plan may wait for the next look).
         self.updated = Fluent(None, name="belief updated")
 
@@ -292,6 +308,11 @@ class BeliefState(Belief):
                 self._refresh(obj, detection, report.stamp)
             gone = []
             if report.view is not None:
+                view = report.view
+                forward = -np.asarray(view.rotation, float).reshape(3, 3)[:, 2]
+                self.looks = [*self.looks[-(MAX_LOOKS - 1):],
+                              Look(report.stamp, tuple(view.position), tuple(float(v) for v in forward),
+                                   view.fovy, view.max_range)]
                 for j, obj in enumerate(known):
                     if j not in used and not obj.gone and obj.pose is not None \
                             and report.view.expects_visible(obj.pose):
