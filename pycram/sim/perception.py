@@ -75,9 +75,9 @@ def _back_project(view: CameraView, rows: np.ndarray, cols: np.ndarray) -> np.nd
     return local @ np.asarray(view.rotation, float).reshape(3, 3).T + np.asarray(view.position, float)
 
 
-def _measure(view: CameraView, type_name: str, rows: np.ndarray, cols: np.ndarray, rgb: np.ndarray,
+def _measure(view: CameraView, type_name: str, points: np.ndarray, colours: np.ndarray,
              environment: Environment, container_states: dict[str, float]) -> Detection:
-    points = _back_project(view, rows, cols)
+    """A detection from an object's visible pixels: their map `points` [m] and `colours`."""
     # horizontal axes of the view: across it and along it (away from the camera)
     rotation = np.asarray(view.rotation, float).reshape(3, 3)
     across = rotation[:2, 0] / max(np.linalg.norm(rotation[:2, 0]), 1e-9)
@@ -95,35 +95,37 @@ def _measure(view: CameraView, type_name: str, rows: np.ndarray, cols: np.ndarra
     x, y = (centre_a * across + centre_b * along).tolist()
     surface = support_of(environment, x, y, lowest, container_states)
     bottom = surface.height if surface is not None else max(0.0, lowest)
-    if surface is not None and environment.container_of(surface.name) is not None:
-        container = environment.container_of(surface.name).name
-    else:
-        container = None
-    mean = rgb[rows, cols].reshape(-1, 3).mean(axis=0) / 255.0
+    container = None if surface is None else environment.container_of(surface.name)
+    mean = colours.mean(axis=0) / 255.0
     return Detection(type_name, (x, y, (top + bottom) / 2.0), (width, depth, top - bottom),
                      color_name(mean), tuple(float(c) for c in mean),
-                     None if surface is None else surface.name, container, len(rows))
+                     None if surface is None else surface.name, None if container is None else container.name,
+                     int(len(points)))
 
 
 def measure_detections(ids: np.ndarray, depth: np.ndarray, rgb: np.ndarray, view: CameraView,
                        objects: dict[str, tuple[str, list[int]]], environment: Environment,
                        container_states: dict[str, float], faults: PerceptionFaults,
                        rng: np.random.Generator, min_pixels: int = MIN_PIXELS) -> list[Detection]:
-    """The detections in one look: `ids` geom ids per pixel, `depth` [m] and `rgb` images of
-    the same camera; `objects` maps each object to (type, its geoms). Most visible first."""
+    """The detections in one look: `ids` geom ids per pixel (-1: none), `depth` [m] and `rgb`
+    images of the same camera; `objects` maps each object to (type, its geoms). Most visible
+    first."""
+    types = [type_name for type_name, _ in objects.values()]
+    last = int(max((max(g) for _, g in objects.values() if g), default=0))
+    lookup = np.full(last + 2, -1, np.int64)  # geom id -> object index; the extra last entry: none
+    for index, (_, geoms) in enumerate(objects.values()):
+        lookup[geoms] = index
+    labels = lookup[np.where((ids >= 0) & (ids <= last), ids, last + 1)]
+    counts = np.bincount(labels[labels >= 0], minlength=len(types))
     detections = []
-    for _, (type_name, geoms) in objects.items():
-        mask = np.isin(ids, geoms)
-        count = int(mask.sum())
-        if count < min_pixels:
-            continue
-        rows, cols = np.nonzero(mask)
-        distances = np.linalg.norm(_back_project(view, rows, cols) - np.asarray(view.position), axis=1)
-        if float(np.median(distances)) > view.max_range:
+    for index in np.nonzero(counts >= min_pixels)[0]:
+        rows, cols = np.nonzero(labels == index)
+        points = _back_project(view, rows, cols)
+        if float(np.median(np.linalg.norm(points - np.asarray(view.position), axis=1))) > view.max_range:
             continue
         if faults.miss_probability and rng.random() < faults.miss_probability:
             continue
-        detection = _measure(view, type_name, rows, cols, rgb, environment, container_states)
+        detection = _measure(view, types[index], points, rgb[rows, cols], environment, container_states)
         if faults.pose_noise:
             noisy = tuple(float(v) for v in np.asarray(detection.position) + rng.normal(0.0, faults.pose_noise, 3))
             detection = _replace(detection, position=noisy)
