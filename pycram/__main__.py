@@ -14,9 +14,13 @@ def main(argv: list[str] | None = None) -> int:
     """Run `argv[0]` as a plan script if it names a Python file, else the pycram CLI."""
     args = sys.argv[1:] if argv is None else argv
     if args and (args[0].endswith(".py") or os.path.isfile(args[0])):
-        from pycram.macros import run_script
+        from pycram.macros import format_script_error, run_script
 
-        run_script(args[0], args[1:])
+        try:
+            run_script(args[0], args[1:])
+        except Exception as e:  # reported as `python FILE` would, from the script's first frame
+            sys.stderr.write(format_script_error(e, args[0]))
+            return 1
         return 0
     from pycram.cli import main as cli_main
 

@@ -3,13 +3,16 @@
     pycram run FILE.py [ARGS...]        run a plan script (block syntax on), recorded by default
     pycram demo [--robot pr2|tiago]...  the thesis demo in the simulated kitchen, recorded by default
     pycram scene --env apartment --seed 3 -o scene.png   a labelled picture of a random scene
-    pycram runs                         recorded runs, newest first, one line each
+    pycram runs                         recorded runs, newest first, one line each (with why they failed)
     pycram show [RUN]                   a run's task tree with statuses, durations, failures
     pycram graph [RUN] -o tree.svg      the task tree as an SVG picture
     pycram timeline [RUN] -o tl.png     which branches ran when (Gantt chart)
 
 The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
-`pycram.trace.db`). Recording for `run`/`demo` is on unless `--no-record` or `PYCRAM_RECORD=0`.
+`pycram.trace.db`); a database named with `--db` must exist for the inspecting commands, and
+one that cannot be read gives a one-line error and exit code 1. Recording for `run`/`demo` is
+on unless `--no-record` or `PYCRAM_RECORD=0`; records the database could not take are counted
+and reported at the end of the run (the plan's outcome does not depend on them).
 Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the commands that
 need them.
 """
@@ -35,6 +38,28 @@ app = typer.Typer(
 )
 console = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from pycram._version import __version__
+
+        console.print(f"pycram {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    ctx: typer.Context,
+    version: bool = typer.Option(False, "--version", help="Print PyCRAM's version and exit.",
+                                 callback=_print_version, is_eager=True),
+) -> None:
+    """PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs."""
+    # `pycram run` leaves logging to the script (its basicConfig must not be a no-op); the
+    # other commands show the library's warnings.
+    if ctx.invoked_subcommand != "run":
+        logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+
 
 #: Runs of this many identical successful siblings are shown as one line / box / row (×N);
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
@@ -64,6 +89,34 @@ def _trace_errors(fn: Any, *args: Any, **kwargs: Any) -> Any:
         _fail(str(e))
 
 
+def _reading(db: Optional[str], fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """`_trace_errors` for the inspecting commands: a database named with `--db` must exist
+    (reading never creates one), and any database failure is a one-line error."""
+    from sqlalchemy import exc as sa_exc
+
+    from pycram.trace.db import database_error, resolve_url, sqlite_file
+
+    if db is not None and db.strip():
+        _trace_errors(resolve_url, db)  # a malformed URL is reported as such
+        path = sqlite_file(db)
+        if path is not None and not path.exists():
+            where = (f"the folder {path.parent} does not exist" if not path.parent.is_dir()
+                     else f"{path} does not exist")
+            _fail(f"no such database: {where} (`pycram run` and `pycram demo` create it when they record)")
+    try:
+        return _trace_errors(fn, *args, **kwargs)
+    except sa_exc.SQLAlchemyError as e:  # a failure no query layer translated
+        _fail(str(database_error(resolve_url(db), e, "read")))
+
+
+def _write_errors(fn: Any, *args: Any) -> Any:
+    """`fn(*args)` writing a picture: an unwritable output path is a one-line error."""
+    try:
+        return fn(*args)
+    except OSError as e:
+        _fail(f"cannot write {e.filename or 'the picture'}: {e.strerror or e}")
+
+
 def _local(when: _dt.datetime | None) -> str:
     return when.astimezone().strftime("%Y-%m-%d %H:%M:%S") if when is not None else "–"
 
@@ -84,20 +137,38 @@ def runs_command(
     plan: Optional[str] = typer.Option(None, "--plan", help="Only runs whose plan name contains this."),
     db: Optional[str] = DbOption,
 ) -> None:
-    """List recorded runs, newest first: id, start, plan, robot, outcome, duration."""
+    """List recorded runs, newest first: id, start, plan, robot, outcome, wall-clock duration
+    and why a run failed."""
+    from rich.table import Table
+
     from pycram.trace import query
     from pycram.trace.display import STATUS_STYLE, format_duration
 
-    found = _trace_errors(query.runs, db, limit or None, plan)
+    found = _reading(db, query.runs, db, limit or None, plan)
     if not found:
         err.print("no runs recorded yet (run `pycram run FILE.py` or `pycram demo`)")
         return
+    table = Table(box=None, pad_edge=False, header_style="bold")
+    for name in ("id", "started", "plan", "robot", "outcome"):
+        table.add_column(name, no_wrap=name != "plan")
+    table.add_column("took", no_wrap=True, justify="right")
+    table.add_column("reason", overflow="fold")
     for run in found:
         state = run.state
         style = STATUS_STYLE.get(state, "white")
-        console.print(f"{run.id}  {_local(run.started_at)}  {escape(run.plan or '–')}  "
-                      f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {format_duration(run.elapsed)}",
-                      soft_wrap=True)
+        table.add_row(str(run.id), _local(run.started_at), escape(run.plan or "–"), escape(run.robot or "–"),
+                      f"[{style}]{state}[/{style}]", format_duration(run.elapsed),
+                      escape(_reason(run)))
+    console.print(table)
+
+
+def _reason(run: Any) -> str:
+    """Why the run did not succeed (its recorded error), "" for a successful run."""
+    if run.error:
+        return run.error
+    if run.state == "unfinished":
+        return "the process ended without finishing the record (killed?)"
+    return ""
 
 
 @app.command("show")
@@ -110,30 +181,42 @@ def show_command(
 ) -> None:
     """Print a run's task tree with statuses, durations and failures.
 
-    Runs of 3 or more consecutive identical successful sibling tasks (e.g. a motion repeated by
-    a `whenever` loop) are shown as one line with a count, unless --expand.
+    Every process-module execution is shown (a blocking one under the task that performed it).
+    A failure shows its error where it was raised; enclosing tasks it failed say "passed on".
+    Tree times are on the plan's clock (the header says: simulated or wall clock); the run's
+    duration and start are wall-clock. Runs of 3 or more consecutive identical successful
+    sibling tasks (e.g. a motion repeated by a `whenever` loop) are shown as one line with a
+    count, unless --expand.
     """
     from pycram.trace import query
-    from pycram.trace.display import STATUS_STYLE, format_duration, task_tree
+    from pycram.trace.display import STATUS_STYLE, clock_label, format_duration, task_tree
 
-    info = _trace_errors(query.get_run, run, db)
-    records = _trace_errors(query.tasks, info.id, db)
-    executions = _trace_errors(query.executions, info.id, url=db)
+    info = _reading(db, query.get_run, run, db)
+    records, execution_records = _reading(db, query.tree_records, info.id, db)
+    executions = _reading(db, query.executions, info.id, url=db)
     state = info.state
     style = STATUS_STYLE.get(state, "white")
     title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
-             f"[{style}]{state}[/{style}] · {format_duration(info.elapsed)} · started {_local(info.started_at)}")
-    tree, tasks_shown = task_tree(title, records, expand=expand, max_nodes=max_nodes)
+             f"[{style}]{state}[/{style}] · took {format_duration(info.elapsed)} (wall-clock) · "
+             f"started {_local(info.started_at)}\n[grey50]times in the tree: {escape(clock_label(info.clock))}[/grey50]")
+    shown_records = records + execution_records
+    tree, shown = task_tree(title, shown_records, expand=expand, max_nodes=max_nodes)
     console.print(tree)
-    failed = sum(1 for r in records if r.status == "failed")
-    summary = f"{len(records)} tasks, {failed} failed"
+    failed = [r for r in records if r.status == "failed"]
+    raised = sum(1 for r in failed if not r.propagated)
+    summary = f"{len(records)} tasks, {len(failed)} failed"
+    if raised < len(failed):
+        summary += f" ({raised} where the error was raised, {len(failed) - raised} passing it on)"
     if executions:
         summary += f", {len(executions)} process-module executions"
-    if tasks_shown < len(records):
-        summary += f" ({len(records) - tasks_shown} not shown; raise --max-nodes)"
+    if shown < len(shown_records):
+        summary += f" ({len(shown_records) - shown} not shown; raise --max-nodes)"
     console.print(summary)
     if info.error:
         console.print(f"[red]{escape(info.error)}[/red]")
+    if info.lost_records:
+        console.print(f"[yellow]{info.lost_records} trace records of this run could not be written: "
+                      "the tree may be incomplete[/yellow]")
 
 
 @app.command("graph")
@@ -146,7 +229,7 @@ def graph_command(
     """Draw a run's task tree as an SVG picture (identical successful siblings: one box ×N)."""
     from pycram.trace.pictures import write_tree_svg
 
-    path = _trace_errors(write_tree_svg, run, output, db, 0 if expand else _COLLAPSE)
+    path = _reading(db, _write_errors, write_tree_svg, run, output, db, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 
@@ -162,7 +245,7 @@ def timeline_command(
     siblings share a row) as a PNG picture."""
     from pycram.trace.pictures import write_timeline_png
 
-    path = _trace_errors(write_timeline_png, run, output, db, max_rows, 0 if expand else _COLLAPSE)
+    path = _reading(db, _write_errors, write_timeline_png, run, output, db, max_rows, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 
@@ -179,8 +262,13 @@ def run_command(
     plan: Optional[str] = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
     robot: Optional[str] = typer.Option(None, "--robot", help="Robot name recorded for the run."),
 ) -> None:
-    """Run a plan script; arguments after FILE go to the script (in sys.argv)."""
-    from pycram.macros import run_script
+    """Run a plan script; arguments after FILE go to the script (in sys.argv).
+
+    The script owns logging (`logging.basicConfig` in it works as under `python FILE.py`);
+    an exception it raises is reported with a traceback that starts at the script's code, and
+    the exit code is 1.
+    """
+    from pycram.macros import format_script_error, run_script
 
     recorder = None
     if _record_flag(record):
@@ -198,6 +286,9 @@ def run_command(
     except KeyboardInterrupt as e:
         outcome, error, code = "interrupted", e, 130
         raise
+    except Exception as e:
+        outcome, error, code = "failed", e, 1
+        sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
     except BaseException as e:
         outcome, error, code = "failed", e, 1
         raise
@@ -206,6 +297,9 @@ def run_command(
             _robot_from_active(recorder)
             run_id = recorder.finish(outcome, error)
             err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+            if recorder.lost_records:
+                err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
+                          soft_wrap=True)
     raise typer.Exit(code)
 
 
@@ -222,13 +316,39 @@ def _robot_from_active(recorder: Any) -> None:
         recorder.set_run_info(robot=str(getattr(robot, "name", robot)))
 
 
+#: `--steal` above this is refused: the plan gives up long before (it retries a few times).
+_MAX_STEALS = 100
+
+
+def _check_output_folder(output: str) -> None:
+    """Refuse (exit code 2, one line) an `--output` folder that cannot be created or written.
+
+    Creates nothing: the folder must be a writable directory, or its nearest existing ancestor
+    must be one (the demo creates the rest).
+    """
+    import os
+
+    path = Path(output).expanduser()
+    existing = path
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing == path and not path.is_dir():
+        _fail(f"--output {output}: exists and is not a folder", code=2)
+    if not existing.is_dir():
+        _fail(f"--output {output}: cannot create the folder, {existing} is not a folder", code=2)
+    if not os.access(existing, os.W_OK | os.X_OK):
+        _fail(f"--output {output}: cannot write to {existing} (permission denied)", code=2)
+
+
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
-    item_at: int = typer.Option(1, "--item-at", help="Where the item starts: position 1, 2 or 3 (0: no item)."),
-    steal: int = typer.Option(0, "--steal", help="How many times the item is taken from the gripper while the robot carries it."),
-    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
+                                help="Where the item starts: position 1, 2 or 3 (0: no item)."),
+    steal: int = typer.Option(0, "--steal", min=0, max=_MAX_STEALS,
+                              help="How many times the item is taken from the gripper while the robot carries it."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed (a non-negative integer)."),
     realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
     interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
     record: Optional[bool] = typer.Option(None, "--record/--no-record",
@@ -237,6 +357,8 @@ def demo_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
+    if output is not None:
+        _check_output_folder(output)
     try:
         from pycram.demos.kitchen import main as demo_main
     except ModuleNotFoundError as e:
@@ -310,7 +432,6 @@ def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Pa
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `pycram` script. Returns the exit code (also when typer exits)."""
-    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         app(args=argv, prog_name="pycram", standalone_mode=True)
     except SystemExit as e:

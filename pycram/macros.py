@@ -74,6 +74,7 @@ import logging
 import os
 import sys
 import tokenize
+import traceback
 import types
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping, Sequence, TypeVar
@@ -82,6 +83,7 @@ __all__ = [
     "NOT_ENABLED_MESSAGE",
     "plan",
     "run_script",
+    "format_script_error",
     "transform_source",
     "compile_source",
     "install_import_hook",
@@ -955,6 +957,27 @@ def run_script(path: str | os.PathLike[str], argv: Sequence[str] = (), *, activa
         if installed:
             uninstall_import_hook()
     return module.__dict__
+
+
+def format_script_error(error: BaseException, path: str | os.PathLike[str]) -> str:
+    """The report of ``error`` raised by :func:`run_script` for the script at ``path``, as
+    ``python path`` would print it: the traceback starts at the script's first frame, without
+    the frames of ``run_script`` and its callers (a command line, ``runpy``). A syntax error in
+    the script (also one the block-syntax transform reports) is shown without a traceback, as
+    Python shows it. Chained exceptions keep their own tracebacks. An exception that did not
+    pass through ``run_script`` is formatted whole.
+    """
+    tb = error.__traceback__
+    while tb is not None and tb.tb_frame.f_code is not run_script.__code__:
+        tb = tb.tb_next
+    if tb is None:
+        tb = error.__traceback__
+    else:
+        tb = tb.tb_next  # the script's module frame, or run_script's helpers (compiling it)
+        in_script = tb is not None and os.path.abspath(tb.tb_frame.f_code.co_filename) == os.path.abspath(path)
+        if not in_script and isinstance(error, SyntaxError):
+            tb = None
+    return "".join(traceback.format_exception(type(error), error, tb))
 
 
 # --------------------------------------------------------------------------------------------

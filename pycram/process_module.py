@@ -32,8 +32,12 @@ Guarantees
   ``FAILED`` / ``CANCELLED`` (outcome of the last designator; the module is idle again) →
   ``RUNNING`` ...; ``OFFLINE`` after :meth:`ProcessModule.shutdown`. Every transition is set
   while the module's state is consistent (under its condition).
+- **Checked first.** :meth:`ProcessModule.perform` checks a motion designator against the active
+  robot's motion types before choosing a module (a missing, misspelled or invalid key raises
+  :class:`~pycram.designators.motion_types.MotionPropertyError`; nothing is queued).
 - **No module.** :class:`NoProcessModuleError` names the designator's properties, the resolvers
-  asked and the active robot.
+  asked and the active robot; :class:`UnknownMotionTypeError` (a subclass) also lists the motion
+  types the active robot knows when the designator's type is none of them.
 - **Events.** Every started execution is announced once on :mod:`pycram.events`
   (``PROCESS_MODULE_EXECUTED``, in the executing task's thread, when its outcome is settled);
   every :meth:`ProcessModule.perform` announces ``DESIGNATOR_PERFORMED``. Observers never change
@@ -51,6 +55,9 @@ from typing import Any, Callable, ClassVar, Optional
 
 from pycram import events
 from pycram.designators.core import DesignatorError, callable_name, known_solution
+from pycram.designators.motion import MotionDesignator
+from pycram.designators.motion_types import (active_motion_types, check_motion,
+                                             describe_known_types)
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
 from pycram.runtime import current_clock, no_evaporation, wait_until
@@ -62,6 +69,7 @@ __all__ = [
     "ProcessModuleFailure",
     "ProcessModuleOffline",
     "NoProcessModuleError",
+    "UnknownMotionTypeError",
     "ExecutionCancelled",
     "Execution",
 ]
@@ -113,6 +121,18 @@ class ExecutionCancelled(ProcessModuleError):
 
 class NoProcessModuleError(ProcessModuleError, DesignatorError, LookupError):
     """No resolver returned a process module for the designator."""
+
+
+class UnknownMotionTypeError(NoProcessModuleError):
+    """No process module serves the designator and its type is not among the motion types the
+    active robot declares (``robot.motion_types``); the message lists them. ``motion_type`` is
+    the unknown type, ``known_types`` the declared ones."""
+
+    def __init__(self, message: str, designator: Any = None, motion_type: Any = None,
+                 known_types: Any = ()) -> None:
+        super().__init__(message, designator=designator)
+        self.motion_type = motion_type
+        self.known_types = sorted(known_types, key=str)
 
 
 class Execution:
@@ -213,6 +233,7 @@ class ProcessModule:
         exception if one is raised) before returning or raising.
         """
         try:
+            _check_motion(designator)
             module = ProcessModule.resolve(designator)
             if designator.prop_value("wait") is False:
                 result = module.execute_nowait(designator)
@@ -227,6 +248,7 @@ class ProcessModule:
     @staticmethod
     def perform_nowait(designator: Any) -> Execution:
         """Like :meth:`perform` but never blocks: returns the :class:`Execution` handle."""
+        _check_motion(designator)
         return ProcessModule.resolve(designator).execute_nowait(designator)
 
     @staticmethod
@@ -249,6 +271,13 @@ class ProcessModule:
                     f"process-module resolver {callable_name(resolver)} returned {module!r} "
                     f"for {designator!r}, not a ProcessModule", designator=designator)
             return module
+        types = active_motion_types()
+        motion_type = _type_of(designator)
+        if types and motion_type not in {str(t) for t in types}:
+            raise UnknownMotionTypeError(
+                f"no process module for {designator!r}: unknown motion type {motion_type!r}; "
+                f"{describe_known_types(types, motion_type)}",
+                designator=designator, motion_type=motion_type, known_types=types)
         robot = current_robot()
         available = sorted(robot.process_modules) if robot is not None else []
         raise NoProcessModuleError(
@@ -470,6 +499,12 @@ class ProcessModule:
                        error: Optional[BaseException]) -> None:
         execution.exception = error
         execution.status.set_value(outcome)
+
+
+def _check_motion(designator: Any) -> None:
+    """Check a motion designator against the active robot's motion types (before it is queued)."""
+    if isinstance(designator, MotionDesignator):
+        check_motion(designator)
 
 
 def _type_of(designator: Any) -> str:

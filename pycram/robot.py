@@ -61,6 +61,11 @@ class ResolverSet:
       ``True`` or ``None`` (does not apply) accept it.
     - ``action_resolvers``: ``f(designator) -> plan | iterable of plans | None``; a plan is a
       function ``plan(designator)`` that :func:`pycram.designator.perform` runs as a task.
+
+    ``motion_types`` maps a motion type's name to its
+    :class:`~pycram.designators.motion_types.MotionType` (keys, units, valid values): the
+    vocabulary motion designators are checked against before anything moves. Empty: nothing is
+    checked.
     """
 
     def __init__(self, name: str = "resolvers") -> None:
@@ -70,6 +75,7 @@ class ResolverSet:
         self.location_generators: list[Callable[..., Any]] = []
         self.location_validators: list[Callable[..., Any]] = []
         self.action_resolvers: list[Callable[..., Any]] = []
+        self.motion_types: dict[Any, Any] = {}
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"

@@ -332,6 +332,65 @@ def test_resolver_returning_non_iterable_is_named(returned):
     assert info.value.designator is d and info.value.resolver is int_resolver
 
 
+def test_resolver_returning_a_dict_is_refused_not_resolved_to_its_first_key():
+    def dict_resolver(d):
+        return {'cmd': 'navigate', 'pose': (1, 2, 0)}  # meant as one solution
+
+    MotionDesignator.resolvers.append(dict_resolver)
+    d = MotionDesignator([('type', 'moving')])
+    with pytest.raises(ResolverError, match='dict_resolver returned a mapping') as info:
+        d.reference()
+    assert 'wrap a single solution in a list' in str(info.value)
+    assert info.value.designator is d and info.value.resolver is dict_resolver
+
+
+def _yields_none():
+    yield None
+
+
+@pytest.mark.parametrize('returned', [[None], [1, None], [_yields_none]])
+def test_none_as_a_solution_is_refused(returned):
+    def none_resolver(d):
+        return returned
+
+    MotionDesignator.resolvers.append(none_resolver)
+    d = MotionDesignator([('type', 'x')])
+    solutions = []
+    with pytest.raises(ResolverError, match='none_resolver gave None as a solution') as info:
+        solutions = [d.reference()]
+        solutions.append(d.next_solution().reference())
+    assert None not in solutions
+    assert info.value.resolver is none_resolver
+
+
+@pytest.mark.parametrize('bad', [('type',), ('type', 'moving', 'extra'), ()])
+def test_malformed_constraint_is_a_property_error(bad):
+    d = Designator([('type', 'moving')])
+    with pytest.raises(PropertyError, match='neither a key nor a .key, value. pair') as info:
+        d.check_constraints([bad])
+    assert "Designator([('type', 'moving')])" in str(info.value)
+    with pytest.raises(PropertyError):
+        d.make_dictionary([bad])
+
+
+def test_resolver_saying_why_there_is_no_solution_reaches_the_caller_unchanged():
+    def first(d):
+        return ['a']
+
+    def declining(d):
+        raise NoSolutionError('nothing beyond a: the shelf is empty', designator=d)
+
+    MotionDesignator.resolvers.extend([first, declining])
+    d = MotionDesignator([('type', 'x')])
+    assert d.reference() == 'a' and list(d.solutions()) == ['a']
+    assert d.next_solution() is None
+    MotionDesignator.resolvers[:] = [declining]
+    other = MotionDesignator([('type', 'x')])
+    with pytest.raises(NoSolutionError, match='the shelf is empty') as info:
+        other.reference()
+    assert not isinstance(info.value, ResolverError) and info.value.designator is other
+
+
 def test_unknown_kinds_as_parent_or_equate_target():
     with pytest.raises(UnknownKindError, match="parent must be a Designator.*'cup'"):
         MotionDesignator([('type', 'x')], parent='cup')

@@ -13,9 +13,16 @@ Guarantees
   the same solution. Repeated calls return the same solution.
 - Resolution is lazy: resolvers and generators are advanced only as far as the solutions
   requested so far (:class:`GeneratorList`).
-- A broken resolver (raises, returns a non-iterable) surfaces as :class:`ResolverError` naming the
-  designator and the resolver, never as a silent empty result; a designator without solutions
-  raises :class:`NoSolutionError` naming its properties and the resolvers tried.
+- A broken resolver (raises, returns a non-iterable, a mapping, or ``None`` as a solution)
+  surfaces as :class:`ResolverError` naming the designator and the resolver, never as a silent
+  empty or wrong result; a designator without solutions raises :class:`NoSolutionError` naming
+  its properties and the resolvers tried.
+- A resolver that knows *why* a designator has no solution raises
+  ``NoSolutionError(reason, designator=d)`` itself: it reaches the caller unchanged and ends the
+  resolution (no later resolver is asked). Likewise a :class:`DesignatorError` a resolver raises
+  about ``d`` itself (``error.designator is d``, e.g. an invalid property) is not wrapped.
+- Malformed constraints given to ``check_constraints`` / ``make_dictionary`` (a tuple that is not
+  a pair) raise :class:`PropertyError`.
 """
 
 from __future__ import annotations
@@ -40,6 +47,7 @@ __all__ = [
 
 logger = logging.getLogger("pycram.designator")
 
+#: One designator property: a ``(key, value)`` pair.
 Property = tuple[Any, Any]
 
 
@@ -257,23 +265,30 @@ class Designator:
         """``True`` iff every constraint holds.
 
         A tuple ``(key, value)`` requires the property to equal ``value``; any other element is a
-        key whose value must not be ``None``.
+        key whose value must not be ``None``. A tuple of another length raises
+        :class:`PropertyError`.
         """
         for prop in properties:
             if type(prop) == tuple:  # noqa: E721 - thesis semantics: only tuples are pairs
-                key, value = prop
+                key, value = self._constraint_pair(prop, "check_constraints")
                 if self.prop_value(key) != value:
                     return False
             elif self.prop_value(prop) is None:
                 return False
         return True
 
+    def _constraint_pair(self, prop: tuple, caller: str) -> tuple[Any, Any]:
+        if len(prop) != 2:
+            raise PropertyError(
+                f"{caller} on {self!r}: {_short(prop)} is neither a key nor a (key, value) pair")
+        return prop
+
     def make_dictionary(self, properties: Iterable[Any]) -> dict[Any, Any]:
         """A dict of the listed properties: tuples are taken literally, keys are looked up."""
         dictionary: dict[Any, Any] = {}
         for prop in properties:
             if type(prop) == tuple:  # noqa: E721
-                key, value = prop
+                key, value = self._constraint_pair(prop, "make_dictionary")
                 dictionary[key] = value
             else:
                 dictionary[prop] = self.prop_value(prop)
@@ -458,17 +473,24 @@ class GeneratorList:
 
 def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[Any]:
     """Yield the solutions in a resolver's ``result``: items may be plain solutions,
-    generators or generator functions (thesis). Failures become :class:`ResolverError`."""
+    generators or generator functions (thesis).
+
+    Failures become :class:`ResolverError`: a resolver that raises, a result that is not a list
+    of solutions (a non-iterable, a string, a mapping -- whose iteration would yield its keys),
+    and a ``None`` solution. A :class:`DesignatorError` about ``designator`` itself (e.g. a
+    :class:`NoSolutionError` saying why there is none) passes unchanged.
+    """
     name = callable_name(resolver)
     if result is None:
         return
     if isgeneratorfunction(result):
         result = result()
-    if isinstance(result, (str, bytes)) or not isinstance(result, Iterable):
+    if isinstance(result, (str, bytes, Mapping)) or not isinstance(result, Iterable):
+        kind = "a mapping" if isinstance(result, Mapping) else "a non-iterable"
         raise ResolverError(
-            f"resolver {name} returned a non-iterable {_short(result)} for {designator!r}; "
-            f"resolvers must return a list of solutions", designator=designator,
-            resolver=resolver)
+            f"resolver {name} returned {kind} {_short(result)} for {designator!r}; "
+            f"resolvers must return a list of solutions (wrap a single solution in a list)",
+            designator=designator, resolver=resolver)
     iterator = iter(result)
     while True:
         try:
@@ -476,6 +498,7 @@ def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[An
         except StopIteration:
             return
         except Exception as e:
+            _reraise_own(designator, e)
             raise ResolverError(f"resolver {name} failed while resolving {designator!r}: {e!r}",
                                 designator=designator, resolver=resolver, cause=e) from e
         if isgeneratorfunction(solution):
@@ -487,26 +510,42 @@ def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[An
                 except StopIteration:
                     break
                 except Exception as e:
+                    _reraise_own(designator, e)
                     raise ResolverError(
                         f"a solution generator of resolver {name} failed while resolving "
                         f"{designator!r}: {e!r}", designator=designator, resolver=resolver,
                         cause=e) from e
-                yield item
+                yield _not_none(designator, resolver, item)
         else:
-            yield solution
+            yield _not_none(designator, resolver, solution)
+
+
+def _not_none(designator: Any, resolver: Any, solution: Any) -> Any:
+    if solution is None:
+        raise ResolverError(
+            f"resolver {callable_name(resolver)} gave None as a solution of {designator!r}; "
+            f"a resolver with nothing to offer returns None or an empty list",
+            designator=designator, resolver=resolver)
+    return solution
+
+
+def _reraise_own(designator: Any, error: BaseException) -> None:
+    """Re-raise ``error`` if it is a designator error about ``designator`` itself (a resolver
+    that says why there is no solution, or which property is wrong): it needs no wrapping."""
+    if isinstance(error, DesignatorError) and getattr(error, "designator", None) is designator:
+        raise error
 
 
 def call_resolver(designator: Any, resolver: Any, *args: Any) -> Any:
-    """Call ``resolver(designator, *args)``, turning an exception into :class:`ResolverError`."""
+    """Call ``resolver(designator, *args)``, turning an exception into :class:`ResolverError`.
+
+    A :class:`DesignatorError` whose ``designator`` is ``designator`` (a resolver's own
+    :class:`NoSolutionError` or property error about it) passes unchanged.
+    """
     try:
         return resolver(designator, *args)
-    except DesignatorError as e:
-        if isinstance(e, ResolverError) and e.designator is designator:
-            raise
-        raise ResolverError(
-            f"resolver {callable_name(resolver)} failed while resolving {designator!r}: {e!r}",
-            designator=designator, resolver=resolver, cause=e) from e
     except Exception as e:
+        _reraise_own(designator, e)
         raise ResolverError(
             f"resolver {callable_name(resolver)} failed while resolving {designator!r}: {e!r}",
             designator=designator, resolver=resolver, cause=e) from e
@@ -570,7 +609,11 @@ class LazyDesignator(Designator):
             raise
         except DesignatorError:
             pass
-        if self._solutions is not None and self._solutions.has(self._index + 1):
+        try:
+            more = self._solutions is not None and self._solutions.has(self._index + 1)
+        except NoSolutionError:  # a resolver said there are no more, and why
+            return None
+        if more:
             desig = self.__class__(self._properties, self)
             desig._solutions = self._solutions
             desig._index = self._index + 1

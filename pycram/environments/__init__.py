@@ -19,7 +19,9 @@ __all__ = ["ENVIRONMENT_NAMES", "DEFAULT_ENVIRONMENT", "load"]
 
 #: Environment name -> module under `pycram.environments`.
 _MODULES = {"thesis-kitchen": "thesis_kitchen", "apartment": "apartment"}
+#: The names `load` accepts.
 ENVIRONMENT_NAMES = tuple(_MODULES)
+#: The environment a `World` gets when none is named (the thesis demo's kitchen).
 DEFAULT_ENVIRONMENT = "thesis-kitchen"
 
 

@@ -101,8 +101,13 @@ class SimProcessModule(ProcessModule):
 
         Blocks until the command ends or ``timeout`` [s, simulated] passes (then the command is
         cancelled). Evaporable: the caller's evaporation interrupts the wait (the module's cancel
-        hook stops the command). Raises :class:`SimMotionFailed` on any unsuccessful outcome.
+        hook stops the command). Raises :class:`SimMotionFailed` on any unsuccessful outcome,
+        ``ValueError`` (before sending anything) for a time-out that is not a positive finite
+        number -- a NaN time-out would never expire.
         """
+        if not (isinstance(timeout, (int, float)) and math.isfinite(timeout) and timeout > 0):
+            raise ValueError(f"{command}: the time-out must be a positive number of seconds, "
+                             f"got {timeout!r}")
         handle = start()
         self._handle = handle
         if not handle.result.wait_for(timeout):

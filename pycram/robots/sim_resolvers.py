@@ -39,7 +39,7 @@ executing it.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Iterator, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 from pycram.sim.types import Pose2D, yaw_to_quat
 from pycram.world.environment import FURNITURE_TOPS
@@ -103,6 +103,33 @@ def _relative_to(base: Pose2D, pose: Pose2D) -> Pose2D:
                   base.yaw + pose.yaw)
 
 
+def base_goal_in_map(world: Any, pose: Any, frame: Any = None) -> Pose2D:
+    """A base goal ``pose`` given in ``frame`` (``'map'``, the default, or ``'base_footprint'``:
+    relative to the base pose now) as a ``Pose2D`` in the map frame."""
+    pose = _pose2d(pose)
+    frame = frame or "map"
+    if frame == "base_footprint":
+        return _relative_to(world.base_pose.get_value(), pose)
+    if frame != "map":
+        raise ValueError(f"unknown frame {frame!r}; available: map, base_footprint")
+    return pose
+
+
+def on_free_floor(world: Any, x: float, y: float) -> bool:
+    """``True`` iff the base may stand at (x, y) [m, map]: on the floor of ``world``'s environment
+    and off its furniture (``Environment.is_free_floor``). Goals of ``moving`` and the base poses
+    of ``to_reach`` must lie there; this is the one place resolvers ask."""
+    return bool(world.environment.is_free_floor(x, y))
+
+
+def describe_free_floor(world: Any) -> str:
+    """``the free floor of thesis-kitchen (x in [-0.45, 3] m, y in [-0.9, 3.5] m, off the furniture)``
+    (for messages)."""
+    env = world.environment
+    areas = "; ".join(f"x in [{x0:g}, {x1:g}] m, y in [{y0:g}, {y1:g}] m" for x0, y0, x1, y1 in env.floor)
+    return f"the free floor of {env.name} ({areas}, off the furniture)"
+
+
 def approach_target(description: Any, base: Pose2D, target: Sequence[float],
                     phase: Optional[str]) -> tuple[tuple[float, float, float], tuple[float, ...]]:
     """Tool position [m, map] and orientation (w, x, y, z) for ``phase`` of reaching ``target``.
@@ -156,12 +183,7 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
         solutions = []
         wait = desig.prop_value("wait") is not False
         if desig.check_constraints([("type", "moving"), "pose"]):
-            pose = _pose2d(desig.prop_value("pose"))
-            frame = desig.prop_value("frame") or "map"
-            if frame == "base_footprint":
-                pose = _relative_to(world.base_pose.get_value(), pose)
-            elif frame != "map":
-                raise ValueError(f"unknown frame {frame!r}; available: map, base_footprint")
+            pose = base_goal_in_map(world, desig.prop_value("pose"), desig.prop_value("frame"))
             solutions.append(desig.make_dictionary(
                 [("cmd", "navigate"), ("pose", pose), ("frame", "map"), ("wait", wait)]))
         if desig.check_constraints([("type", "cancelling_movement")]):
@@ -274,23 +296,35 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
 
     Yields base poses (``Pose2D``, map frame) from which the arm (default
     ``description.DEFAULT_ARM``) reaches the point: the best one first, then the same with the
-    base 5 cm further back, 5 cm closer and 10 cm further back. Returns ``None`` for other
-    location designators.
+    base 5 cm further back, 5 cm closer and 10 cm further back -- each only if it lies on the
+    environment's free floor (:func:`on_free_floor`). Raises ``NoSolutionError`` saying why when
+    none does (the point is outside the environment, or too far from the floor). Returns
+    ``None`` for other location designators.
     """
     d = description
 
-    def to_reach(desig: Any) -> Optional[Iterator[Pose2D]]:
+    def to_reach(desig: Any) -> Optional[list[Pose2D]]:
         if not desig.check_constraints(["to_reach"]):
             return None
         point = _point(desig.prop_value("to_reach"))
+        if not all(math.isfinite(v) for v in point):
+            raise ValueError(f"the point to reach must be finite [m], got {point}")
         arm = physical_arm(d, desig.prop_value("arm") or d.DEFAULT_ARM)
         current = world.base_pose.get_value()
+        candidates = [base_pose_to_reach(d, point, arm, current, extra, world.environment)
+                      for extra in (0.0, 0.05, -0.05, 0.10)]
+        poses = [pose for pose in candidates if on_free_floor(world, pose.x, pose.y)]
+        if not poses:
+            from pycram.designators.core import NoSolutionError
 
-        def poses() -> Iterator[Pose2D]:
-            for extra in (0.0, 0.05, -0.05, 0.10):
-                yield base_pose_to_reach(d, point, arm, current, extra, world.environment)
-
-        return poses()
+            where = ("outside the environment" if not on_free_floor(world, point[0], point[1])
+                     and _counter_normal(world.environment, point[0], point[1]) is None else "out of reach")
+            best = candidates[0]
+            raise NoSolutionError(
+                f"Cannot resolve {desig!r}: the point {point} [m, map] is {where}: the "
+                f"{d.NAME} {arm} arm would reach it from (x={best.x:.2f}, y={best.y:.2f}), but "
+                f"the base can only stand on {describe_free_floor(world)}", designator=desig)
+        return poses
 
     to_reach.__qualname__ = f"{d.NAME}_to_reach"
     return to_reach

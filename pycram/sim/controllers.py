@@ -3,6 +3,11 @@
 A controller is started once, updated every control tick (before the physics steps) until it
 returns an `Outcome`, and stopped when it is cancelled or preempted. Controllers that share a
 `channel` (a part of the robot) preempt each other.
+
+Every controller with an end ends within a bounded simulated time, whatever its input: `start`
+refuses (outcome "invalid", nothing moves) goals, durations, tolerances and time-outs that are
+not finite numbers or out of range -- a NaN goal would otherwise make a duration NaN, and a
+comparison with NaN never ends a motion. Only `HeadPointing(track=True)` runs until cancelled.
 """
 
 from __future__ import annotations
@@ -28,6 +33,32 @@ def ok(value: object = None, message: str = "") -> Outcome:
 
 def fail(reason: str, message: str, value: object = None) -> Outcome:
     return Outcome(False, reason, message, value)
+
+
+def invalid_input(**inputs: object) -> Outcome | None:
+    """An "invalid" outcome naming the first input that is not finite, else None.
+
+    Each input is a number, a sequence of numbers, or None (not given); a duration-like input
+    named with a `positive_` prefix must also be > 0.
+    """
+    for name, value in inputs.items():
+        if value is None:
+            continue
+        values = np.atleast_1d(np.asarray(value, dtype=float)) if _numeric(value) else None
+        label = name.removeprefix("positive_")
+        if values is None or not np.all(np.isfinite(values)):
+            return fail("invalid", f"{label} must be finite, got {value!r}")
+        if name.startswith("positive_") and not np.all(values > 0):
+            return fail("invalid", f"{label} must be positive, got {value!r}")
+    return None
+
+
+def _numeric(value: object) -> bool:
+    try:
+        np.asarray(value, dtype=float)
+        return True
+    except (TypeError, ValueError):
+        return False
 
 
 class Controller:
@@ -72,6 +103,11 @@ class BaseDrive(Controller):
         self.goal, self.tol, self.yaw_tol, self.max_lag = goal, tolerance, yaw_tolerance, max_lag
 
     def start(self, eng: Engine) -> Outcome | None:
+        refused = invalid_input(goal=(self.goal.x, self.goal.y, self.goal.yaw),
+                                positive_tolerance=self.tol, positive_yaw_tolerance=self.yaw_tol,
+                                positive_max_lag=self.max_lag)
+        if refused is not None:
+            return refused
         b = eng.desc.BASE
         self.start_pose = p = eng.base_pose()
         self.dx, self.dy = self.goal.x - p.x, self.goal.y - p.y
@@ -136,6 +172,13 @@ class JointTrajectory(Controller):
         self.tol, self.settle = tolerance, settle_time
 
     def start(self, eng: Engine) -> Outcome | None:
+        refused = invalid_input(goal=self.goal, positive_duration=self.duration,
+                                positive_max_velocity=self.vmax, positive_tolerance=self.tol,
+                                positive_settle_time=self.settle)
+        if refused is not None:
+            return refused
+        if len(self.goal) != len(self.joints):
+            return fail("invalid", f"{len(self.joints)} joints {self.joints}, got {len(self.goal)} positions")
         m = eng.model
         for j, g in zip(self.joints, self.goal):
             jid = eng.scene.joint_id(j)
@@ -180,6 +223,9 @@ class GripperCommand(Controller):
         self.gripper, self.opening, self.effort = gripper, opening, effort
 
     def start(self, eng: Engine) -> Outcome | None:
+        refused = invalid_input(opening=self.opening, effort=self.effort)
+        if refused is not None:
+            return refused
         g = eng.grippers[self.gripper]
         spec = g.spec
         effort = spec["default_effort"] if self.effort is None else self.effort
@@ -238,7 +284,10 @@ class HeadPointing(Controller):
 
     def start(self, eng: Engine) -> Outcome | None:
         h = eng.desc.HEAD
-        self.joints = (h["pan_joint"], h["tilt_joint"])
+        self.joints = (h["pan_joint"], h["tilt_joint"])  # before any outcome: `stop` holds them
+        refused = invalid_input(point=self.point, positive_tolerance=self.tol)
+        if refused is not None:
+            return refused
         self.dofs = [eng.scene.joint_dof(j) for j in self.joints]
         self.jids = [eng.scene.joint_id(j) for j in self.joints]
         self.jacr = np.zeros((3, eng.model.nv))
@@ -311,6 +360,10 @@ class Reach(Controller):
     def start(self, eng: Engine) -> Outcome | None:
         from .ik import solve_ik
 
+        refused = invalid_input(position=self.goal.position, orientation=self.goal.orientation,
+                                positive_duration=self.duration, positive_tolerance=self.tol)
+        if refused is not None:
+            return refused
         sol = solve_ik(eng, self.arm, self.goal, self.use_orientation)
         if sol is None:
             return fail("unreachable", f"no IK solution for {self.arm} arm to {self.goal}")
@@ -351,6 +404,9 @@ class GiveItem(Controller):
         self.closer: GripperCommand | None = None
 
     def start(self, eng: Engine) -> Outcome | None:
+        refused = invalid_input(positive_timeout=self.timeout)
+        if refused is not None:
+            return refused
         g = eng.grippers[self.gripper]
         if g.holding is not None:
             return fail("invalid", f"gripper {self.gripper} already holds {g.holding}")

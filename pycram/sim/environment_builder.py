@@ -19,7 +19,9 @@ from pycram.world.environment import Box, Container, Environment
 
 from . import collision
 
+#: How many movable obstacles every scene holds for `World.place_obstacle` (parked when unused).
 N_OBSTACLES = 3
+#: Where unused obstacles wait [m]: far away, below the ground.
 OBSTACLE_PARKING = (20.0, 20.0, -5.0)  # [m] where unused obstacles wait (far away, below ground)
 _COOKER_RGBA = [0.55, 0.08, 0.05, 1]
 _HANDLE_RGBA = [0.35, 0.35, 0.38, 1]
@@ -29,6 +31,7 @@ _HANDLE_STANDOFF = 0.04  # [m] between a front panel and its handle bar
 #: An orthographic camera looking straight down on the whole environment (image up: +y).
 PLAN_CAMERA = "plan"
 PLAN_CAMERA_HEIGHT = 8.0  # [m]
+#: Width / height of images of the plan camera.
 PLAN_ASPECT = 4.0 / 3.0  # width / height of images of the plan camera
 
 

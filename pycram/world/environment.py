@@ -14,8 +14,11 @@ from typing import Iterable, Literal
 
 from .errors import UnknownNameError
 
+#: A point or vector in the floor plane (x, y) [m].
 XY = tuple[float, float]
+#: A point or vector in space (x, y, z) [m].
 Vec3 = tuple[float, float, float]
+#: A colour: red, green, blue, alpha in [0, 1].
 RGBA = tuple[float, float, float, float]
 #: An axis-aligned rectangle on the floor: (x_min, y_min, x_max, y_max) [m].
 Rect = tuple[float, float, float, float]

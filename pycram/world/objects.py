@@ -14,6 +14,7 @@ from typing import Literal
 
 from .errors import UnknownNameError
 
+#: A colour: red, green, blue, alpha in [0, 1].
 RGBA = tuple[float, float, float, float]
 #: Horizontal approach directions in the object's frame; "side" means any horizontal direction
 #: (round objects), "top" straight down.
@@ -114,6 +115,7 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
 
 _ANY_SURFACE = ("counter", "table", "shelf", "drawer")
 
+#: Every object type by name.
 OBJECT_TYPES: dict[str, ObjectType] = {t.name: t for t in (
     ObjectType("cup", "cylinder", (0.035, 0.045), 0.2, (0.80, 0.18, 0.15, 1.0),
                (Grasp("side", 0.07, 0.05),), _ANY_SURFACE, "a drinking cup, 7 cm wide, 9 cm tall"),

@@ -18,6 +18,7 @@ from pycram.process_module import ProcessModule
 from pycram.robots import sim_modules as sm
 from pycram.robots.sim_resolvers import (make_motion_resolver, make_to_reach_generator,
                                          physical_arm, physical_gripper)
+from pycram.robots.sim_vocabulary import motion_types
 from pycram.robots.tiago import description
 
 __all__ = ["make_robot"]
@@ -41,6 +42,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
     perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
 
+    robot.motion_types.update(motion_types(world, description))
     robot.motion_resolvers.append(make_motion_resolver(world, description))
     robot.location_generators.append(make_to_reach_generator(world, description))
 
