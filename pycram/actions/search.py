@@ -29,8 +29,9 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable, Optional
+from typing import Any
 
 from pycram.designators.core import DesignatorError
 from pycram.designators.motion import MotionDesignator
@@ -70,7 +71,7 @@ class Lookout:
     surface: str
     target: tuple[float, float, float]
     stand: tuple[float, float, float]
-    container: Optional[str] = None
+    container: str | None = None
 
 
 #: Clearance [m] of a standing pose from walls and furniture (a robot base's half diagonal).
@@ -82,7 +83,7 @@ def _free(environment: Environment, x: float, y: float) -> bool:
 
 
 def _stand_along(environment: Environment, point: tuple[float, float], towards: tuple[float, float],
-                 n: tuple[float, float], standoff: float) -> Optional[tuple[float, float]]:
+                 n: tuple[float, float], standoff: float) -> tuple[float, float] | None:
     """A free standing spot `standoff` [m] out from `point` on an edge (outward normal `n`),
     moved along the edge towards `towards` (in 0.1 m steps, at most to it) when `point` is not
     free; None when there is none."""
@@ -127,7 +128,7 @@ def _surface_lookouts(environment: Environment, surface: Surface, near: tuple[fl
     return out
 
 
-def lookouts(environment: Environment, type_name: Optional[str] = None, near: tuple[float, float] = (0.0, 0.0),
+def lookouts(environment: Environment, type_name: str | None = None, near: tuple[float, float] = (0.0, 0.0),
              standoff: float = STANDOFF) -> list[Lookout]:
     """The places of `environment` where an object of `type_name` is likely (all surfaces when
     the type is None or unknown), with where to stand for each, nearest to `near` [m] first."""
@@ -160,7 +161,7 @@ def _robot_belief() -> BeliefState:
     return belief
 
 
-def _believed(description: ObjectDesignator, belief: BeliefState) -> Optional[PerceivedObject]:
+def _believed(description: ObjectDesignator, belief: BeliefState) -> PerceivedObject | None:
     return next((o for o in belief.present() if description.matches(o)), None)
 
 
@@ -180,14 +181,14 @@ def _target(lookout: Lookout, environment: Environment, belief: BeliefState) -> 
     return (x + q * container.opening_direction[0], y + q * container.opening_direction[1], z)
 
 
-def _look(description: ObjectDesignator, target: tuple[float, float, float]) -> Optional[PerceivedObject]:
+def _look(description: ObjectDesignator, target: tuple[float, float, float]) -> PerceivedObject | None:
     """Point the head at `target` and detect; the best match seen, or None."""
     perform(MotionDesignator(type="pointing_head", coordinates=target))
     seen = perform(MotionDesignator(type="detecting", object=description))
     return seen[0] if seen else None
 
 
-def _look_around(description: Optional[ObjectDesignator], places: list[Lookout], here: tuple[float, float],
+def _look_around(description: ObjectDesignator | None, places: list[Lookout], here: tuple[float, float],
                  belief: BeliefState, look_range: float, looked: list[str], close: set[str]) -> list[PerceivedObject]:
     """Look at each place within `look_range` of `here`; stop at the first match of a
     `description` (None: look at every place and return everything seen)."""
@@ -216,7 +217,7 @@ def _look_around(description: Optional[ObjectDesignator], places: list[Lookout],
 
 
 @as_task(name="look_around")
-def look_around(description: Optional[ObjectDesignator] = None, *, belief: Optional[BeliefState] = None,
+def look_around(description: ObjectDesignator | None = None, *, belief: BeliefState | None = None,
                 look_range: float = LOOK_RANGE) -> list[PerceivedObject]:
     """Look at every likely place within `look_range` [m] from where the robot stands (for the
     type of `description`, all places without one), detecting at each, without driving; stops
@@ -232,8 +233,8 @@ def look_around(description: Optional[ObjectDesignator] = None, *, belief: Optio
 
 
 @as_task(name="search_for")
-def search_for(description: ObjectDesignator, *, belief: Optional[BeliefState] = None,
-               open_container: Optional[Callable[[str], Any]] = None, look_range: float = LOOK_RANGE,
+def search_for(description: ObjectDesignator, *, belief: BeliefState | None = None,
+               open_container: Callable[[str], Any] | None = None, look_range: float = LOOK_RANGE,
                standoff: float = STANDOFF) -> PerceivedObject:
     """Find an object matching `description` (see the module's description); returns the believed
     object found, to which `description` is then equated (``description.current()``).
@@ -271,8 +272,8 @@ def search_for(description: ObjectDesignator, *, belief: Optional[BeliefState] =
 
 
 def _visit(description: ObjectDesignator, lookout: Lookout, environment: Environment, belief: BeliefState,
-           open_container: Optional[Callable[[str], Any]], looked: list[str],
-           skipped: dict[str, str]) -> Optional[PerceivedObject]:
+           open_container: Callable[[str], Any] | None, looked: list[str],
+           skipped: dict[str, str]) -> PerceivedObject | None:
     container = lookout.container
     if container is not None and belief.container_open(container) is False and open_container is None:
         skipped[lookout.name] = f"{container} is closed"
@@ -282,7 +283,7 @@ def _visit(description: ObjectDesignator, lookout: Lookout, environment: Environ
     except _FAILURES as failure:
         skipped[lookout.name] = f"could not get there: {failure}"
         return None
-    for attempt in range(2):
+    for _ in range(2):  # a look that finds the container closed opens it and looks again
         if container is not None and belief.container_open(container) is False:
             if open_container is None:
                 skipped[lookout.name] = f"{container} is closed"
@@ -303,4 +304,5 @@ def _visit(description: ObjectDesignator, lookout: Lookout, environment: Environ
         if container is None or belief.container_open(container) is not False:
             looked.append(lookout.name)
             return None
+    looked.append(lookout.name)
     return None

@@ -46,8 +46,8 @@ from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
 from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames
-from .render import Renderers, write_animation, write_png
 from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
+from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
 from .scene import build_scene
 from .types import Outcome, Pose, Pose2D, VisibleItem
@@ -499,7 +499,6 @@ class World:
         in_view = {name: q for name, q in states.items()
                    if view.in_image(self.environment.container(name).handle_position(q))}
         return PerceptionReport(eng.time, tuple(detections), view, in_view)
-        return self._call("detect", fn)
 
     def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
                              height: int = 240) -> CommandHandle:

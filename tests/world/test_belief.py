@@ -11,8 +11,7 @@ import pytest
 from pycram.designator import NoSolutionError, ObjectDesignator
 from pycram.environments import load
 from pycram.robot import ResolverSet
-from pycram.world.belief import (BeliefState, CameraView, Detection, PerceptionReport, color_name,
-                                 support_of)
+from pycram.world.belief import BeliefState, CameraView, Detection, PerceptionReport, color_name, support_of
 
 APARTMENT = load("apartment")
 
