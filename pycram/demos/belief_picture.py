@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from pycram.demos.scene_picture import _BOX, _OBJECT_COLOR, VIEW_SIZE, _Labels, _render
+from pycram.demos.scene_picture import _BOX, _OBJECT_COLOR, VIEW_SIZE, _Labels, _render, _save
 
 __all__ = ["write_belief_picture"]
 
@@ -119,9 +119,4 @@ def write_belief_picture(world: Any, belief: Any, path: str | Path, title: str |
     belief_ax.text(x0 + 0.1, y1 - 0.1, f"blue wedges: the camera's {len(belief.looks)} looks\n"
                    "disc: believed object, perceived colour and measured size\ncrossed: believed gone",
                    ha="left", va="top", fontsize=8, color="#263238", bbox={**_BOX, "facecolor": "white"})
-    fig.suptitle(title or f"{env.name}: belief and ground truth", fontsize=14, y=0.95)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    return _save(fig, path, title or f"{env.name}: belief and ground truth")
