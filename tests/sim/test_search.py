@@ -46,6 +46,21 @@ def test_search_finds_an_object_on_a_surface_out_of_view():
         world.close()
 
 
+def test_search_drives_around_the_table_to_an_object_beyond_the_cameras_range():
+    world = apartment((4.3, 0.9, math.pi / 2))  # south of the table, the cabinet 4.5 m away
+    put(world, "cup", "cabinet top", (0.2, 2.6))
+    robot = robot_in(world)
+    try:
+        with robot:
+            found = search_for(ObjectDesignator(type="cup"))
+            assert found.properties["on"] == "cabinet top" and within(found, world, "cup")
+            base = world.base_pose.get_value()
+            assert base.x < 2.5  # it went over to the cabinet's side of the room
+    finally:
+        robot.shutdown()
+        world.close()
+
+
 @pytest.mark.parametrize("robot_name", ["pr2", "tiago"])
 def test_search_finds_an_object_in_an_open_drawer(robot_name):
     world = apartment(START) if robot_name == "pr2" else _tiago_apartment()
