@@ -403,8 +403,11 @@ def scene_command(
                                 help="Comma-separated object types to place at random ('' for none)."),
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
+    belief: bool = typer.Option(False, "--belief",
+                                help="Let the robot look around and draw its belief beside the ground truth."),
 ) -> None:
-    """A labelled picture of a scene: plan and overview with surfaces, containers and objects."""
+    """A labelled picture of a scene: plan and overview with surfaces, containers and objects
+    (with --belief: what the robot perceived from where it stands beside what is)."""
     try:
         from pycram.demos.scene_picture import VIEW_SIZE, write_scene_picture
         from pycram.sim import World
@@ -418,7 +421,10 @@ def scene_command(
     except (KeyError, PlacementError) as e:
         _fail(str(e).strip("'\""))
     try:
-        path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
+        if belief:
+            path = _belief_picture(world, robot, output, title=f"{env} · seed {seed} · {robot}: belief")
+        else:
+            path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
         for p in world.placements:
             where = p.support + (f" (in {p.container})" if p.container else "")
             console.print(f"  {escape(p.name):<10} {escape(where)}")
@@ -458,6 +464,23 @@ def sim_ros_bridge_command(
 
     run_bridge(robot, item_at=item_at, realtime=realtime, publish_rate=publish_rate,
                ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True))
+
+
+def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Path:
+    """The robot looks around from where it stands; its belief is drawn beside the truth."""
+    from pycram import robots
+    from pycram.actions import look_around
+    from pycram.demos.belief_picture import write_belief_picture
+
+    robot = robots.load(robot_name, world)
+    try:
+        with robot:
+            look_around()
+    finally:
+        robot.shutdown()
+    for obj in robot.belief.objects():
+        console.print(f"  believed: {escape(repr(obj))}")
+    return write_belief_picture(world, robot.belief, output, title=title)
 
 
 def main(argv: list[str] | None = None) -> int:

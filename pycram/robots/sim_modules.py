@@ -362,23 +362,38 @@ class SensorModule(SimProcessModule):
 
 
 class PerceptionModule(SimProcessModule):
-    """Perceives the items visible to the head camera (``'cmd': 'perceive'``).
+    """Object perception with the head camera (``'cmd': 'perceive'``), filling the robot's belief.
 
-    Returns a list of :class:`pycram.sim.VisibleItem` (most visible first), restricted to
-    items whose name or type equals ``'object'`` when given (possibly empty).
+    Each execution takes one look (:meth:`pycram.sim.World.detect`: segmentation, depth and
+    colour images measured into detections) and folds it into ``belief`` (a
+    :class:`pycram.world.belief.BeliefState`). Returns the believed objects seen in this look
+    (:class:`pycram.world.belief.PerceivedObject`, most visible first), restricted by
+    ``'object'`` when given: a type or belief name, or an object designator; for a designator
+    the best match is recorded with ``designator.perceived(obj)`` (equated to it, thesis 3.3).
+    The look's :class:`pycram.world.belief.BeliefUpdate` is kept in ``last_update``.
     """
 
-    def __init__(self, world: Any, name: str = "perception") -> None:
+    def __init__(self, world: Any, belief: Any, name: str = "perception") -> None:
         super().__init__(name, world)
+        self.belief = belief
+        self.last_update: Any = None
 
     def _execute(self, designator: Any) -> Any:
+        from pycram.designators.object import ObjectDesignator
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
-        seen = self._run_command(self.world.perceive, "perceive", timeout=10.0)
+        report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
+        update = self.last_update = self.belief.update(report)
+        seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
         wanted = solution.get("object")
         if wanted is None:
-            return list(seen)
-        return [item for item in seen if wanted in (item.name, item.type)]
+            return seen
+        if isinstance(wanted, ObjectDesignator):
+            matching = [obj for obj in seen if wanted.matches(obj)]
+            if matching:
+                wanted.perceived(matching[0], timestamp=report.stamp)
+            return matching
+        return [obj for obj in seen if wanted in (obj.name, obj.type)]
 
 
 def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
@@ -400,14 +415,21 @@ def shutdown_modules(robot: Robot) -> None:
 class SimRobot(Robot):
     """A :class:`pycram.robot.Robot` bound to a simulated :class:`pycram.sim.World`.
 
-    ``world`` is the world, ``description`` the robot's description module. :meth:`shutdown`
+    ``world`` is the world, ``description`` the robot's description module, ``belief`` the
+    robot's :class:`pycram.world.belief.BeliefState` (its resolver is the robot's object
+    resolver, so object designators resolve against what it perceived). :meth:`shutdown`
     ends every subscription and takes every process module offline (idempotent).
     """
 
     def __init__(self, name: str, world: Any, description: Any) -> None:
+        from pycram.world.belief import BeliefState
         super().__init__(name)
         self.world = world
         self.description = description
+        #: What this robot believes is in the world: filled by its perception module, read by
+        #: its object resolver.
+        self.belief = BeliefState(getattr(world, "environment", None))
+        self.object_resolvers.append(self.belief.resolver)
         make_prospection = getattr(world, "prospection", None)
         self.prospection = make_prospection() if callable(make_prospection) else None
 
