@@ -14,13 +14,15 @@ hanging the suite (pytest-timeout is the second line of defence).
 
 from __future__ import annotations
 
+import os
+import random
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, given, seed, settings
 from hypothesis import strategies as st
 
 import pycram
@@ -460,3 +462,32 @@ def test_random_nested_plans_obey_the_rules() -> None:
     _examples_run[0] = 0
     check_random_nested_plan()
     assert _examples_run[0] >= EXAMPLES, f"only {_examples_run[0]} random plans ran"
+
+
+STRESS_RUNS = int(os.environ.get("PYCRAM_STRESS", "0") or 0)
+
+
+@pytest.mark.skipif(not STRESS_RUNS, reason="stress mode: set PYCRAM_STRESS=100 to run the property test 100 times")
+@pytest.mark.timeout(max(STRESS_RUNS, 1) * 60)
+def test_stress_random_nested_plans_with_many_seeds() -> None:
+    """Stress mode (opt-in): the property test above, `PYCRAM_STRESS` times, each with its own
+    hypothesis seed; every failing seed is reported. `PYCRAM_STRESS_SEED` fixes the first seed."""
+    first = int(os.environ.get("PYCRAM_STRESS_SEED", "0") or 0) or random.randrange(1 << 32)
+    failures: list[str] = []
+    started = time.monotonic()
+    try:
+        for run in range(STRESS_RUNS):
+            _examples_run[0] = 0
+            try:
+                seed(first + run)(check_random_nested_plan)()
+            except Exception as exc:  # noqa: BLE001 - collected and reported below
+                failures.append(f"seed {first + run}: {exc}")
+            else:
+                if _examples_run[0] < EXAMPLES:
+                    failures.append(f"seed {first + run}: only {_examples_run[0]} random plans ran")
+    finally:
+        check_random_nested_plan._hypothesis_internal_use_seed = None  # as the decorator left it
+    took = time.monotonic() - started
+    print(f"stress: {STRESS_RUNS} runs of {EXAMPLES} random plans (seeds {first}..{first + STRESS_RUNS - 1}) "
+          f"in {took:.0f} s, {len(failures)} failed")
+    assert not failures, "\n\n".join(failures)

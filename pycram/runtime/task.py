@@ -116,9 +116,11 @@ class Task:
         "exception",
         "result",
         "info",
+        "location",
         "_evaporating",
         "_runner",
         "_path",
+        "_pending_end",
     )
 
     def __init__(self, name: str, kind: str = "task", parent: Task | None = None) -> None:
@@ -133,8 +135,10 @@ class Task:
         self.exception: BaseException | None = None
         self.result: Any = None
         self.info: dict[str, Any] = {}
+        self.location: str | None = None
         self._runner: Runner | None = None
         self._path: str | None = None
+        self._pending_end: tuple[TaskStatus, BaseException | None] | None = None
         if parent is None:
             self._evaporating = False
         else:
@@ -184,11 +188,35 @@ class Task:
             listener.task_started(self)
 
     def _end(self, status: TaskStatus, exception: BaseException | None = None) -> None:
-        self.end_time = current_clock().now()
-        self.exception = exception
-        self.status.set_value(status)
-        for listener in _listeners:
-            listener.task_ended(self)
+        """The task's own code has ended with `status`; the task ends once its children have.
+
+        A child may still run when its parent's code ends: a process-module execution started
+        with `('wait', False)` inside a `seq` step or an `@as_task` function, for example. The
+        parent's final status, end time and `task_ended` notification then wait for the last
+        such child, whose own end completes the parent's (in the child's thread).
+        """
+        with _tree_lock:
+            if any(not child.done for child in self.children):
+                self._pending_end = (status, exception)
+                return
+        self._finish(status, exception)
+
+    def _finish(self, status: TaskStatus, exception: BaseException | None) -> None:
+        task: Task | None = self
+        while task is not None:
+            task.end_time = current_clock().now()
+            task.exception = exception
+            task.status.set_value(status)
+            for listener in _listeners:
+                listener.task_ended(task)
+            parent = task.parent
+            task = None
+            if parent is not None:
+                with _tree_lock:  # the last child to end completes its parent's pending end
+                    pending = parent._pending_end
+                    if pending is not None and all(child.done for child in parent.children):
+                        parent._pending_end = None
+                        task, (status, exception) = parent, pending
 
     def evaporate(self) -> None:
         """Stop this task and all its descendants; returns at once (idempotent).
@@ -349,8 +377,10 @@ class TaskGroup:
 
     A `detached` group is one its creator will not necessarily wait for (a process-module
     execution started with `('wait', False)`). It still does not outlive the branch that
-    started it: before that branch's thread ends, it waits for the group — after evaporating it
-    if the branch failed or was evaporated.
+    started it: before that branch ends, it waits for the group — after evaporating it if the
+    branch failed or was evaporated. A task whose code ends while a child still runs (a
+    detached execution started in a `seq` step, say) gets its final status when that child
+    has ended (see `Task._end`).
     """
 
     def __init__(self, on_end: Callable[[Task], None] | None = None, detached: bool = False) -> None:
@@ -402,14 +432,14 @@ class TaskGroup:
                 break
             except BaseException:
                 status = TaskStatus.EVAPORATED if task._evaporating else status
+        if runner.detached:  # before the task ends: its final status comes after its children's
+            _settle_detached(runner, stop=status is not TaskStatus.SUCCEEDED)
         task.result = result
         task._end(status, error)
         if self._on_end is not None:
             with self._cv:  # report the outcome at once: the expression may decide on it
                 self._on_end(task)
                 self._cv.notify_all()
-        if runner.detached:
-            _settle_detached(runner, stop=status is not TaskStatus.SUCCEEDED)
         with self._cv:
             self._running -= 1
             self._cv.notify_all()
