@@ -33,6 +33,7 @@ The thesis' block syntax (`with par(errors) as s:`) is a front end to these func
 
 from __future__ import annotations
 
+import sys
 from enum import Enum
 from typing import Any, Callable, Sequence
 
@@ -50,6 +51,7 @@ __all__ = [
     "try_in_order",
     "failure_handling",
     "retry",
+    "RetriesExhausted",
     "current_attempt",
     "with_timeout",
     "whenever",
@@ -284,6 +286,15 @@ def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: s
     Returns the state fluent: SUCCEEDED if fn returned in time; FAILED if it raised (its
     exception goes to `errors`) or timed out (a `TimeoutError` goes to `errors`). Never raises
     fn's exceptions; returns only after fn's task has ended.
+
+    What it can bound is what evaporation can stop: PyCRAM waits (`Fluent.wait_for`,
+    `whenever`, `pycram.sleep`, process-module executions) end at once, plain Python code
+    within a few milliseconds. It cannot interrupt C-level blocking inside fn — `time.sleep`,
+    `threading.Event.wait`, `Lock.acquire`, `socket.recv`, a long numpy call: evaporation lands
+    only when that call returns, and since with_timeout waits for fn's task to end, it returns
+    that late too. Block with the PyCRAM equivalents instead: `pycram.sleep(s)` for
+    `time.sleep(s)`, a `Fluent` and `wait_for(timeout)` for an `Event`, a process module for
+    hardware calls.
     """
     if not callable(fn):
         raise TypeError(f"with_timeout(): fn must be callable, got {type(fn).__name__}")
@@ -350,7 +361,9 @@ class _FailureHandling(BlockForm):
         """Run `body`; each `retry()` inside it restarts it (thesis 3.2.3).
 
         `max_retries` limits the restarts (the body then runs at most `max_retries + 1` times);
-        once it is reached, `retry()` does nothing and returns. Negative means unlimited. Each
+        once it is reached, `retry()` re-raises the exception being handled (so
+        `except SomeError: retry()` ends the failure_handling with that error), or raises
+        `RetriesExhausted` when none is. Negative means unlimited. Each
         run is a task "attempt N" under a "failure_handling" task (`task.info["attempts"]`;
         inside the body `current_attempt()`). Returns the body's result; other exceptions of
         the body propagate. Implemented as a loop: 10,000 retries do not grow the stack. An
@@ -381,20 +394,34 @@ def _innermost_handler() -> tuple[Task, _FailureHandler] | None:
     return None
 
 
-def retry() -> None:
-    """Restart the body of the innermost enclosing `failure_handling`.
+class RetriesExhausted(RuntimeError):
+    """`retry()` was called beyond `max_retries` with no exception being handled."""
 
-    Returns without doing anything once that failure_handling's `max_retries` is reached.
-    Raises `Evaporated` if the task is evaporating (an evaporating body is never restarted) and
+
+def retry() -> None:
+    """Restart the body of the innermost enclosing `failure_handling`; never returns.
+
+    Once that failure_handling's `max_retries` is used up, `retry()` never swallows the
+    failure: called while an exception is being handled (`except SomeError: retry()`), it
+    re-raises that exception, as a bare `raise` would, so the failure_handling ends with the
+    real error; called with no exception being handled, it raises `RetriesExhausted`. Raises
+    `Evaporated` if the task is evaporating (an evaporating body is never restarted) and
     `RuntimeError` outside any failure_handling.
     """
     check_evaporation()
     found = _innermost_handler()
     if found is None:
         raise RuntimeError("retry() was called outside any failure_handling body")
-    _, handler = found
+    task, handler = found
     if 0 <= handler.max_retries <= handler.retries:
-        return
+        handled = sys.exc_info()[1]
+        if handled is not None:
+            raise handled
+        raise RetriesExhausted(
+            f"retry() called after {handler.retries} of {handler.max_retries} retries in "
+            f"{task.parent.name if task.parent is not None else 'failure_handling'}, with no "
+            f"exception being handled (call it in an `except` clause to re-raise the failure)"
+        )
     handler.retries += 1
     raise RetryRequested(handler)
 

@@ -9,6 +9,7 @@ import pytest
 from pycram.block_forms import BlockSyntaxNotEnabled
 from pycram.fluent import Fluent, whenever
 from pycram.language import (
+    RetriesExhausted,
     State,
     current_attempt,
     failure_handling,
@@ -416,10 +417,51 @@ def test_thesis_failure_handling_with_limit_runs_body_limit_plus_one_times():
         except Exception:
             retry()
 
-    failure_handling(body, 5)
+    with pytest.raises(Boom, match="c"):  # retries used up: retry() re-raises the real error
+        failure_handling(body, 5)
     assert runs == [1, 2, 3, 4, 5, 6]
     task = last_expression_task()
     assert task.info["attempts"] == 6 and len(task.children) == 6
+    assert task.status.get_value() is TaskStatus.FAILED and isinstance(task.exception, Boom)
+
+
+def test_retry_beyond_the_limit_reraises_the_handled_exception_of_that_type():
+    class GraspFailed(Exception):
+        pass
+
+    def body():
+        try:
+            raise GraspFailed(f"attempt {current_attempt()}")
+        except GraspFailed:
+            retry()
+        return "swallowed"  # never reached: retry() does not return
+
+    with pytest.raises(GraspFailed, match="attempt 3"):
+        failure_handling(body, max_retries=2)
+
+
+def test_retry_beyond_the_limit_without_a_handled_exception_is_a_clear_error():
+    def body():
+        retry()
+
+    with pytest.raises(RetriesExhausted, match=r"after 1 of 1 retries in fh.*no exception being handled"):
+        failure_handling(body, max_retries=1, name="fh")
+    assert issubclass(RetriesExhausted, RuntimeError)
+
+
+def test_current_attempt_is_unchanged_by_exhausted_retries():
+    seen = []
+
+    def body():
+        seen.append(current_attempt())
+        try:
+            raise Boom("x")
+        except Boom:
+            retry()
+
+    with pytest.raises(Boom):
+        failure_handling(body, max_retries=0)
+    assert seen == [1]
 
 
 def test_attempt_count_is_observable_inside_and_after():

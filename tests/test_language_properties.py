@@ -155,8 +155,7 @@ class Plan:
                 if calls[0] <= ms:
                     raise Boom(f"flaky {calls[0]}")
             elif kind == "retry":
-                retry()
-                raise Boom("retry limit reached")
+                retry()  # beyond the limit: RetriesExhausted (no exception is being handled)
             if fails:
                 raise Boom(kind)
 
@@ -208,8 +207,7 @@ class Plan:
             try:
                 fn()
             except Exception:
-                retry()
-                raise
+                retry()  # beyond the limit: re-raises the exception being handled
 
         def run_fh() -> None:
             parent = current_task()

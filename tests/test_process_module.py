@@ -473,3 +473,27 @@ def test_public_surface():
     for module in (pm, robot_module, testing):
         for name in module.__all__:
             assert hasattr(module, name), (module.__name__, name)
+
+
+@pytest.mark.parametrize("exit_exception", [SystemExit(3), KeyboardInterrupt()])
+def test_execution_ended_by_systemexit_or_keyboardinterrupt_is_failed_not_cancelled(exit_exception):
+    module = ScriptedProcessModule('nav', script=[exit_exception])
+    route_all_to(module)
+    with pytest.raises(type(exit_exception)) as raised:
+        ProcessModule.perform(motion(1))
+    assert raised.value is exit_exception  # propagates unchanged, not wrapped
+    assert module.status.get_value() is S.FAILED
+    assert module.cancelled == []  # not a cancellation: the cancel hook did not run
+    # the module is free again
+    module.script.append('ok')
+    assert ProcessModule.perform(motion(2)) == 'ok'
+
+
+def test_nowait_execution_ended_by_keyboardinterrupt_reports_failed():
+    module = ScriptedProcessModule('nav', script=[KeyboardInterrupt()])
+    route_all_to(module)
+    handle = ProcessModule.perform_nowait(motion(1))
+    with pytest.raises(KeyboardInterrupt):
+        handle.wait(TIMEOUT)
+    assert handle.status.get_value() is S.FAILED
+    assert isinstance(handle.exception, KeyboardInterrupt)
