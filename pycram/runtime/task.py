@@ -279,7 +279,7 @@ def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task
     runner = current_runner()
     parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
     if parent._evaporating and not runner._protected:
-        raise Evaporated()
+        raise runner.evaporated()
     task = Task(name, kind, parent)
     task._start(runner)
     runner.task = task
@@ -335,7 +335,7 @@ class task_scope:
         runner = current_runner()
         parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
         if parent._evaporating and not runner._protected:
-            raise Evaporated()
+            raise runner.evaporated()
         self._runner = runner
         self._parent = parent
         self.task = Task(name, kind, parent)
@@ -426,7 +426,7 @@ class TaskGroup:
             status, error = TaskStatus.EVAPORATED, late
         while True:  # at most one asynchronous exception can still be pending
             try:
-                if trace is not None:
+                if trace is not None or runner.resurfacing:
                     sys.settrace(None)  # the worker thread is reused: do not trace the next branch
                 runner.seal()
                 break
