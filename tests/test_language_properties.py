@@ -316,7 +316,7 @@ def check_invocation(inv: Invocation, problems: list[str]) -> None:
             if (state is State.SUCCEEDED) != any(s is S for s in statuses):
                 problems.append(f"{where}: try_all {state} with branches {statuses}")
         elif inv.kind == "pursue":
-            ended = sorted((k for k in kids if _st(k) is not E), key=lambda k: k.end_time)
+            ended = sorted((k for k in kids if _st(k).done and _st(k) is not E), key=lambda k: k.end_time)
             if not ended:
                 problems.append(f"{where}: pursue with every branch evaporated: {statuses}")
             else:
@@ -479,7 +479,8 @@ def test_stress_random_nested_plans_with_many_seeds() -> None:
             try:
                 seed(first + run)(check_random_nested_plan)()
             except Exception as exc:  # noqa: BLE001 - collected and reported below
-                failures.append(f"seed {first + run}: {exc}")
+                details = [str(e) for e in getattr(exc, "exceptions", ())]  # hypothesis' groups
+                failures.append("\n".join([f"seed {first + run}: {exc}", *details]))
             else:
                 if _examples_run[0] < EXAMPLES:
                     failures.append(f"seed {first + run}: only {_examples_run[0]} random plans ran")

@@ -203,10 +203,14 @@ class Task:
 
     def _finish(self, status: TaskStatus, exception: BaseException | None) -> None:
         task: Task | None = self
+        due: Evaporated | None = None
         while task is not None:
             task.end_time = current_clock().now()
             task.exception = exception
-            task.status.set_value(status)
+            try:
+                task.status.set_value(status)
+            except Evaporated as held_back:  # this thread's evaporation, due now: after the end
+                due = held_back
             for listener in _listeners:
                 listener.task_ended(task)
             parent = task.parent
@@ -217,6 +221,8 @@ class Task:
                     if pending is not None and all(child.done for child in parent.children):
                         parent._pending_end = None
                         task, (status, exception) = parent, pending
+        if due is not None:
+            raise due
 
     def evaporate(self) -> None:
         """Stop this task and all its descendants; returns at once (idempotent).
@@ -455,8 +461,8 @@ class TaskGroup:
         try:
             wait_until(self._cv, self._all_ended)
         except Evaporated:
-            self.evaporate()
-            with shielded():
+            with shielded():  # evaporating the children must not be cut short by our own
+                self.evaporate()
                 wait_until(self._cv, self._all_ended)
             raise
 
