@@ -98,10 +98,12 @@ def remove_task_listener(listener: TaskListener) -> None:
 class Task:
     """A node of the task tree.
 
-    Attributes: `name`, `kind` (e.g. "seq", "par", "branch", "step", "attempt", "root"),
-    `parent`, `children`, `status` (a `Fluent` of `TaskStatus`), `start_time` / `end_time`
-    (active clock [s]), `exception` (the exception that failed it), `result`, `info` (free-form
-    details, e.g. the source line or the attempt count).
+    Attributes: `name` (what it does: `grab_item`, `perform moving`, `par`...), `kind` (e.g.
+    "seq", "par", "branch", "step", "attempt", "root"), `location` (where in the plan, e.g.
+    `kitchen_plan.py:203` for a block-syntax branch, else None), `parent`, `children`,
+    `status` (a `Fluent` of `TaskStatus`), `start_time` / `end_time` (active clock [s]),
+    `exception` (the exception that failed it), `result`, `info` (free-form details, e.g. the
+    attempt count).
     """
 
     __slots__ = (
@@ -276,17 +278,21 @@ def current_task() -> Task:
     return task
 
 
-def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", **kwargs: Any) -> Any:
+def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", location: str | None = None,
+                **kwargs: Any) -> Any:
     """Run `fn(*args, **kwargs)` as a child task of the current task, in the calling thread.
 
     Returns fn's result or re-raises its exception; the child ends SUCCEEDED, FAILED or
-    EVAPORATED accordingly. Raises `Evaporated` before starting if the caller is evaporating.
+    EVAPORATED accordingly (once its own children have ended, see `Task._end`). Raises
+    `Evaporated` before starting if the caller is evaporating. `location` (e.g. `plan.py:12`)
+    is stored as the task's `location`.
     """
     runner = current_runner()
     parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
     if parent._evaporating and not runner._protected:
         raise runner.evaporated()
     task = Task(name, kind, parent)
+    task.location = location
     task._start(runner)
     runner.task = task
     try:
