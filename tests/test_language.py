@@ -22,7 +22,15 @@ from pycram.language import (
     try_in_order,
     with_timeout,
 )
-from pycram.runtime import Evaporated, TaskStatus, check_evaporation, current_task, no_evaporation, sleep
+from pycram.runtime import (
+    Evaporated,
+    TaskStatus,
+    check_evaporation,
+    current_task,
+    no_evaporation,
+    run_subtask,
+    sleep,
+)
 
 WAIT = 5.0
 
@@ -735,3 +743,40 @@ def test_block_forms_without_block_syntax_refuse_and_explain(make):
 
 def test_evaporated_is_a_base_exception():
     assert issubclass(Evaporated, BaseException) and not issubclass(Evaporated, Exception)
+
+
+def test_a_task_whose_child_was_evaporated_alone_can_still_be_evaporated_later():
+    """Evaporation delivered to a child task (in the same thread) must not keep a later
+    evaporation of the parent from being delivered."""
+    tasks = {}
+    child_started, parent_waiting = Fluent(), Fluent()
+
+    def child():
+        tasks["child"] = current_task()
+        child_started.set_value(True)
+        Fluent().wait_for()
+
+    def parent():
+        tasks["parent"] = current_task()
+        try:
+            run_subtask("child", child)
+        except Evaporated:
+            pass  # the child alone was evaporated: the parent goes on
+        parent_waiting.set_value(True)
+        Fluent().wait_for()  # until the parent itself is evaporated
+
+    def stopper():
+        assert child_started.wait_for(timeout=WAIT)
+        tasks["child"].evaporate()
+        assert parent_waiting.wait_for(timeout=WAIT)
+        tasks["parent"].evaporate()
+
+    helper = threading.Thread(target=stopper, daemon=True)
+    helper.start()
+    errors = []
+    state = with_timeout(WAIT, parent, errors=errors)
+    helper.join(WAIT)
+    assert errors == []  # not timed out: the parent's evaporation reached it
+    assert tasks["child"].status.get_value() is TaskStatus.EVAPORATED
+    assert tasks["parent"].status.get_value() is TaskStatus.EVAPORATED
+    assert state.get_value() is State.FAILED  # its body was evaporated before the time-out

@@ -54,8 +54,9 @@ class Evaporated(BaseException):
     """Raised in a task that was evaporated (stopped from outside).
 
     Derives from `BaseException`: `except Exception` does not catch it. Catching it anyway does
-    not resurrect the task — every later PyCRAM call raises it again — so let it propagate and
-    put clean-up in `finally` blocks or context managers, which always run.
+    not resurrect the task — every later PyCRAM call raises it again, and a task that swallowed
+    it gets it re-delivered at its next line — so let it propagate and put clean-up in `finally`
+    blocks or context managers, which then run uninterrupted.
     """
 
 
@@ -63,7 +64,7 @@ class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
     __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_missed", "_protected", "_lock",
-                 "_sleep", "_delivered_to", "resurfacing")
+                 "_sleep", "_delivered_to", "_delivered_top", "resurfacing")
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
@@ -76,7 +77,8 @@ class Runner:
         self._protected = 0
         self._lock = threading.Lock()
         self._sleep: threading.Condition | None = None
-        self._delivered_to: object | None = None  # the task evaporation was last delivered to
+        self._delivered_to: object | None = None  # the task evaporation was last delivered to,
+        self._delivered_top: object | None = None  # and its outermost ancestor evaporating then
         self.resurfacing = 0  # how often a swallowed evaporation was re-delivered (see evaporated)
 
     # -- state of the current task -------------------------------------------------------------
@@ -87,14 +89,22 @@ class Runner:
         return task is not None and task._evaporating and not self._protected
 
     def _delivered_here(self) -> bool:
-        """True when evaporation was delivered to the current task or to one of its
-        descendants (whose `Evaporated` is then on its way up through this task)."""
+        """True when evaporation was delivered to the current task, or to a descendant of it
+        and this task was already evaporating then (its `Evaporated` is on its way up here)."""
         current, task = self.task, self._delivered_to
         while task is not None:
             if task is current:
                 return True
+            if task is self._delivered_top:
+                return False
             task = task.parent  # type: ignore[attr-defined]
         return False
+
+    def _mark_delivered(self) -> None:
+        task = top = self.task
+        while top.parent is not None and top.parent._evaporating:  # type: ignore[union-attr]
+            top = top.parent  # type: ignore[union-attr]
+        self._delivered_to, self._delivered_top = task, top
 
     def evaporated(self) -> Evaporated:
         """The `Evaporated` a PyCRAM call raises on finding its task evaporating.
@@ -108,7 +118,7 @@ class Runner:
         if self._delivered_here() and not isinstance(sys.exc_info()[1], Evaporated):
             self.resurfacing += 1
             _resurface_in_plan_frames(sys._getframe(1))
-        self._delivered_to = self.task
+        self._mark_delivered()
         return Evaporated()
 
     # -- entering and leaving the runtime -----------------------------------------------------
@@ -175,7 +185,7 @@ class Runner:
             return  # not due, or on its way up already: never interrupt its clean-up
         injected = False
         with self._lock:
-            self._delivered_to = self.task
+            self._mark_delivered()
             condition = self._waiting_on
             if condition is None and self._mode == _USER and not self._injected and self.ident is not None:
                 self._injected = injected = True
@@ -465,7 +475,7 @@ def _raise_if_swallowing(frame: Any, event: str, arg: object) -> object:
         return None
     if runner.evaporation_due() and runner._mode == _USER:
         if sys.exc_info()[1] is None or _handler_swallows(frame.f_code, frame.f_lasti):
-            runner._delivered_to = task
+            runner._mark_delivered()
             raise Evaporated()
     return _raise_if_swallowing
 
