@@ -144,7 +144,7 @@ class _BlockUse(BlockForm):
 
 
 def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
-    with task_scope(name, "seq") as scope:
+    with task_scope(name, "seq", plan_code=False) as scope:
         for index, fn in enumerate(fns):
             try:
                 name, location = _label(fn, index)
@@ -158,7 +158,7 @@ def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> N
 
 
 def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
-    with task_scope(name, "try_in_order") as scope:
+    with task_scope(name, "try_in_order", plan_code=False) as scope:
         for index, fn in enumerate(fns):
             try:
                 name, location = _label(fn, index)
@@ -261,7 +261,7 @@ class _Concurrent:
 def _concurrent_runner(kind: str) -> Callable[[Sequence[Branch], list, Fluent, str], None]:
     def run(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
         engine = _Concurrent(kind, errors, state)
-        with task_scope(name, kind) as scope:
+        with task_scope(name, kind, plan_code=False) as scope:
             if not fns:
                 engine._decide(State.SUCCEEDED if kind in ("par", "pursue") else State.FAILED)
             else:
@@ -315,7 +315,7 @@ def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: s
     label = name or f"with_timeout({seconds:g} s)"
     state = Fluent(name=label)
     engine = _Concurrent("pursue", errors, state)
-    with task_scope(label, "with_timeout") as scope:
+    with task_scope(label, "with_timeout", plan_code=False) as scope:
         if not engine.run([fn], label, deadline=seconds):
             error = TimeoutError(f"{label}: {getattr(fn, '__name__', 'body')} did not end within {seconds:g} s")
             errors.append(error)
@@ -351,7 +351,7 @@ def _run_failure_handling(body: Branch, max_retries: int, name: str | None) -> A
         current_task().info["retry_handler"] = handler
         return body()
 
-    with task_scope(name or "failure_handling", "failure_handling") as scope:
+    with task_scope(name or "failure_handling", "failure_handling", plan_code=False) as scope:
         number = 0
         while True:
             number += 1

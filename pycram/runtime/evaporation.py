@@ -64,7 +64,7 @@ class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
     __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_missed", "_protected", "_lock",
-                 "_sleep", "_delivered_to", "_delivered_top", "resurfacing")
+                 "_sleep", "_delivered_to", "_delivered_top", "resurfacing", "in_plan")
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
@@ -80,6 +80,9 @@ class Runner:
         self._delivered_to: object | None = None  # the task evaporation was last delivered to,
         self._delivered_top: object | None = None  # and its outermost ancestor evaporating then
         self.resurfacing = 0  # how often a swallowed evaporation was re-delivered (see evaporated)
+        # True while the thread runs plan code (the only place an asynchronous Evaporated may
+        # land); the task runtime sets it False around its own bookkeeping (see take_back_pending)
+        self.in_plan = True
 
     # -- state of the current task -------------------------------------------------------------
 
@@ -158,6 +161,15 @@ class Runner:
                 took_back, self._missed = took_back or self._missed, False
         return took_back and self.evaporation_due()
 
+    def take_back_pending(self) -> None:
+        """Cancel an asynchronous `Evaporated` still pending for the calling thread (the runtime
+        calls it after setting `in_plan` False, when `_injected` says one may be pending). The
+        pending exception may land at this call instead: callers treat it as the plan code's."""
+        with self._lock:
+            if self._injected:
+                self._injected = False
+                _take_back_async_exception(self.ident)
+
     def _wait_on(self, condition: threading.Condition) -> None:
         """Register the condition a wait blocks on, so that `interrupt` can notify it."""
         with self._lock:
@@ -184,12 +196,17 @@ class Runner:
         if not self.evaporation_due() or self._delivered_here():
             return  # not due, or on its way up already: never interrupt its clean-up
         injected = False
+        inject = _api()[0]
         with self._lock:
             self._mark_delivered()
             condition = self._waiting_on
-            if condition is None and self._mode == _USER and not self._injected and self.ident is not None:
+            # Only into plan code: the runtime's own bookkeeping (in_plan False) checks for a due
+            # evaporation when it hands back to plan code. No eval-breaker check lies between
+            # reading in_plan and the C call, so the thread cannot leave plan code in between.
+            if condition is None and self._mode == _USER and self.in_plan and not self._injected \
+                    and self.ident is not None:
                 self._injected = injected = True
-                _inject_async_exception(self.ident)
+                inject(self.ident, Evaporated)
             elif condition is None and self._mode == _RUNTIME:
                 self._missed = True  # raised by the runtime code when it leaves (leave_runtime)
         if condition is not None:

@@ -288,27 +288,58 @@ def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task
     is stored as the task's `location`.
     """
     runner = current_runner()
+    in_plan, runner.in_plan = runner.in_plan, False  # no asynchronous Evaporated in here
     parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
     if parent._evaporating and not runner._protected:
+        runner.in_plan = in_plan
         raise runner.evaporated()
     task = Task(name, kind, parent)
     task.location = location
     task._start(runner)
     runner.task = task
     try:
+        runner.in_plan = True
         result = fn(*args, **kwargs)
+        runner.in_plan = False
+        if runner._injected:
+            runner.take_back_pending()  # one pending for fn lands here at the latest: as fn's
     except Evaporated as exc:
+        _leave_plan_code(runner)
         runner.task = parent
         task._end(TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED, exc)
+        runner.in_plan = in_plan
         raise
     except BaseException as exc:
+        _leave_plan_code(runner)
         runner.task = parent
         task._end(TaskStatus.FAILED, exc)
+        runner.in_plan = in_plan
         raise
     runner.task = parent
     task.result = result
     task._end(TaskStatus.SUCCEEDED)
+    _back_to_plan_code(runner, in_plan)
     return result
+
+
+def _leave_plan_code(runner: Runner) -> None:
+    """In the runtime's handler of an exception from plan code: no asynchronous `Evaporated`
+    may land from here on (one still pending is taken back; if it lands instead, it is dropped:
+    an exception of the plan code is being handled already)."""
+    runner.in_plan = False
+    if runner._injected:
+        try:
+            runner.take_back_pending()
+        except Evaporated:
+            pass
+
+
+def _back_to_plan_code(runner: Runner, in_plan: bool) -> None:
+    """Hand back to the caller; raise `Evaporated` here if an evaporation became due while the
+    runtime's bookkeeping held it back (as if it had landed right after the call)."""
+    runner.in_plan = in_plan
+    if in_plan and runner.evaporation_due():
+        raise Evaporated()
 
 
 def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, kind: str = "plan") -> Any:
@@ -338,16 +369,20 @@ class task_scope:
     Usage: `with task_scope("par", "par") as scope: ...; scope.fail(error)`. The task ends
     EVAPORATED if `Evaporated` leaves the block while it is evaporating, FAILED if another
     exception leaves it or `scope.fail()` was called, SUCCEEDED otherwise. Raises `Evaporated`
-    on entry if the caller is evaporating.
+    on entry if the caller is evaporating. `plan_code=False` (the language's expressions) says
+    the block is runtime bookkeeping: no asynchronous `Evaporated` lands in it; it is raised
+    after the block instead if it became due meanwhile.
     """
 
-    __slots__ = ("task", "error", "_parent", "_runner")
+    __slots__ = ("task", "error", "_parent", "_runner", "_in_plan", "_plan_code")
 
-    def __init__(self, name: str, kind: str = "task") -> None:
+    def __init__(self, name: str, kind: str = "task", *, plan_code: bool = True) -> None:
         runner = current_runner()
         parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
         if parent._evaporating and not runner._protected:
             raise runner.evaporated()
+        self._in_plan, runner.in_plan = runner.in_plan, False  # none in the bookkeeping
+        self._plan_code = plan_code
         self._runner = runner
         self._parent = parent
         self.task = Task(name, kind, parent)
@@ -360,10 +395,13 @@ class task_scope:
     def __enter__(self) -> task_scope:
         self.task._start(self._runner)
         self._runner.task = self.task
+        self._runner.in_plan = self._plan_code
         return self
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
         task = self.task
+        if self._plan_code:
+            _leave_plan_code(self._runner)
         self._runner.task = self._parent
         if exc is None:
             if self.error is None:
@@ -374,6 +412,10 @@ class task_scope:
             task._end(TaskStatus.EVAPORATED, exc)
         else:
             task._end(TaskStatus.FAILED, exc)
+        if exc is None:
+            _back_to_plan_code(self._runner, self._in_plan)
+        else:
+            self._runner.in_plan = self._in_plan
         return False
 
 
@@ -410,6 +452,7 @@ class TaskGroup:
         """Start `fn` as a child task on a worker thread of its own; returns the task."""
         task = Task(name, kind, self.parent)
         runner = Runner(task)
+        runner.in_plan = False  # until the branch's own code runs
         task._runner = runner
         with self._cv:
             self._running += 1
@@ -428,7 +471,9 @@ class TaskGroup:
                 task._start(runner)
                 if task._evaporating:  # evaporated before this thread got to run it
                     raise Evaporated()
+                runner.in_plan = True
                 result = fn()
+                runner.in_plan = False
                 status = TaskStatus.SUCCEEDED
             except Evaporated as exc:
                 status, error = (TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED), exc
@@ -436,6 +481,7 @@ class TaskGroup:
                 status, error = TaskStatus.FAILED, exc
         except BaseException as late:  # an asynchronous exception landing in the handlers above
             status, error = TaskStatus.EVAPORATED, late
+        runner.in_plan = False
         while True:  # at most one asynchronous exception can still be pending
             try:
                 if trace is not None or runner.resurfacing:
