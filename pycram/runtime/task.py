@@ -304,13 +304,19 @@ def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task
         if runner._injected:
             runner.take_back_pending()  # one pending for fn lands here at the latest: as fn's
     except Evaporated as exc:
-        _leave_plan_code(runner)
+        try:
+            _leave_plan_code(runner)
+        except Evaporated:
+            pass  # the one pending landed at the call: taken back in effect
         runner.task = parent
         task._end(TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED, exc)
         runner.in_plan = in_plan
         raise
     except BaseException as exc:
-        _leave_plan_code(runner)
+        try:
+            _leave_plan_code(runner)
+        except Evaporated:
+            pass  # the one pending landed at the call: taken back in effect
         runner.task = parent
         task._end(TaskStatus.FAILED, exc)
         runner.in_plan = in_plan
@@ -325,7 +331,8 @@ def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task
 def _leave_plan_code(runner: Runner) -> None:
     """In the runtime's handler of an exception from plan code: no asynchronous `Evaporated`
     may land from here on (one still pending is taken back; if it lands instead, it is dropped:
-    an exception of the plan code is being handled already)."""
+    an exception of the plan code is being handled already). Call it inside `try/except
+    Evaporated`: a pending one may land at this very call."""
     runner.in_plan = False
     if runner._injected:
         try:
@@ -401,7 +408,10 @@ class task_scope:
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
         task = self.task
         if self._plan_code:
-            _leave_plan_code(self._runner)
+            try:
+                _leave_plan_code(self._runner)
+            except Evaporated:
+                pass
         self._runner.task = self._parent
         if exc is None:
             if self.error is None:
