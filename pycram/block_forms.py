@@ -9,7 +9,7 @@ the syntax on.
 
 from __future__ import annotations
 
-__all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE"]
+__all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE", "BRANCHES"]
 
 #: The error text when block syntax is used without being switched on; ``{form}`` is the block's form.
 NOT_ENABLED_MESSAGE = (
@@ -40,3 +40,10 @@ class BlockForm:
 
     def __exit__(self, *exc_info: object) -> bool:
         return False
+
+
+BRANCHES: dict[tuple[str, str], tuple[str | None, str]] = {}
+"""What the block syntax knows about each branch it generated, for naming its task: keyed by
+(file name, code name of the branch function, e.g. `par@plan.py:12#1`), the value is (what the
+branch does — the callee of a branch that is a single call, e.g. `grab_item` or `perform
+moving`, else None — and where it is, e.g. `plan.py:13`). Filled when plans are compiled."""

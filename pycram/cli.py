@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -371,6 +372,9 @@ def demo_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
     animation: bool = typer.Option(True, "--animation/--no-animation",
                                    help="Record the animation run.gif (--no-animation: a faster run)."),
+    backend: str = typer.Option("sim", "--backend",
+                                help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
+                                     "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set)."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     if output is not None:
@@ -383,7 +387,7 @@ def demo_command(
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
                          realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet, animation=animation)
+                         quiet=quiet, animation=animation, backend=backend)
     raise typer.Exit(int(code or 0))
 
 
@@ -402,8 +406,11 @@ def scene_command(
     costmap: str = typer.Option("", "--costmap",
                                 help="Draw a location designator's costmap layers and chosen poses instead, "
                                      "e.g. \"to_reach cup\" or \"on table, for bowl\"."),
+    belief: bool = typer.Option(False, "--belief",
+                                help="Let the robot look around and draw its belief beside the ground truth."),
 ) -> None:
-    """A labelled picture of a scene: plan and overview with surfaces, containers and objects.
+    """A labelled picture of a scene: plan and overview with surfaces, containers and objects
+    (with --belief: what the robot perceived from where it stands beside what is).
 
     With --costmap: the costmap layers of a location designator over the floor plan and the
     poses it chose (or why there are none)."""
@@ -423,7 +430,10 @@ def scene_command(
         _costmap_picture(world, robot, costmap, output, f"{env} · seed {seed} · {robot} · {costmap}")
         return
     try:
-        path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
+        if belief:
+            path = _belief_picture(world, robot, output, title=f"{env} · seed {seed} · {robot}: belief")
+        else:
+            path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
         for p in world.placements:
             where = p.support + (f" (in {p.container})" if p.container else "")
             console.print(f"  {escape(p.name):<10} {escape(where)}")
@@ -469,7 +479,56 @@ def costmap_command(
     output: Path = typer.Option(Path("costmap.png"), "--output", "-o", help="PNG file to write."),
 ) -> None:
     """The costmap layers of a location designator over the floor plan, and the poses it chose."""
-    scene_command(env=env, seed=seed, objects=objects, robot=robot, output=output, costmap=location)
+    scene_command(env=env, seed=seed, objects=objects, robot=robot, output=output, costmap=location, belief=False)
+
+@app.command("sim-ros-bridge")
+def sim_ros_bridge_command(
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
+                                help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."),
+    realtime: bool = typer.Option(False, "--realtime", help="Simulate at real-time speed (default: as fast as "
+                                  "possible; /clock carries the simulation time)."),
+    publish_rate: float = typer.Option(50.0, "--publish-rate", min=1.0, help="Sensor topics per second [Hz, wall]."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address the node binds to and advertises (ROS_IP). "
+                             "Loopback by default: nothing outside this machine can command the robot."),
+    allow_remote_master: bool = typer.Option(False, "--allow-remote-master",
+                                             help="Accept a ROS_MASTER_URI that is not on loopback."),
+) -> None:
+    """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
+    /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
+    if robot not in ("pr2", "tiago"):
+        _fail(f"--robot must be 'pr2' or 'tiago', not {robot!r}", code=2)
+    try:
+        from pycram.ros.launch import check_master_uri
+    except ImportError as e:
+        _fail(f"sim-ros-bridge needs ROS 1 (run scripts/install_ros.sh): {e}")
+    try:
+        check_master_uri(os.environ.get("ROS_MASTER_URI"), allow_remote=allow_remote_master)
+    except ValueError as e:
+        _fail(str(e), code=2)
+    os.environ["ROS_IP"] = os.environ["ROS_HOSTNAME"] = host
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from pycram.ros.bridge import run_bridge
+
+    run_bridge(robot, item_at=item_at, realtime=realtime, publish_rate=publish_rate,
+               ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True))
+
+
+def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Path:
+    """The robot looks around from where it stands; its belief is drawn beside the truth."""
+    from pycram import robots
+    from pycram.actions import look_around
+    from pycram.demos.belief_picture import write_belief_picture
+
+    robot = robots.load(robot_name, world)
+    try:
+        with robot:
+            look_around()
+    finally:
+        robot.shutdown()
+    for obj in robot.belief.objects():
+        console.print(f"  believed: {escape(repr(obj))}")
+    return write_belief_picture(world, robot.belief, output, title=title)
 
 
 def main(argv: list[str] | None = None) -> int:

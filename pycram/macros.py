@@ -92,6 +92,8 @@ __all__ = [
     "opts_in",
 ]
 
+from pycram.block_forms import BRANCHES
+
 log = logging.getLogger(__name__)
 
 try:  # the lead's placeholder objects format this message; keep one text
@@ -415,6 +417,31 @@ class _Form:
     target: ast.expr | None
 
 
+def _what_it_does(stmt: ast.stmt) -> str | None:
+    """A task name for a branch whose body is the single call `stmt` (also `x = call(...)`,
+    `return call(...)`): the callee's name, followed by the designator type if the call names
+    one (`motion(type="moving", ...)` → `motion moving`, `ProcessModule.perform(
+    MotionDesignator([('type', 'moving'), ...]))` → `perform moving`). None for anything else."""
+    value = getattr(stmt, "value", None) if isinstance(stmt, (ast.Expr, ast.Assign, ast.Return)) else None
+    if not isinstance(value, ast.Call):
+        return None
+    func = value.func
+    callee = func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else None
+    if callee is None:
+        return None
+    for node in ast.walk(value):
+        if isinstance(node, ast.keyword) and node.arg == "type":
+            kind = node.value
+        elif isinstance(node, (ast.Tuple, ast.List)) and len(node.elts) == 2 and \
+                isinstance(node.elts[0], ast.Constant) and node.elts[0].value == "type":
+            kind = node.elts[1]
+        else:
+            continue
+        if isinstance(kind, ast.Constant) and isinstance(kind.value, str):
+            return f"{callee} {kind.value}"
+    return callee
+
+
 class _Transformer:
     """Rewrites recognised `with` blocks of one module / function tree (in place)."""
 
@@ -682,6 +709,7 @@ class _Transformer:
         self._located(out, node)
         branch_names: list[str] = []
         for index, stmt in enumerate(node.body, 1):
+            BRANCHES[(self.filename, f"{label}#{index}")] = (_what_it_does(stmt), f"{self.basename}:{stmt.lineno}")
             body = self.stmt(stmt, scope)
             gen = self._fresh(form.name, line)
             out.append(self._branch_def(gen, f"{label}#{index}", body, scope, node))

@@ -26,7 +26,9 @@ Guarantees
   propagates to the caller.
 - **Failures.** An exception raised by ``_execute`` reaches the caller as
   :class:`ProcessModuleFailure` (``cause`` / ``__cause__`` is the original exception); the module
-  is freed and its status becomes ``FAILED``.
+  is freed and its status becomes ``FAILED``. ``SystemExit`` and ``KeyboardInterrupt`` raised
+  inside ``_execute`` also end it ``FAILED`` (not ``CANCELLED``: only evaporation cancels) and
+  propagate unchanged.
 - **Status.** ``module.status`` is a :class:`~pycram.fluent.Fluent` of
   :class:`ProcessModuleStatus`: ``WAITING`` (idle, ready) → ``RUNNING`` → ``SUCCEEDED`` /
   ``FAILED`` / ``CANCELLED`` (outcome of the last designator; the module is idle again) →
@@ -60,7 +62,7 @@ from pycram.designators.motion_types import (active_motion_types, check_motion,
                                              describe_known_types)
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
-from pycram.runtime import current_clock, no_evaporation, wait_until
+from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
 
 __all__ = [
     "ProcessModule",
@@ -452,6 +454,10 @@ class ProcessModule:
                         designator=designator, module=self, cause=e)
                     failure.__cause__ = e
                     error, outcome = failure, ProcessModuleStatus.FAILED
+                except BaseException as e:  # SystemExit, KeyboardInterrupt: failed, not cancelled
+                    if not isinstance(e, Evaporated):
+                        error, outcome = e, ProcessModuleStatus.FAILED  # e propagates unchanged
+                    raise
         finally:
             self._settle(execution, started, outcome, error, result)
         if error is not None:

@@ -594,6 +594,47 @@ def test_plan_tracebacks_and_task_names_point_at_the_user_lines() -> None:
     assert task.name == f"par@test_block_syntax.py:{par_line}" and task.children[1].name.endswith("#2")
 
 
+def test_a_branch_that_is_a_single_call_is_named_after_the_callee() -> None:
+    def grab_item():
+        return "grabbed"
+
+    class ProcessModule:  # stands in for pycram's: only the call's shape matters for the name
+        @staticmethod
+        def perform(designator):
+            return designator
+
+    def motion(**properties):
+        return properties
+
+    @plan
+    def fetch() -> None:
+        with par:  # marker: names par
+            grab_item()  # marker: names grab
+            ProcessModule.perform([('type', 'moving'), ('pose', (1, 2, 0))])
+            pose = motion(type="looking", target="cup")
+            if True:  # marker: names block
+                x = 1
+                grab_item()
+        with seq:
+            grab_item()  # marker: names step
+
+    fetch()
+    seq_task = current_task().children[-1]
+    par_task = current_task().children[-2]
+    here = "test_block_syntax.py"
+    branches = [(b.name, b.location) for b in par_task.children]
+    assert branches == [
+        ("grab_item", f"{here}:{_line_of('# marker: names grab')}"),
+        ("perform moving", f"{here}:{_line_of('# marker: names grab') + 1}"),
+        ("motion looking", f"{here}:{_line_of('# marker: names grab') + 2}"),
+        (f"par@{here}:{_line_of('# marker: names par')}#4", f"{here}:{_line_of('# marker: names block')}"),
+    ]
+    assert [(t.name, t.kind, t.location) for t in seq_task.children] == [
+        ("grab_item", "step", f"{here}:{_line_of('# marker: names step')}")
+    ]
+    assert par_task.name == f"par@{here}:{_line_of('# marker: names par')}"  # the expression keeps its place
+
+
 def _line_of(marker: str) -> int:
     """The line of this file that holds `marker` (once, besides this lookup's own argument)."""
     lines = [i for i, text in enumerate(Path(__file__).read_text().splitlines(), 1) if marker in text and "_line_of(" not in text]

@@ -36,7 +36,8 @@ EXPECTED_LISTINGS: dict[str, Any] = {
     "par_state_loop_truthy": ("FAILED", ["s1"]),
     "pursue": ("SUCCEEDED", 0),
     "failure_handling_5": 3,
-    "failure_handling_5_exhausted": 6,  # max_retries=5: the first run and 5 retries
+    # max_retries=5: the first run and 5 retries, then retry() re-raises the handled Boom("c")
+    "failure_handling_5_exhausted": (6, "c"),
     "failure_handling_unlimited": 20,
 }
 TARGETS = [[1, 0], [2, 0], [3, 0]]

@@ -161,10 +161,11 @@ def test_demo_passes_options_through(monkeypatch, db):
     monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
     result = _invoke("demo", "--robot", "tiago", "--output", "out", "--item-at", "2", "--steal", "1",
                      "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet",
-                     "--no-animation")
+                     "--no-animation", "--backend", "ros")
     assert result.exit_code == 0, result.output
     assert calls == dict(robot="tiago", output="out", item_at=2, steal=1, seed=7, realtime=True,
-                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True, animation=False)
+                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True, animation=False,
+                         backend="ros")
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")
     assert calls["record"] is False and calls["robot"] == "pr2"

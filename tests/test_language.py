@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import threading
+import time
 
 import pytest
 
 from pycram.block_forms import BlockSyntaxNotEnabled
 from pycram.fluent import Fluent, whenever
 from pycram.language import (
+    RetriesExhausted,
     State,
     current_attempt,
     failure_handling,
@@ -20,7 +22,15 @@ from pycram.language import (
     try_in_order,
     with_timeout,
 )
-from pycram.runtime import Evaporated, TaskStatus, check_evaporation, current_task, no_evaporation, sleep
+from pycram.runtime import (
+    Evaporated,
+    TaskStatus,
+    check_evaporation,
+    current_task,
+    no_evaporation,
+    run_subtask,
+    sleep,
+)
 
 WAIT = 5.0
 
@@ -273,20 +283,164 @@ def test_evaporation_is_sticky_for_every_later_pycram_call():
         "retry": retry,
     }
 
-    def stubborn():
+    def stubborn(name, call):
         started.set_value(True)
         try:
             Fluent().wait_for()
         except BaseException:
             pass  # a bare except ...
-        for name, call in calls.items():
-            try:
-                call()
-            except Evaporated:
-                raised.append(name)  # ... cannot save the task: every pycram call raises again
+        try:
+            call()
+        except Evaporated:
+            raised.append(name)  # ... cannot save the task: every pycram call raises again
+            raise
 
-    pursue(stubborn, lambda: started.wait_for(timeout=WAIT))
+    for name, call in calls.items():
+        started.set_value(None)
+        pursue(lambda: stubborn(name, call), lambda: started.wait_for(timeout=WAIT))
+        assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
     assert raised == list(calls)
+
+
+def test_a_bare_except_loop_loser_ends_right_after_the_winner():
+    """`while True: try: sleep() except: pass` swallows every Evaporated a PyCRAM call raises;
+    the runtime re-delivers it where the loop would swallow it again, so the loop ends after at
+    most two more passes (structural), well within 100 ms (a generous bound against a hang)."""
+    won = Fluent()
+    passes_after_win = []
+
+    def stubborn():
+        while True:
+            try:
+                sleep(0.01)
+            except:  # noqa: E722 - the point of the test
+                pass
+            if won.get_value():
+                passes_after_win.append(1)
+
+    def winner():
+        sleep(0.03)
+        won.set_value(time.monotonic())
+
+    state = pursue(stubborn, winner)
+    returned = time.monotonic()
+    assert state.get_value() is State.SUCCEEDED
+    loser = last_expression_task().children[0]
+    assert loser.status.get_value() is TaskStatus.EVAPORATED
+    assert len(passes_after_win) <= 2, f"{len(passes_after_win)} passes of the loop after the winner ended"
+    assert loser._runner.resurfacing >= 1  # it swallowed, and was re-delivered
+    assert returned - won.get_value() < 1.0  # a hang guard, not a speed test
+
+
+def test_a_bare_except_loop_in_a_seq_step_inside_a_loser_ends_too():
+    def stubborn_step():
+        while True:
+            try:
+                Fluent().wait_for(timeout=0.01)
+                check_evaporation()
+            except BaseException:
+                pass
+
+    state = pursue(lambda: seq(stubborn_step), lambda: sleep(0.02))
+    assert state.get_value() is State.SUCCEEDED
+    assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
+
+
+class _Clean:
+    """A context manager whose exit records whether it ran to its end."""
+
+    def __init__(self, log, in_cleanup, go):
+        self.log, self.in_cleanup, self.go = log, in_cleanup, go
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.log.append("exit started")
+        self.in_cleanup.set()
+        self.go.wait(WAIT)
+        self.log.append("exit finished")
+        return False
+
+
+@pytest.mark.parametrize("cleanup", ["finally", "context manager", "except-and-raise"])
+def test_a_task_letting_evaporated_propagate_is_never_interrupted_in_its_cleanup(cleanup):
+    """Deterministic: while the evaporated loser sits in its clean-up, it is evaporated again
+    three times (as enclosing expressions do); nothing may land in the clean-up."""
+    log = []
+    in_cleanup, go = threading.Event(), threading.Event()
+    started = Fluent()
+
+    def clean_up_slowly():
+        log.append("cleanup started")
+        in_cleanup.set()
+        go.wait(WAIT)  # C-level blocking: a pending asynchronous exception would land right after
+        log.append("cleanup finished")
+
+    def loser():
+        started.set_value(True)
+        if cleanup == "finally":
+            try:
+                Fluent().wait_for()
+            finally:
+                clean_up_slowly()
+        elif cleanup == "context manager":
+            with _Clean(log, in_cleanup, go):
+                Fluent().wait_for()
+        else:
+            try:
+                Fluent().wait_for()
+            except Evaporated:
+                clean_up_slowly()
+                raise
+
+    tasks = []
+
+    def evaporate_again():
+        assert in_cleanup.wait(WAIT)
+        for _ in range(3):
+            tasks[0].evaporate()
+        go.set()
+
+    def loser_task():
+        tasks.append(current_task())
+        loser()
+
+    helper = threading.Thread(target=evaporate_again, daemon=True)
+    helper.start()
+    state = pursue(loser_task, lambda: started.wait_for(timeout=WAIT))
+    helper.join(WAIT)
+    assert state.get_value() is State.SUCCEEDED
+    assert log[-1] in ("cleanup finished", "exit finished"), log
+    assert tasks[0].status.get_value() is TaskStatus.EVAPORATED
+    assert tasks[0]._runner.resurfacing == 0  # it never swallowed
+
+
+def test_no_evaporation_still_protects_a_task_that_swallows_evaporated():
+    """A bare-except loop whose passes run a protected section: every section that began runs
+    to its end; the loop still ends (Evaporated is raised at the end of a section, swallowed,
+    then re-delivered)."""
+    started = Fluent()
+    steps = []
+
+    def stubborn():
+        while True:
+            try:
+                with no_evaporation():
+                    steps.append("begin")
+                    started.set_value(True)
+                    sleep(0.005)  # not interrupted inside the block
+                    check_evaporation()  # does not raise inside the block
+                    steps.append("end")
+                sleep(0.005)
+            except:  # noqa: E722 - the point of the test
+                pass
+
+    state = pursue(stubborn, lambda: started.wait_for(timeout=WAIT) and sleep(0.02))
+    assert state.get_value() is State.SUCCEEDED
+    assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
+    assert steps and steps.count("begin") == steps.count("end"), steps
+    assert steps[-1] == "end"
 
 
 class Resource:
@@ -416,10 +570,51 @@ def test_thesis_failure_handling_with_limit_runs_body_limit_plus_one_times():
         except Exception:
             retry()
 
-    failure_handling(body, 5)
+    with pytest.raises(Boom, match="c"):  # retries used up: retry() re-raises the real error
+        failure_handling(body, 5)
     assert runs == [1, 2, 3, 4, 5, 6]
     task = last_expression_task()
     assert task.info["attempts"] == 6 and len(task.children) == 6
+    assert task.status.get_value() is TaskStatus.FAILED and isinstance(task.exception, Boom)
+
+
+def test_retry_beyond_the_limit_reraises_the_handled_exception_of_that_type():
+    class GraspFailed(Exception):
+        pass
+
+    def body():
+        try:
+            raise GraspFailed(f"attempt {current_attempt()}")
+        except GraspFailed:
+            retry()
+        return "swallowed"  # never reached: retry() does not return
+
+    with pytest.raises(GraspFailed, match="attempt 3"):
+        failure_handling(body, max_retries=2)
+
+
+def test_retry_beyond_the_limit_without_a_handled_exception_is_a_clear_error():
+    def body():
+        retry()
+
+    with pytest.raises(RetriesExhausted, match=r"after 1 of 1 retries in fh.*no exception being handled"):
+        failure_handling(body, max_retries=1, name="fh")
+    assert issubclass(RetriesExhausted, RuntimeError)
+
+
+def test_current_attempt_is_unchanged_by_exhausted_retries():
+    seen = []
+
+    def body():
+        seen.append(current_attempt())
+        try:
+            raise Boom("x")
+        except Boom:
+            retry()
+
+    with pytest.raises(Boom):
+        failure_handling(body, max_retries=0)
+    assert seen == [1]
 
 
 def test_attempt_count_is_observable_inside_and_after():
@@ -548,3 +743,40 @@ def test_block_forms_without_block_syntax_refuse_and_explain(make):
 
 def test_evaporated_is_a_base_exception():
     assert issubclass(Evaporated, BaseException) and not issubclass(Evaporated, Exception)
+
+
+def test_a_task_whose_child_was_evaporated_alone_can_still_be_evaporated_later():
+    """Evaporation delivered to a child task (in the same thread) must not keep a later
+    evaporation of the parent from being delivered."""
+    tasks = {}
+    child_started, parent_waiting = Fluent(), Fluent()
+
+    def child():
+        tasks["child"] = current_task()
+        child_started.set_value(True)
+        Fluent().wait_for()
+
+    def parent():
+        tasks["parent"] = current_task()
+        try:
+            run_subtask("child", child)
+        except Evaporated:
+            pass  # the child alone was evaporated: the parent goes on
+        parent_waiting.set_value(True)
+        Fluent().wait_for()  # until the parent itself is evaporated
+
+    def stopper():
+        assert child_started.wait_for(timeout=WAIT)
+        tasks["child"].evaporate()
+        assert parent_waiting.wait_for(timeout=WAIT)
+        tasks["parent"].evaporate()
+
+    helper = threading.Thread(target=stopper, daemon=True)
+    helper.start()
+    errors = []
+    state = with_timeout(WAIT, parent, errors=errors)
+    helper.join(WAIT)
+    assert errors == []  # not timed out: the parent's evaporation reached it
+    assert tasks["child"].status.get_value() is TaskStatus.EVAPORATED
+    assert tasks["parent"].status.get_value() is TaskStatus.EVAPORATED
+    assert state.get_value() is State.FAILED  # its body was evaporated before the time-out

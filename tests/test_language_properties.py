@@ -14,13 +14,15 @@ hanging the suite (pytest-timeout is the second line of defence).
 
 from __future__ import annotations
 
+import os
+import random
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, given, seed, settings
 from hypothesis import strategies as st
 
 import pycram
@@ -153,8 +155,7 @@ class Plan:
                 if calls[0] <= ms:
                     raise Boom(f"flaky {calls[0]}")
             elif kind == "retry":
-                retry()
-                raise Boom("retry limit reached")
+                retry()  # beyond the limit: RetriesExhausted (no exception is being handled)
             if fails:
                 raise Boom(kind)
 
@@ -206,8 +207,7 @@ class Plan:
             try:
                 fn()
             except Exception:
-                retry()
-                raise
+                retry()  # beyond the limit: re-raises the exception being handled
 
         def run_fh() -> None:
             parent = current_task()
@@ -316,7 +316,7 @@ def check_invocation(inv: Invocation, problems: list[str]) -> None:
             if (state is State.SUCCEEDED) != any(s is S for s in statuses):
                 problems.append(f"{where}: try_all {state} with branches {statuses}")
         elif inv.kind == "pursue":
-            ended = sorted((k for k in kids if _st(k) is not E), key=lambda k: k.end_time)
+            ended = sorted((k for k in kids if _st(k).done and _st(k) is not E), key=lambda k: k.end_time)
             if not ended:
                 problems.append(f"{where}: pursue with every branch evaporated: {statuses}")
             else:
@@ -460,3 +460,33 @@ def test_random_nested_plans_obey_the_rules() -> None:
     _examples_run[0] = 0
     check_random_nested_plan()
     assert _examples_run[0] >= EXAMPLES, f"only {_examples_run[0]} random plans ran"
+
+
+STRESS_RUNS = int(os.environ.get("PYCRAM_STRESS", "0") or 0)
+
+
+@pytest.mark.skipif(not STRESS_RUNS, reason="stress mode: set PYCRAM_STRESS=100 to run the property test 100 times")
+@pytest.mark.timeout(max(STRESS_RUNS, 1) * 60)
+def test_stress_random_nested_plans_with_many_seeds() -> None:
+    """Stress mode (opt-in): the property test above, `PYCRAM_STRESS` times, each with its own
+    hypothesis seed; every failing seed is reported. `PYCRAM_STRESS_SEED` fixes the first seed."""
+    first = int(os.environ.get("PYCRAM_STRESS_SEED", "0") or 0) or random.randrange(1 << 32)
+    failures: list[str] = []
+    started = time.monotonic()
+    try:
+        for run in range(STRESS_RUNS):
+            _examples_run[0] = 0
+            try:
+                seed(first + run)(check_random_nested_plan)()
+            except Exception as exc:  # noqa: BLE001 - collected and reported below
+                details = [str(e) for e in getattr(exc, "exceptions", ())]  # hypothesis' groups
+                failures.append("\n".join([f"seed {first + run}: {exc}", *details]))
+            else:
+                if _examples_run[0] < EXAMPLES:
+                    failures.append(f"seed {first + run}: only {_examples_run[0]} random plans ran")
+    finally:
+        check_random_nested_plan._hypothesis_internal_use_seed = None  # as the decorator left it
+    took = time.monotonic() - started
+    print(f"stress: {STRESS_RUNS} runs of {EXAMPLES} random plans (seeds {first}..{first + STRESS_RUNS - 1}) "
+          f"in {took:.0f} s, {len(failures)} failed")
+    assert not failures, "\n\n".join(failures)

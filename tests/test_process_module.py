@@ -322,10 +322,11 @@ def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
     route_all_to(module)
     queued = []
 
-    def stopper():
-        assert module.wait_started(1, TIMEOUT)
-        queued.append(ProcessModule.perform_nowait(motion('next')))
-        wait_true(module.queued >= 1)
+    def queue_next_and_release_it():  # a caller outside the pursue, queued behind 'A'
+        if module.wait_started(1, TIMEOUT):
+            queued.append(ProcessModule.perform_nowait(motion('next')))
+            if module.wait_started(2, TIMEOUT):
+                module.release()
 
     tasks = []
 
@@ -333,19 +334,17 @@ def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
         tasks.append(current_task())
         perform(motion('A'))
 
-    def releaser():  # the stopper's branch waits for its non-waited execution before ending
-        if module.wait_started(2, TIMEOUT):
-            module.release()
+    def stopper():
+        wait_true(module.queued >= 1)
 
-    helper = threading.Thread(target=releaser, daemon=True)
+    helper = threading.Thread(target=queue_next_and_release_it, daemon=True)
     helper.start()
     state = pursue(mover, stopper)
     helper.join(TIMEOUT)
     assert state.get_value() is State.SUCCEEDED
     assert [d.prop_value('n') for d in module.cancelled] == ['A']
     assert tasks[0].status.get_value().name == 'EVAPORATED'
-    # the module was freed, the next queued designator started and ran before pursue returned
-    assert queued[0].done
+    # the module was freed: the next queued designator started and ran
     assert queued[0].wait(TIMEOUT) is None
     assert [e for e, _ in module.log] == ['start', 'cancel', 'start', 'end']
     assert module.status.get_value() is S.SUCCEEDED
@@ -474,3 +473,27 @@ def test_public_surface():
     for module in (pm, robot_module, testing):
         for name in module.__all__:
             assert hasattr(module, name), (module.__name__, name)
+
+
+@pytest.mark.parametrize("exit_exception", [SystemExit(3), KeyboardInterrupt()])
+def test_execution_ended_by_systemexit_or_keyboardinterrupt_is_failed_not_cancelled(exit_exception):
+    module = ScriptedProcessModule('nav', script=[exit_exception])
+    route_all_to(module)
+    with pytest.raises(type(exit_exception)) as raised:
+        ProcessModule.perform(motion(1))
+    assert raised.value is exit_exception  # propagates unchanged, not wrapped
+    assert module.status.get_value() is S.FAILED
+    assert module.cancelled == []  # not a cancellation: the cancel hook did not run
+    # the module is free again
+    module.script.append('ok')
+    assert ProcessModule.perform(motion(2)) == 'ok'
+
+
+def test_nowait_execution_ended_by_keyboardinterrupt_reports_failed():
+    module = ScriptedProcessModule('nav', script=[KeyboardInterrupt()])
+    route_all_to(module)
+    handle = ProcessModule.perform_nowait(motion(1))
+    with pytest.raises(KeyboardInterrupt):
+        handle.wait(TIMEOUT)
+    assert handle.status.get_value() is S.FAILED
+    assert isinstance(handle.exception, KeyboardInterrupt)

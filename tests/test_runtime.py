@@ -315,3 +315,141 @@ def test_as_task_runs_each_call_as_a_named_child_task():
     assert failed.status.get_value() is TaskStatus.FAILED and isinstance(failed.exception, LookupError)
     assert (placed.name, placed.kind) == ("put down", "action")
     assert grab.__name__ == "grab" and grab.__doc__ == "Grab something."
+
+
+# -- a task's final status comes after its children's (issue 12) --------------------------------------
+
+
+class _EndOrder:
+    """Task listener: records every task that ended while one of its children had not."""
+
+    def __init__(self) -> None:
+        self.early: list[str] = []
+
+    def task_started(self, task) -> None:
+        pass
+
+    def task_ended(self, task) -> None:
+        running = [child.name for child in task.children if not child.done]
+        if running:
+            self.early.append(f"{task.name} ended {task.status.get_value().name} while {running} ran")
+
+
+@pytest.fixture
+def end_order():
+    listener = _EndOrder()
+    add_task_listener(listener)
+    yield listener
+    remove_task_listener(listener)
+
+
+def _blocking_module(name="held"):
+    """A process module (test double) whose executions block until `release` is set or they are
+    evaporated; routed for every designator while the test runs."""
+    from pycram.process_module import ProcessModule
+
+    release = Fluent()
+
+    class Held(ProcessModule):
+        def _execute(self, designator):
+            release.wait_for()
+            return "done"
+
+    return Held(name), release
+
+
+@pytest.fixture
+def routed_module():
+    from pycram.process_module import ProcessModule
+
+    module, release = _blocking_module()
+    saved = list(ProcessModule.resolvers)
+    ProcessModule.resolvers[:] = [lambda d: module]
+    yield module, release
+    ProcessModule.resolvers[:] = saved
+
+
+def test_a_failed_branch_ends_only_after_its_detached_execution_ended(end_order, routed_module):
+    """Deterministic: the execution blocks until evaporated, and only the branch's own end
+    evaporates it — today's order (status first, then settle) shows the branch FAILED while
+    the execution still runs."""
+    from pycram.designator import MotionDesignator, perform
+
+    handles = []
+
+    def branch():
+        handles.append(perform(MotionDesignator([("type", "moving"), ("wait", False)])))
+        raise RuntimeError("the branch fails while its drive runs")
+
+    errors = []
+    par(branch, errors=errors)
+    assert [type(e) for e in errors] == [RuntimeError]
+    branch_task = current_task().children[-1].children[0]
+    execution_task = branch_task.children[0]
+    assert execution_task.status.get_value() is TaskStatus.EVAPORATED
+    assert branch_task.status.get_value() is TaskStatus.FAILED
+    assert execution_task.end_time <= branch_task.end_time
+    assert end_order.early == []
+
+
+def test_a_succeeded_branch_ends_only_after_its_detached_execution_ended(end_order, routed_module):
+    from pycram.designator import MotionDesignator, perform
+
+    _, release = routed_module
+    returned = Fluent()
+
+    def branch():
+        perform(MotionDesignator([("type", "moving"), ("wait", False)]))
+        returned.set_value(True)  # the branch's code ends here; its execution still runs
+
+    def releaser():
+        assert returned.wait_for(WAIT)
+        release.set_value(True)
+
+    helper = threading.Thread(target=releaser, daemon=True)
+    helper.start()
+    state = par(branch)
+    helper.join(WAIT)
+    assert state.get_value() is State.SUCCEEDED
+    branch_task = current_task().children[-1].children[0]
+    assert branch_task.children[0].status.get_value() is TaskStatus.SUCCEEDED
+    assert branch_task.children[0].end_time <= branch_task.end_time
+    assert end_order.early == []
+
+
+def test_a_subtask_whose_code_returned_ends_with_its_last_child(end_order, routed_module):
+    """An action subtask (`run_subtask`, `@as_task`, a `seq` step) that started an execution
+    with ('wait', False) returns at once, but stays RUNNING until the execution has ended."""
+    from pycram.designator import MotionDesignator, perform
+
+    _, release = routed_module
+
+    def start_drive():
+        return perform(MotionDesignator([("type", "moving"), ("wait", False)]))
+
+    handle = run_subtask("start_drive", start_drive, kind="action")
+    action = current_task().children[-1]
+    assert action.name == "start_drive"
+    assert action.status.get_value() is TaskStatus.RUNNING  # its drive still runs
+    assert action.end_time is None
+    release.set_value(True)
+    assert handle.wait(WAIT) == "done"
+    assert (action.status == TaskStatus.SUCCEEDED).wait_for(WAIT)
+    assert action.end_time >= action.children[0].end_time
+    assert end_order.early == []
+
+
+def test_a_seq_ends_after_the_detached_execution_of_one_of_its_steps(end_order, routed_module):
+    from pycram.designator import MotionDesignator, perform
+
+    _, release = routed_module
+    handles = []
+    state = seq(lambda: handles.append(perform(MotionDesignator([("type", "moving"), ("wait", False)]))),
+                lambda: None, name="drive-and-go-on")
+    assert state.get_value() is State.SUCCEEDED  # decided: the steps succeeded
+    expression = current_task().children[-1]
+    assert expression.status.get_value() is TaskStatus.RUNNING  # but a child still runs
+    release.set_value(True)
+    handles[0].wait(WAIT)
+    assert (expression.status == TaskStatus.SUCCEEDED).wait_for(WAIT)
+    assert end_order.early == []

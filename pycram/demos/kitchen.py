@@ -42,9 +42,6 @@ ANIMATION_SPEED_UP = 2.0
 RENDER_CATCH_UP = 300.0
 #: Size of the animation's frames [px]; snapshots are 640 x 480.
 ANIMATION_SIZE = (480, 360)
-#: The item's colour (RGBA): a yellow that stands out against the grey counters, the dark stoves
-#: and the red cookers (colour only: the item's size and mass are what the grasps depend on).
-ITEM_COLOUR = (1.0, 0.82, 0.05, 1.0)
 #: Where the pictures' camera frames bodies [m]: the kitchen (x_min, y_min, x_max, y_max); an
 #: item put aside out of the kitchen is not followed.
 KITCHEN_REGION = (-1.3, -1.8, 3.2, 3.6)
@@ -66,6 +63,7 @@ class DemoOptions:
     record: bool = True
     quiet: bool = False
     animation: bool = True  # record run.gif (False: no animation, a faster run)
+    backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
 
 
 @dataclass
@@ -180,6 +178,8 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
 
     if options.item_at not in (0, 1, 2, 3):
         raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {options.item_at}")
+    if options.backend not in ("sim", "ros"):
+        raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in ("pr2", "tiago"):
         raise ValueError(f"--robot must be 'pr2' or 'tiago', not {options.robot!r}")
     stop = stop if stop is not None else StopSignals()  # never signalled unless entered
@@ -232,32 +232,40 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
     from pycram.demos import kitchen_plan as plan
     from pycram.demos.kitchen_world import (
         ITEM_NAME,
-        SLOTS,
         START_POSE,
         Helper,
         KitchenFacts,
         Operator,
         Thief,
+        demo_items,
         operator_resolver,
     )
+    from pycram.environments import load as load_environment
     from pycram.runtime import add_task_listener, format_task_tree, remove_task_listener
-    from pycram.sim import FollowView, ItemSpec, Pose2D, World
+    from pycram.sim import FollowView, Pose2D, World
     from pycram.sim.render import write_animation
 
     output = result.output
     rng = random.Random(options.seed)
-    mug = ItemSpec(ITEM_NAME, "mug", "cylinder", (0.03, 0.05), 0.25,
-                   (*SLOTS[options.item_at], None) if options.item_at else (5.0, 5.0, None), ITEM_COLOUR)
-    items = [mug] if options.item_at else []
-    world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
-    counter_height = world.environment.surface("cooker #1").height
-    camera = FollowView((world.description.ROOT_LINK, *(item.name for item in items)), region=KITCHEN_REGION,
-                        side_of=ROOM_MIDDLE, elevation=-50.0, min_distance=2.8, margin=2.2)
+    items = demo_items(options.item_at)
+    mug = demo_items(1)[0]  # the mug's size, also when it is not in the kitchen
+    camera: Any = "overview"
+    if options.backend == "ros":  # plan -> ROS process modules -> roscore -> sim-ros-bridge -> MuJoCo
+        from pycram.ros.sim_environment import open_ros_world
+
+        world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
+        counter_height = load_environment("thesis-kitchen").surface("cooker #1").height
+    else:
+        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+        robot = None
+        counter_height = world.environment.surface("cooker #1").height
+        camera = FollowView((world.description.ROOT_LINK, *(item.name for item in items)), region=KITCHEN_REGION,
+                            side_of=ROOM_MIDDLE, elevation=-50.0, min_distance=2.8, margin=2.2)
     thief = None
     story = None
     frames: list = []
     try:
-        robot = robot_packages.load(options.robot, world)
+        robot = robot or robot_packages.load(options.robot, world)
         helper = Helper(world, interactive=options.interactive)
         gripper_of = _gripper_mapper(world)
         operator = Operator(helper, gripper_of)
@@ -570,7 +578,7 @@ def _log_to_terminal() -> None:
 
 def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal: int = 0, seed: int = 0,
          realtime: bool = False, interactive: bool = False, db: str | None = None, record: bool = True,
-         quiet: bool = False, animation: bool = True) -> int:
+         quiet: bool = False, animation: bool = True, backend: str = "sim") -> int:
     """Run the demo, print the task tree and a summary; return the process exit code (0: the item
     rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
     from rich.console import Console
@@ -583,7 +591,7 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     console = Console()
     options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
                           seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
-                          quiet=quiet, animation=animation)
+                          quiet=quiet, animation=animation, backend=backend)
     try:
         with StopSignals(on_second=lambda: _stderr_console().show_cursor(True)) as stop:
             result = run_demo(options, stop)

@@ -11,7 +11,14 @@ Exception` in plan code does not swallow it:
 * never inside a `no_evaporation()` block — it is delivered when the block ends.
 
 It is sticky: catching it does not save the task. Every later PyCRAM call made by an evaporating
-task (`check_evaporation`, waits, `sleep`, expressions, `retry`) raises it again.
+task (`check_evaporation`, waits, `sleep`, expressions, `retry`) raises it again. A task that
+swallowed it (a later PyCRAM call finds it still evaporating, outside any handler or `finally`
+of an `Evaporated`) is re-delivered `Evaporated` at the next line its own code executes, and
+again each time it swallows it, until it ends — so even `while True: try: sleep(0.01)
+except: pass` ends (see `Runner.evaporated`).
+
+It is delivered once: a task that lets `Evaporated` propagate is never interrupted again on
+its way up, so its `finally` blocks and context-manager exits run uninterrupted.
 
 Every thread that runs PyCRAM code has a `Runner`: its current task and the state needed to
 interrupt it. This module knows tasks only through two attributes: `_evaporating` (bool) and
@@ -21,9 +28,10 @@ interrupt it. This module knows tasks only through two attributes: `_evaporating
 from __future__ import annotations
 
 import os
+import sys
 import threading
 from contextlib import contextmanager
-from typing import Callable, Iterator
+from typing import Any, Callable, Iterator
 
 from pycram.runtime.clock import current_clock
 
@@ -46,8 +54,9 @@ class Evaporated(BaseException):
     """Raised in a task that was evaporated (stopped from outside).
 
     Derives from `BaseException`: `except Exception` does not catch it. Catching it anyway does
-    not resurrect the task — every later PyCRAM call raises it again — so let it propagate and
-    put clean-up in `finally` blocks or context managers, which always run.
+    not resurrect the task — every later PyCRAM call raises it again, and a task that swallowed
+    it gets it re-delivered at its next line — so let it propagate and put clean-up in `finally`
+    blocks or context managers, which then run uninterrupted.
     """
 
 
@@ -55,7 +64,7 @@ class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
     __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_missed", "_protected", "_lock",
-                 "_sleep")
+                 "_sleep", "_delivered_to", "_delivered_top", "resurfacing", "in_plan")
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
@@ -68,6 +77,12 @@ class Runner:
         self._protected = 0
         self._lock = threading.Lock()
         self._sleep: threading.Condition | None = None
+        self._delivered_to: object | None = None  # the task evaporation was last delivered to,
+        self._delivered_top: object | None = None  # and its outermost ancestor evaporating then
+        self.resurfacing = 0  # how often a swallowed evaporation was re-delivered (see evaporated)
+        # True while the thread runs plan code (the only place an asynchronous Evaporated may
+        # land); the task runtime sets it False around its own bookkeeping (see take_back_pending)
+        self.in_plan = True
 
     # -- state of the current task -------------------------------------------------------------
 
@@ -75,6 +90,39 @@ class Runner:
         """True when the current task is evaporating and not inside `no_evaporation`."""
         task = self.task
         return task is not None and task._evaporating and not self._protected
+
+    def _delivered_here(self) -> bool:
+        """True when evaporation was delivered to the current task, or to a descendant of it
+        and this task was already evaporating then (its `Evaporated` is on its way up here)."""
+        current, task = self.task, self._delivered_to
+        while task is not None:
+            if task is current:
+                return True
+            if task is self._delivered_top:
+                return False
+            task = task.parent  # type: ignore[attr-defined]
+        return False
+
+    def _mark_delivered(self) -> None:
+        task = top = self.task
+        while top.parent is not None and top.parent._evaporating:  # type: ignore[union-attr]
+            top = top.parent  # type: ignore[union-attr]
+        self._delivered_to, self._delivered_top = task, top
+
+    def evaporated(self) -> Evaporated:
+        """The `Evaporated` a PyCRAM call raises on finding its task evaporating.
+
+        If it had been delivered already and the call is not made while an `Evaporated` is
+        being handled (an `except` clause, a `finally` block, a context manager's exit on its
+        way up), the task swallowed it: from now on each line of the task's own code re-raises
+        it (a trace function on the thread's plan frames, never inside PyCRAM or the standard
+        library), until the task ends.
+        """
+        if self._delivered_here() and not isinstance(sys.exc_info()[1], Evaporated):
+            self.resurfacing += 1
+            _resurface_in_plan_frames(sys._getframe(1))
+        self._mark_delivered()
+        return Evaporated()
 
     # -- entering and leaving the runtime -----------------------------------------------------
 
@@ -113,6 +161,15 @@ class Runner:
                 took_back, self._missed = took_back or self._missed, False
         return took_back and self.evaporation_due()
 
+    def take_back_pending(self) -> None:
+        """Cancel an asynchronous `Evaporated` still pending for the calling thread (the runtime
+        calls it after setting `in_plan` False, when `_injected` says one may be pending). The
+        pending exception may land at this call instead: callers treat it as the plan code's."""
+        with self._lock:
+            if self._injected:
+                self._injected = False
+                _take_back_async_exception(self.ident)
+
     def _wait_on(self, condition: threading.Condition) -> None:
         """Register the condition a wait blocks on, so that `interrupt` can notify it."""
         with self._lock:
@@ -136,14 +193,20 @@ class Runner:
         code gets an asynchronous `Evaporated`; a thread inside the runtime or inside
         `no_evaporation` notices the flag at its next check.
         """
-        if not self.evaporation_due():
-            return
+        if not self.evaporation_due() or self._delivered_here():
+            return  # not due, or on its way up already: never interrupt its clean-up
         injected = False
+        inject = _api()[0]
         with self._lock:
+            self._mark_delivered()
             condition = self._waiting_on
-            if condition is None and self._mode == _USER and not self._injected and self.ident is not None:
+            # Only into plan code: the runtime's own bookkeeping (in_plan False) checks for a due
+            # evaporation when it hands back to plan code. No eval-breaker check lies between
+            # reading in_plan and the C call, so the thread cannot leave plan code in between.
+            if condition is None and self._mode == _USER and self.in_plan and not self._injected \
+                    and self.ident is not None:
                 self._injected = injected = True
-                _inject_async_exception(self.ident)
+                inject(self.ident, Evaporated)
             elif condition is None and self._mode == _RUNTIME:
                 self._missed = True  # raised by the runtime code when it leaves (leave_runtime)
         if condition is not None:
@@ -195,7 +258,7 @@ def check_evaporation() -> None:
     """
     runner = current_runner()
     if runner.evaporation_due():
-        raise Evaporated()
+        raise runner.evaporated()
 
 
 @contextmanager
@@ -229,7 +292,7 @@ def no_evaporation() -> Iterator[None]:
     with shielded() as runner:
         yield
     if runner.evaporation_due():
-        raise Evaporated()
+        raise runner.evaporated()
 
 
 def wait_until(
@@ -246,7 +309,7 @@ def wait_until(
     """
     runner = current_runner()
     if runner.evaporation_due():
-        raise Evaporated()
+        raise runner.evaporated()
     token = runner.enter_runtime()  # before taking the condition's lock, left after releasing it
     try:
         with condition:
@@ -369,3 +432,92 @@ def _take_back_async_exception(ident: int) -> None:
         except _TakenBack:
             return
     _api()[1](ident, None)  # pragma: no cover - never seen: fall back to the documented way
+
+
+# -- re-delivering a swallowed evaporation ------------------------------------------------------
+
+_code_dirs: tuple[str, tuple[str, ...], tuple[str, ...]] | None = None
+
+
+def _is_plan_code(filename: str) -> bool:
+    """True for a plan's own code; False for PyCRAM itself and the standard library, where an
+    exception raised between two lines could leave a lock held or a queue inconsistent."""
+    global _code_dirs
+    if _code_dirs is None:
+        import sysconfig  # only once a task swallowed evaporation: keeps `import pycram` lean
+
+        pycram_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+        library = {os.path.abspath(sysconfig.get_paths()[k]) + os.sep for k in ("stdlib", "platstdlib")}
+        _code_dirs = (pycram_dir, (os.path.join(pycram_dir, "demos") + os.sep,), tuple(library))
+    pycram_dir, plan_dirs, library_dirs = _code_dirs
+    path = os.path.abspath(filename)
+    if path.startswith(pycram_dir):
+        return path.startswith(plan_dirs)
+    return not path.startswith(library_dirs) and not filename.startswith("<frozen")
+
+
+def _resurface_in_plan_frames(frame: object) -> None:
+    """Trace the calling thread's plan frames from `frame` outwards, so that the task is
+    re-delivered `Evaporated` where it would swallow it again (see `_raise_if_swallowing`).
+
+    Raising from a trace function unsets it (CPython), so each swallow re-arms it through the
+    next PyCRAM call. A thread already traced by a debugger or coverage is left alone (its
+    evaporation stays sticky at every PyCRAM call, as before).
+    """
+    if sys.gettrace() is not None:
+        return
+    while frame is not None:
+        if _is_plan_code(frame.f_code.co_filename):  # type: ignore[attr-defined]
+            frame.f_trace = _raise_if_swallowing  # type: ignore[attr-defined]
+            frame.f_trace_lines = True  # type: ignore[attr-defined]
+        frame = frame.f_back  # type: ignore[attr-defined]
+    sys.settrace(_trace_no_new_frames)  # line events reach f_trace only while a trace is set
+
+
+def _trace_no_new_frames(frame: object, event: str, arg: object) -> None:
+    return None  # frames called from now on (PyCRAM, the library, `__exit__`s) run untraced
+
+
+def _raise_if_swallowing(frame: Any, event: str, arg: object) -> object:
+    """Line trace of a plan frame of a task that swallowed `Evaporated`: raise it again at a
+    line outside any exception handler, and inside a handler that ends by swallowing what it
+    handles (`except: pass`) — never in a `finally` block or a handler that re-raises, which
+    is the task letting it propagate."""
+    if event != "line":
+        return _raise_if_swallowing
+    runner = current_runner()
+    task = runner.task
+    if task is None or not task._evaporating:  # type: ignore[attr-defined]
+        sys.settrace(None)  # the evaporated task ended: stop tracing this thread
+        return None
+    if runner.evaporation_due() and runner._mode == _USER:
+        if sys.exc_info()[1] is None or _handler_swallows(frame.f_code, frame.f_lasti):
+            runner._mark_delivered()
+            raise Evaporated()
+    return _raise_if_swallowing
+
+
+_handler_ends: dict[tuple[Any, int], bool] = {}
+
+
+def _handler_swallows(code: Any, offset: int) -> bool:
+    """True if the exception handler running at `offset` of `code` ends by dropping the
+    exception (`POP_EXCEPT` comes first) rather than re-raising it (`RERAISE`, `raise`)."""
+    key = (code, offset)
+    found = _handler_ends.get(key)
+    if found is None:
+        import dis  # only for tasks that swallowed evaporation
+
+        found = False
+        for instruction in dis.get_instructions(code):
+            if instruction.offset < offset:
+                continue
+            if instruction.opname == "POP_EXCEPT":
+                found = True
+                break
+            if instruction.opname in ("RERAISE", "RAISE_VARARGS"):
+                break
+        if len(_handler_ends) > 4096:
+            _handler_ends.clear()
+        _handler_ends[key] = found
+    return found

@@ -101,10 +101,12 @@ def remove_task_listener(listener: TaskListener) -> None:
 class Task:
     """A node of the task tree.
 
-    Attributes: `name`, `kind` (e.g. "seq", "par", "branch", "step", "attempt", "root"),
-    `parent`, `children`, `status` (a `Fluent` of `TaskStatus`), `start_time` / `end_time`
-    (active clock [s]), `exception` (the exception that failed it), `result`, `info` (free-form
-    details, e.g. the source line or the attempt count).
+    Attributes: `name` (what it does: `grab_item`, `perform moving`, `par`...), `kind` (e.g.
+    "seq", "par", "branch", "step", "attempt", "root"), `location` (where in the plan, e.g.
+    `kitchen_plan.py:203` for a block-syntax branch, else None), `parent`, `children`,
+    `status` (a `Fluent` of `TaskStatus`), `start_time` / `end_time` (active clock [s]),
+    `exception` (the exception that failed it), `result`, `info` (free-form details, e.g. the
+    attempt count).
     """
 
     __slots__ = (
@@ -119,9 +121,11 @@ class Task:
         "exception",
         "result",
         "info",
+        "location",
         "_evaporating",
         "_runner",
         "_path",
+        "_pending_end",
     )
 
     def __init__(self, name: str, kind: str = "task", parent: Task | None = None) -> None:
@@ -136,8 +140,10 @@ class Task:
         self.exception: BaseException | None = None
         self.result: Any = None
         self.info: dict[str, Any] = {}
+        self.location: str | None = None
         self._runner: Runner | None = None
         self._path: str | None = None
+        self._pending_end: tuple[TaskStatus, BaseException | None] | None = None
         if parent is None:
             self._evaporating = False
         else:
@@ -187,11 +193,41 @@ class Task:
             listener.task_started(self)
 
     def _end(self, status: TaskStatus, exception: BaseException | None = None) -> None:
-        self.end_time = current_clock().now()
-        self.exception = exception
-        self.status.set_value(status)
-        for listener in _listeners:
-            listener.task_ended(self)
+        """The task's own code has ended with `status`; the task ends once its children have.
+
+        A child may still run when its parent's code ends: a process-module execution started
+        with `('wait', False)` inside a `seq` step or an `@as_task` function, for example. The
+        parent's final status, end time and `task_ended` notification then wait for the last
+        such child, whose own end completes the parent's (in the child's thread).
+        """
+        with _tree_lock:
+            if any(not child.done for child in self.children):
+                self._pending_end = (status, exception)
+                return
+        self._finish(status, exception)
+
+    def _finish(self, status: TaskStatus, exception: BaseException | None) -> None:
+        task: Task | None = self
+        due: Evaporated | None = None
+        while task is not None:
+            task.end_time = current_clock().now()
+            task.exception = exception
+            try:
+                task.status.set_value(status)
+            except Evaporated as held_back:  # this thread's evaporation, due now: after the end
+                due = held_back
+            for listener in _listeners:
+                listener.task_ended(task)
+            parent = task.parent
+            task = None
+            if parent is not None:
+                with _tree_lock:  # the last child to end completes its parent's pending end
+                    pending = parent._pending_end
+                    if pending is not None and all(child.done for child in parent.children):
+                        parent._pending_end = None
+                        task, (status, exception) = parent, pending
+        if due is not None:
+            raise due
 
     def evaporate(self) -> None:
         """Stop this task and all its descendants; returns at once (idempotent).
@@ -293,33 +329,75 @@ def current_task() -> Task:
     return task
 
 
-def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", **kwargs: Any) -> Any:
+def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", location: str | None = None,
+                **kwargs: Any) -> Any:
     """Run `fn(*args, **kwargs)` as a child task of the current task, in the calling thread.
 
     Returns fn's result or re-raises its exception; the child ends SUCCEEDED, FAILED or
-    EVAPORATED accordingly. Raises `Evaporated` before starting if the caller is evaporating.
+    EVAPORATED accordingly (once its own children have ended, see `Task._end`). Raises
+    `Evaporated` before starting if the caller is evaporating. `location` (e.g. `plan.py:12`)
+    is stored as the task's `location`.
     """
     runner = current_runner()
+    in_plan, runner.in_plan = runner.in_plan, False  # no asynchronous Evaporated in here
     parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
     if parent._evaporating and not runner._protected:
-        raise Evaporated()
+        runner.in_plan = in_plan
+        raise runner.evaporated()
     task = Task(name, kind, parent)
+    task.location = location
     task._start(runner)
     runner.task = task
     try:
+        runner.in_plan = True
         result = fn(*args, **kwargs)
+        runner.in_plan = False
+        if runner._injected:
+            runner.take_back_pending()  # one pending for fn lands here at the latest: as fn's
     except Evaporated as exc:
+        try:
+            _leave_plan_code(runner)
+        except Evaporated:
+            pass  # the one pending landed at the call: taken back in effect
         runner.task = parent
         task._end(TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED, exc)
+        runner.in_plan = in_plan
         raise
     except BaseException as exc:
+        try:
+            _leave_plan_code(runner)
+        except Evaporated:
+            pass  # the one pending landed at the call: taken back in effect
         runner.task = parent
         task._end(TaskStatus.FAILED, exc)
+        runner.in_plan = in_plan
         raise
     runner.task = parent
     task.result = result
     task._end(TaskStatus.SUCCEEDED)
+    _back_to_plan_code(runner, in_plan)
     return result
+
+
+def _leave_plan_code(runner: Runner) -> None:
+    """In the runtime's handler of an exception from plan code: no asynchronous `Evaporated`
+    may land from here on (one still pending is taken back; if it lands instead, it is dropped:
+    an exception of the plan code is being handled already). Call it inside `try/except
+    Evaporated`: a pending one may land at this very call."""
+    runner.in_plan = False
+    if runner._injected:
+        try:
+            runner.take_back_pending()
+        except Evaporated:
+            pass
+
+
+def _back_to_plan_code(runner: Runner, in_plan: bool) -> None:
+    """Hand back to the caller; raise `Evaporated` here if an evaporation became due while the
+    runtime's bookkeeping held it back (as if it had landed right after the call)."""
+    runner.in_plan = in_plan
+    if in_plan and runner.evaporation_due():
+        raise Evaporated()
 
 
 def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, kind: str = "plan") -> Any:
@@ -349,16 +427,20 @@ class task_scope:
     Usage: `with task_scope("par", "par") as scope: ...; scope.fail(error)`. The task ends
     EVAPORATED if `Evaporated` leaves the block while it is evaporating, FAILED if another
     exception leaves it or `scope.fail()` was called, SUCCEEDED otherwise. Raises `Evaporated`
-    on entry if the caller is evaporating.
+    on entry if the caller is evaporating. `plan_code=False` (the language's expressions) says
+    the block is runtime bookkeeping: no asynchronous `Evaporated` lands in it; it is raised
+    after the block instead if it became due meanwhile.
     """
 
-    __slots__ = ("task", "error", "_parent", "_runner")
+    __slots__ = ("task", "error", "_parent", "_runner", "_in_plan", "_plan_code")
 
-    def __init__(self, name: str, kind: str = "task") -> None:
+    def __init__(self, name: str, kind: str = "task", *, plan_code: bool = True) -> None:
         runner = current_runner()
         parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
         if parent._evaporating and not runner._protected:
-            raise Evaporated()
+            raise runner.evaporated()
+        self._in_plan, runner.in_plan = runner.in_plan, False  # none in the bookkeeping
+        self._plan_code = plan_code
         self._runner = runner
         self._parent = parent
         self.task = Task(name, kind, parent)
@@ -371,10 +453,16 @@ class task_scope:
     def __enter__(self) -> task_scope:
         self.task._start(self._runner)
         self._runner.task = self.task
+        self._runner.in_plan = self._plan_code
         return self
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
         task = self.task
+        if self._plan_code:
+            try:
+                _leave_plan_code(self._runner)
+            except Evaporated:
+                pass
         self._runner.task = self._parent
         if exc is None:
             if self.error is None:
@@ -385,6 +473,10 @@ class task_scope:
             task._end(TaskStatus.EVAPORATED, exc)
         else:
             task._end(TaskStatus.FAILED, exc)
+        if exc is None:
+            _back_to_plan_code(self._runner, self._in_plan)
+        else:
+            self._runner.in_plan = self._in_plan
         return False
 
 
@@ -400,8 +492,10 @@ class TaskGroup:
 
     A `detached` group is one its creator will not necessarily wait for (a process-module
     execution started with `('wait', False)`). It still does not outlive the branch that
-    started it: before that branch's thread ends, it waits for the group — after evaporating it
-    if the branch failed or was evaporated.
+    started it: before that branch ends, it waits for the group — after evaporating it if the
+    branch failed or was evaporated. A task whose code ends while a child still runs (a
+    detached execution started in a `seq` step, say) gets its final status when that child
+    has ended (see `Task._end`).
     """
 
     def __init__(self, on_end: Callable[[Task], None] | None = None, detached: bool = False) -> None:
@@ -419,6 +513,7 @@ class TaskGroup:
         """Start `fn` as a child task on a worker thread of its own; returns the task."""
         task = Task(name, kind, self.parent)
         runner = Runner(task)
+        runner.in_plan = False  # until the branch's own code runs
         task._runner = runner
         with self._cv:
             self._running += 1
@@ -437,7 +532,9 @@ class TaskGroup:
                 task._start(runner)
                 if task._evaporating:  # evaporated before this thread got to run it
                     raise Evaporated()
+                runner.in_plan = True
                 result = fn()
+                runner.in_plan = False
                 status = TaskStatus.SUCCEEDED
             except Evaporated as exc:
                 status, error = (TaskStatus.EVAPORATED if task._evaporating else TaskStatus.FAILED), exc
@@ -445,22 +542,23 @@ class TaskGroup:
                 status, error = TaskStatus.FAILED, exc
         except BaseException as late:  # an asynchronous exception landing in the handlers above
             status, error = TaskStatus.EVAPORATED, late
+        runner.in_plan = False
         while True:  # at most one asynchronous exception can still be pending
             try:
-                if trace is not None:
+                if trace is not None or runner.resurfacing:
                     sys.settrace(None)  # the worker thread is reused: do not trace the next branch
                 runner.seal()
                 break
             except BaseException:
                 status = TaskStatus.EVAPORATED if task._evaporating else status
+        if runner.detached:  # before the task ends: its final status comes after its children's
+            _settle_detached(runner, stop=status is not TaskStatus.SUCCEEDED)
         task.result = result
         task._end(status, error)
         if self._on_end is not None:
             with self._cv:  # report the outcome at once: the expression may decide on it
                 self._on_end(task)
                 self._cv.notify_all()
-        if runner.detached:
-            _settle_detached(runner, stop=status is not TaskStatus.SUCCEEDED)
         with self._cv:
             self._running -= 1
             self._cv.notify_all()

@@ -20,6 +20,7 @@ and never races afterwards to catch up.
 from __future__ import annotations
 
 import atexit
+import copy
 import logging
 import queue
 import threading
@@ -47,6 +48,7 @@ from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
 from .path_drive import PlannedDrive
+from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
 from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames, StateSnapshot
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
@@ -102,8 +104,12 @@ class World:
                  objects: Sequence[str] | None = None, seed: int = 0,
                  base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
-                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
+                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True,
+                 perception_faults: PerceptionFaults | None = None) -> None:
         env = load_environment(environment)
+        #: Faults of `detect` (none by default); its random generator is seeded from them.
+        self.perception_faults = perception_faults or PerceptionFaults()
+        self._fault_rng = np.random.default_rng(self.perception_faults.seed)
         #: Where the `objects` started (a random scene from `seed`; empty without objects).
         self.placements = random_scene(env, objects, seed) if objects else []
         if self.placements:
@@ -147,6 +153,7 @@ class World:
         self._recorder: FrameRecorder | None = None  # the running recording (simulation thread's)
         self._recorders: list[FrameRecorder] = []  # every recorder started, for close() to end
         self._renderers: Renderers | None = None
+        self._perception_renderers: Renderers | None = None
         self.error: BaseException | None = None
         self._previous_clock = set_clock(self.clock) if activate_clock else None
         self._clock_active = activate_clock
@@ -276,8 +283,9 @@ class World:
                 break
             if kind == "start":
                 b._finish(Outcome(False, reason, "world closed"))
-        if self._renderers is not None:
-            self._renderers.close()
+        for renderers in (self._renderers, self._perception_renderers):
+            if renderers is not None:
+                renderers.close()
         if self._recorder is not None:
             self._recorder.abort()  # never blocks; close() joins the thread
         # wake anybody waiting on simulated time one last time
@@ -464,14 +472,32 @@ class World:
             self._renderers = Renderers(self.scene.model)
         return self._renderers
 
-    def request_image(self, camera: str | FollowView = HEAD_CAMERA, width: int = 320,
-                      height: int = 240) -> CommandHandle:
+    def _get_perception_renderers(self) -> Renderers:
+        """Renderers of object perception, on a copy of the model without multisampling (~2x
+        cheaper with a software renderer; the geometry is the model's, the state `eng.data`)."""
+        if self._perception_renderers is None:
+            model = copy.copy(self.scene.model)  # mj_copyModel: nothing shared afterwards
+            model.vis.quality.offsamples = 0
+            self._perception_renderers = Renderers(model)
+        return self._perception_renderers
+
+    def request_image(self, camera: str | FollowView = HEAD_CAMERA, width: int = 320, height: int = 240,
+                      hide_objects: bool = False) -> CommandHandle:
         """Render an RGB image (height x width x 3, uint8) from `camera` (a camera name or a
-        `FollowView`); also set `camera_image`."""
+        `FollowView`); also set `camera_image`.
+
+        `hide_objects` leaves the items out of the picture (e.g. a plan to draw a belief on).
+        """
         self._check_camera(camera)
 
         def fn(eng: Engine) -> np.ndarray:
-            img = self._get_renderers().rgb(eng.data, camera, width, height)
+            geoms = [g for gs in eng.item_part_geoms.values() for g in gs] if hide_objects else []
+            saved = eng.model.geom_rgba[geoms, 3].copy()
+            eng.model.geom_rgba[geoms, 3] = 0.0  # fully transparent geoms are not drawn
+            try:
+                img = self._get_renderers().rgb(eng.data, camera, width, height)
+            finally:
+                eng.model.geom_rgba[geoms, 3] = saved
             self.camera_image.set_value(img)
             return img
 
@@ -510,6 +536,38 @@ class World:
             return sorted(seen, key=lambda v: -v.pixels)
 
         return self._call("perceive", fn)
+
+    def detect(self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS,
+               max_range: float = MAX_RANGE) -> CommandHandle:
+        """One look of the head camera's object perception: value a
+        `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
+        colour images of `width` x `height` [px], most visible first; the camera view with its
+        depth image; the joint positions of the containers whose handle is in the image),
+        stamped with the simulated time.
+
+        Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
+        not reported; `perception_faults` apply. No simulator names or poses are reported.
+        """
+        return self._call("detect", lambda eng: self._detect(eng, width, height, min_pixels, max_range))
+
+    def _detect(self, eng: Engine, width: int, height: int, min_pixels: int, max_range: float) -> Any:
+        """`detect`'s work, in the simulation thread: render, measure, report."""
+        from pycram.world.belief import PerceptionReport
+
+        renderers = self._get_perception_renderers()
+        ids, depth = renderers.segmentation_and_depth(eng.data, HEAD_CAMERA, width, height)
+        rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
+        cam = eng.camera
+        view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]),
+                       depth, max_range)
+        objects = {it.name: (it.type, eng.item_part_geoms[it.name]) for it in self.scene.items}
+        states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
+        detections = measure_detections(ids, depth, rgb, view, objects, self.environment, states,
+                                        self.perception_faults, self._fault_rng, min_pixels)
+        # the joint positions of the containers whose handle is in the image
+        in_view = {name: q for name, q in states.items()
+                   if view.in_image(self.environment.container(name).handle_position(q))}
+        return PerceptionReport(eng.time, tuple(detections), view, in_view)
 
     def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
                              height: int = 240) -> CommandHandle:

@@ -184,13 +184,17 @@ def error_handling():
     out["failure_handling_5"] = attempts
 
     attempts = 0
-    with failure_handling(5):
-        try:
-            attempts += 1
-            fail("c")
-        except Exception as e:
-            retry()
-    out["failure_handling_5_exhausted"] = attempts
+    try:
+        with failure_handling(5):
+            try:
+                attempts += 1
+                fail("c")
+            except Exception as e:
+                retry()  # once the 5 retries are used up, re-raises e
+        error = None
+    except Boom as e:
+        error = str(e)
+    out["failure_handling_5_exhausted"] = (attempts, error)
 
     attempts = 0
     with failure_handling():

@@ -218,13 +218,17 @@ with failure_handling(5):
 RESULTS["failure_handling_5"] = attempts
 
 attempts = 0
-with failure_handling(5):
-    try:
-        attempts += 1
-        fail("c")
-    except Exception as e:
-        retry()
-RESULTS["failure_handling_5_exhausted"] = attempts
+try:
+    with failure_handling(5):
+        try:
+            attempts += 1
+            fail("c")
+        except Exception as e:
+            retry()  # once the 5 retries are used up, re-raises e
+    error = None
+except Boom as e:
+    error = str(e)
+RESULTS["failure_handling_5_exhausted"] = (attempts, error)
 
 attempts = 0
 with failure_handling():

@@ -65,3 +65,16 @@ def test_costmap_of_an_impossible_location_says_why(tmp_path):
     assert out.exists()
     bad = runner.invoke(app, ["costmap", "to_reach", "-o", str(out)])
     assert bad.exit_code != 0 and "a location property is 'key value'" in bad.output
+
+
+def test_scene_command_draws_the_belief_beside_the_ground_truth(tmp_path):
+    import imageio.v3 as iio
+
+    out = tmp_path / "belief.png"
+    result = runner.invoke(app, ["scene", "--env", "apartment", "--seed", "3", "--belief", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    # seed 3: the plate and the milk stand on the table in front of the robot, in view
+    assert "believed: <plate-1: white plate" in result.output and "believed: <milk-1:" in result.output
+    assert "cereal-" not in result.output  # in the closed fridge: never perceived
+    image = iio.imread(out)
+    assert image.shape[1] > 1200 and np.asarray(image).std() > 20
