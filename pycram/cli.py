@@ -481,6 +481,7 @@ def costmap_command(
     """The costmap layers of a location designator over the floor plan, and the poses it chose."""
     scene_command(env=env, seed=seed, objects=objects, robot=robot, output=output, costmap=location, belief=False)
 
+
 @app.command("sim-ros-bridge")
 def sim_ros_bridge_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),

@@ -86,6 +86,8 @@ def _object_like(value: Any) -> Target | None:
     pose = getattr(value, "pose", None)
     holder = pose if pose is not None and hasattr(pose, "position") else value
     position = _point(getattr(holder, "position", None))
+    if position is None and pose is not None:  # a believed object: its pose is its centre
+        position = _point(pose)
     if position is None or otype is None:
         return None
     if isinstance(otype, str):

@@ -225,3 +225,21 @@ def test_to_open_stands_clear_of_the_opening_and_follows_the_handle():
     assert handle_path[0] == pytest.approx(fridge.handle) and handle_path[-1] == pytest.approx(fridge.handle_position(1.2))
     assert drawer.x > 0.6 + 0.2 + 0.335  # in front of the drawer pulled out 0.2 m
     assert asked[-1][-1] == pytest.approx(APARTMENT.container("drawer 3").handle_position(0.2))
+
+
+def test_believed_objects_and_object_designators_are_targets():
+    from pycram.designators.object import BelievedObject
+    from pycram.locations import as_target
+
+    cup = BelievedObject("cup-1", "cup", (4.3, 1.7, 0.795))
+    target = as_target(cup, APARTMENT)
+    assert target.kind == "object" and target.position == (4.3, 1.7, 0.795) and target.type.name == "cup"
+
+    class Designator:  # anything with reference(): an object designator
+        def reference(self):
+            return cup
+
+    assert as_target(Designator(), APARTMENT).name == "cup-1"
+    rs, _ = resolver_set()
+    with rs:
+        assert LocationDesignator([("to_reach", cup)]).reference().grasp == "side"
