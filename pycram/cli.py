@@ -442,6 +442,24 @@ def scene_command(
     console.print(f"wrote {escape(str(path))}")
 
 
+def _perceive_named_objects(robot: Any, properties: list) -> None:
+    """Reasoning knows objects only once perceived: the robot looks around from where it stands,
+    then searches for each object type the location names that it has not seen yet."""
+    from pycram.actions import ObjectNotFound, look_around, search_for
+    from pycram.designators.object import ObjectDesignator
+    from pycram.world.objects import OBJECT_TYPES
+
+    with robot:
+        look_around()
+        for _, value in properties:
+            if isinstance(value, str) and value in OBJECT_TYPES \
+                    and not any(obj.type == value for obj in robot.belief.objects()):
+                try:
+                    search_for(ObjectDesignator(type=value))
+                except ObjectNotFound as e:
+                    console.print(f"[yellow]{escape(str(e))}[/yellow]")
+
+
 def _costmap_picture(world: object, robot_name: str, text: str, output: Path, title: str) -> None:
     """`pycram scene --costmap`: resolve the location `text` with the robot, draw its costmap."""
     from pycram import robots
@@ -456,6 +474,7 @@ def _costmap_picture(world: object, robot_name: str, text: str, output: Path, ti
         up = robot.description.TORSO_POSITIONS["up"]
         world.set_torso(up).wait(30.0)  # type: ignore[attr-defined]  # as plans do before reaching
         try:
+            _perceive_named_objects(robot, properties)
             path, solutions, error = write_costmap_picture(world, robot, properties, output, title=title)
         finally:
             robot.shutdown()

@@ -108,7 +108,7 @@ def as_target(value: Any, environment: Environment | None = None,
     """`value` as a `Target` (see the module docstring).
 
     A string names, in this order, a place, a surface or a container of `environment`, or one of
-    `known_objects`. Raises ``ValueError`` naming the value and what a target may be.
+    `known_objects` (by name, else the first of that object type). Raises ``ValueError`` naming the value and what a target may be.
     """
     if isinstance(value, Target):
         return value
@@ -128,6 +128,9 @@ def as_target(value: Any, environment: Environment | None = None,
                             (thing.pose[0], thing.pose[1], 0.0), "place", thing.name, yaw=thing.pose[2], thing=thing)
         for known in known_objects:
             if known.name == value:
+                return as_target(known, environment)
+        for known in known_objects:  # an object type: the first known object of that type
+            if known.type == value:
                 return as_target(known, environment)
         names = ([p.name for p in environment.places] + [s.name for s in environment.all_surfaces()]
                  + [c.name for c in environment.containers]) if environment is not None else []

@@ -332,33 +332,32 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
     return to_reach
 
 
-def known_objects_of(world: Any) -> list:
-    """The objects of a simulated `world` as `pycram.locations.KnownObject`s (name, type, centre,
-    yaw, footprint radius, half height).
-
-    A stand-in for the robot's belief (issue 15) with the same standing as prospection: the
-    world as it is now.
+def known_objects_of(belief: Any) -> list:
+    """The objects the robot believes in (``belief``: its
+    :class:`pycram.world.belief.BeliefState`; gone ones left out) as
+    ``pycram.locations.KnownObject``s: name, type, believed centre, and the footprint and height of
+    the object's type. Reasoning knows only what was perceived, never the simulator's truth.
     """
     from pycram.locations import KnownObject
+    from pycram.world.objects import OBJECT_TYPES
 
-    poses = world.item_poses.get_value()
-    out = []
-    for item in world.scene.items:
-        pose = poses.get(item.name)
-        if pose is None:
+    known = []
+    for obj in belief.objects():
+        if getattr(obj, "gone", False) or obj.pose is None:
             continue
-        w, x, y, z = pose.orientation
-        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-        radius = math.hypot(item.size[0], item.size[1]) if item.shape == "box" else item.size[0]
-        out.append(KnownObject(item.name, item.type, tuple(pose.position), yaw, radius, item.half_height))
-    return out
+        radius = half_height = None
+        size = obj.properties.get("size")
+        if obj.type not in OBJECT_TYPES and size is not None:  # e.g. the thesis demo's mug: as measured
+            radius, half_height = 0.5 * math.hypot(size[0], size[1]), 0.5 * size[2]
+        known.append(KnownObject(obj.name, obj.type, tuple(float(v) for v in obj.pose[:3]), 0.0, radius, half_height))
+    return known
 
 
-def make_location_generator(world: Any, description: Any) -> Callable[[Any], Any]:
+def make_location_generator(world: Any, description: Any, belief: Any) -> Callable[[Any], Any]:
     """The location generator of the robot of `description` in the simulated `world`: the
     general reasoning of :mod:`pycram.locations` (``to_reach``, ``to_see``, ``to_open``, ``on``,
-    ``in``), with prospection from the world and the world's objects as known objects. Returns
-    ``None`` for designators outside that vocabulary."""
+    ``in``), with prospection from the world and the objects of the robot's ``belief`` as known
+    objects. Returns ``None`` for designators outside that vocabulary."""
     from pycram.locations import LocationReasoner, RobotGeometry
 
     def prospection() -> Any:
@@ -368,7 +367,7 @@ def make_location_generator(world: Any, description: Any) -> Callable[[Any], Any
         return make()
 
     reasoner = LocationReasoner(RobotGeometry.from_description(description), lambda: world.environment,
-                                prospection, lambda: known_objects_of(world))
+                                prospection, lambda: known_objects_of(belief))
 
     def locations(desig: Any) -> Any:
         return reasoner.generator(desig)

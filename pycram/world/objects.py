@@ -119,6 +119,9 @@ _ANY_SURFACE = ("counter", "table", "shelf", "drawer")
 OBJECT_TYPES: dict[str, ObjectType] = {t.name: t for t in (
     ObjectType("cup", "cylinder", (0.035, 0.045), 0.2, (0.80, 0.18, 0.15, 1.0),
                (Grasp("side", 0.07, 0.05),), _ANY_SURFACE, "a drinking cup, 7 cm wide, 9 cm tall"),
+    ObjectType("mug", "cylinder", (0.03, 0.05), 0.25, (1.0, 0.82, 0.05, 1.0),
+               (Grasp("side", 0.06, 0.05),), ("counter", "table", "shelf"),
+               "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)"),
     ObjectType("bowl", "bowl", (0.07, 0.035, 0.008), 0.25, (0.95, 0.82, 0.25, 1.0),
                (Grasp("top", 0.008, 0.06, radius=0.066, across="radial"),), _ANY_SURFACE,
                "a cereal bowl, 14 cm wide, 7 cm tall; grasped at its rim"),

@@ -131,6 +131,14 @@ def test_on_spots_hold_the_object_upright(robot_name):
     world, robot = make(robot_name, 1)  # milk and bowl stand on the table
     try:
         with robot:
+            # the robot knows the objects on the table only by looking at them
+            table = world.environment.surface("table")
+            centre = (sum(p[0] for p in table.polygon) / len(table.polygon),
+                      sum(p[1] for p in table.polygon) / len(table.polygon), table.height)
+            motion(type="moving", pose=LocationDesignator([("to_see", centre)]).reference())
+            motion(type="pointing_head", coordinates=centre)
+            motion(type="detecting")
+            assert {"milk", "bowl"} <= {obj.type for obj in robot.belief.objects()}
             spots = LocationDesignator([("on", "table"), ("for", "cup"), ("near", believed(world, "milk"))])
             for spot, _ in zip(spots.solutions(), range(3)):
                 assert isinstance(spot, Spot) and spot.surface == "table"

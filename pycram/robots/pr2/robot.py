@@ -42,7 +42,7 @@ def make_robot(world: Any) -> sm.SimRobot:
 
     robot.motion_types.update(motion_types(world, description))
     robot.motion_resolvers.append(make_motion_resolver(world, description))
-    robot.location_generators.append(make_location_generator(world, description))
+    robot.location_generators.append(make_location_generator(world, description, robot.belief))
 
     def available_process_modules(desig: Any) -> Optional[ProcessModule]:
         """Thesis ch. 4.2.2: choose the PR2's module by the designator's type (and arm)."""
