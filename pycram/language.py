@@ -252,6 +252,8 @@ class _Concurrent:
             group.evaporate()  # may raise Evaporated (this task's own evaporation, due now) ...
         finally:
             group.wait_all()  # ... but the branches are waited for in any case
+        if not in_time and not any(task.status.get_value() is TaskStatus.EVAPORATED for task in group.tasks):
+            in_time = True  # the deadline passed as the last branch ended by itself: not a time-out
         if self.outcome is None and in_time:
             # every branch ended without deciding (e.g. all evaporated from outside)
             self._decide(State.SUCCEEDED if self.kind == "par" and self.failed == 0 else State.FAILED)

@@ -200,10 +200,11 @@ class Task:
         parent's final status, end time and `task_ended` notification then wait for the last
         such child, whose own end completes the parent's (in the child's thread).
         """
-        with _tree_lock:
-            if any(not child.done for child in self.children):
-                self._pending_end = (status, exception)
-                return
+        if self.children:  # children are added only from this task's own thread: no race here
+            with _tree_lock:
+                if any(not child.done for child in self.children):
+                    self._pending_end = (status, exception)
+                    return
         self._finish(status, exception)
 
     def _finish(self, status: TaskStatus, exception: BaseException | None) -> None:
@@ -218,9 +219,11 @@ class Task:
                 due = held_back
             for listener in _listeners:
                 listener.task_ended(task)
-            parent = task.parent
+            parent, runner = task.parent, task._runner
             task = None
-            if parent is not None:
+            # A parent whose end is pending completes with its last child. A child ending in its
+            # parent's own thread cannot race the parent's `_end` (and sees any pending end): no lock.
+            if parent is not None and (parent._pending_end is not None or parent._runner is not runner):
                 with _tree_lock:  # the last child to end completes its parent's pending end
                     pending = parent._pending_end
                     if pending is not None and all(child.done for child in parent.children):
