@@ -43,6 +43,7 @@ from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_s
 
 __all__ = [
     "State",
+    "StateFluent",
     "seq",
     "par",
     "pursue",
@@ -52,6 +53,8 @@ __all__ = [
     "retry",
     "current_attempt",
     "with_timeout",
+    "try_each_in_order",
+    "par_loop",
     "whenever",
     "Fluent",
     "Behavior",
@@ -79,6 +82,27 @@ def _label(fn: Branch, index: int) -> str:
     if not name or name == "<lambda>":
         return str(index + 1)
     return f"{index + 1}:{name}"
+
+
+class StateFluent(Fluent):
+    """The state fluent an expression returns: its value is a `State` once decided, and
+    `result` holds the return value of the winning branch (see `_set_result`).
+
+    `result` is set *before* the value becomes `State.SUCCEEDED`, so a branch or caller that
+    waited for the state reads the final result. It stays None on failure.
+    """
+
+    __slots__ = ("result",)
+
+    def __init__(self, value: Any = None, name: str | None = None) -> None:
+        super().__init__(value, name)
+        self.result: Any = None
+
+
+def _set_result(state: Fluent, result: Any) -> None:
+    """Record the winning branch's return value on `state` (if undecided and it can hold one)."""
+    if state.get_value() is None and isinstance(state, StateFluent):
+        state.result = result
 
 
 def _decide(state: Fluent, outcome: State) -> None:
@@ -117,7 +141,7 @@ class _Expression(BlockForm):
             raise TypeError(f"{self.kind}(): errors must be a list, got {type(errors).__name__}")
         if state is not None and not isinstance(state, Fluent):
             raise TypeError(f"{self.kind}(): state must be a Fluent, got {type(state).__name__}")
-        state = state if state is not None else Fluent(name=name or self.kind)
+        state = state if state is not None else StateFluent(name=name or self.kind)
         self._run(fns, errors if errors is not None else [], state, name or self.kind)
         return state
 
@@ -135,14 +159,17 @@ class _BlockUse(BlockForm):
 
 def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
     with task_scope(name, "seq") as scope:
+        result = None
         for index, fn in enumerate(fns):
             try:
-                run_subtask(_label(fn, index), fn, kind="step")
+                result = run_subtask(_label(fn, index), fn, kind="step")
             except Exception as exc:
                 errors.append(exc)
                 scope.fail(exc)
                 _decide(state, State.FAILED)
                 return
+        scope.task.result = result
+        _set_result(state, result)
         _decide(state, State.SUCCEEDED)
 
 
@@ -150,10 +177,12 @@ def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: 
     with task_scope(name, "try_in_order") as scope:
         for index, fn in enumerate(fns):
             try:
-                run_subtask(_label(fn, index), fn, kind="step")
+                result = run_subtask(_label(fn, index), fn, kind="step")
             except Exception as exc:
                 errors.append(exc)
                 continue
+            scope.task.result = result
+            _set_result(state, result)
             _decide(state, State.SUCCEEDED)
             return
         scope.fail(errors[-1] if errors else RuntimeError(f"{name}: no alternatives"))
@@ -184,6 +213,7 @@ class _Concurrent:
         self.succeeded = 0
         self.failed = 0
         self.count = 0
+        self.group: TaskGroup | None = None
 
     def on_end(self, task: Task) -> None:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
@@ -206,27 +236,34 @@ class _Concurrent:
             if status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
             elif self.succeeded == self.count:
+                self.result = [t.result for t in self.group.tasks]  # every branch's, in branch order
                 self._decide(State.SUCCEEDED)
         elif kind == "try_all":
             if status is TaskStatus.SUCCEEDED:
+                self.result = task.result
                 self._decide(State.SUCCEEDED)
             elif ended == self.count:
                 self._decide(State.FAILED)
         elif kind == "pursue":
             if status is TaskStatus.SUCCEEDED:
+                self.result = task.result
                 self._decide(State.SUCCEEDED)
             elif status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
 
+    result: Any = None  #: the winning branch's return value (par: all branches' in order)
+
     def _decide(self, outcome: State) -> None:
         if self.outcome is None:
             self.outcome = outcome
+            if outcome is State.SUCCEEDED:
+                _set_result(self.state, self.result)
             _decide(self.state, outcome)
 
     def run(self, fns: Sequence[Branch], name: str, deadline: float | None = None) -> bool:
         """Run the branches; returns False if `deadline` [s] passed before an outcome."""
         self.count = len(fns)
-        group = TaskGroup(self.on_end)
+        group = self.group = TaskGroup(self.on_end)
         with shielded():  # never leave a started thread behind half-registered
             for index, fn in enumerate(fns):
                 group.spawn(_label(fn, index), fn)
@@ -253,6 +290,8 @@ def _concurrent_runner(kind: str) -> Callable[[Sequence[Branch], list, Fluent, s
                 engine.run(fns, name)
             if engine.outcome is State.FAILED:
                 scope.fail(engine.first_error or engine.retry or RuntimeError(f"{name} failed"))
+            else:
+                scope.task.result = engine.result
         if engine.retry is not None:
             raise engine.retry  # a branch called retry(): restart the enclosing failure_handling
 
@@ -278,6 +317,46 @@ pursue = _Expression(
 )
 
 
+def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Branch]:
+    if not callable(body):
+        raise TypeError(f"{form}(): body must be a callable taking one item, got {type(body).__name__}: {body!r}")
+    try:
+        items = list(items)
+    except TypeError:
+        raise TypeError(f"{form}(): items must be iterable, got {type(items).__name__}: {items!r}") from None
+    branches = []
+    for index, item in enumerate(items):
+        def branch(item: Any = item) -> Any:
+            return body(item)
+
+        branch.__pycram_name__ = f"{index + 1}:{item!r}"[:60]  # type: ignore[attr-defined]
+        branches.append(branch)
+    return branches
+
+
+def try_each_in_order(items: Any, body: Callable[[Any], Any], errors: list | None = None,
+                      name: str | None = None, state: Fluent | None = None) -> Fluent:
+    """`try_in_order` over `body(item)` for each item (CRAM's `try-each-in-order`).
+
+    Calls `body(item)` for the items in order until one returns without raising; returns the
+    state fluent, whose `result` is that call's return value. FAILED (with every failure in
+    `errors`, in order) when all calls fail or `items` is empty.
+    """
+    branches = _item_branches(items, body, "try_each_in_order")
+    return try_in_order(*branches, errors=errors, state=state, name=name or "try_each_in_order")
+
+
+def par_loop(items: Any, body: Callable[[Any], Any], errors: list | None = None,
+             name: str | None = None, state: Fluent | None = None) -> Fluent:
+    """`par` over `body(item)` for each item (CRAM's `par-loop`): one branch per item.
+
+    SUCCEEDED when every call returned — `result` is then the list of return values in item
+    order; the first failure evaporates the other branches (as `par`).
+    """
+    branches = _item_branches(items, body, "par_loop")
+    return par(*branches, errors=errors, state=state, name=name or "par_loop")
+
+
 def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: str | None = None) -> Fluent:
     """Run `fn` as a task; evaporate it if it has not ended after `seconds` [s] of the active clock.
 
@@ -289,7 +368,7 @@ def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: s
         raise TypeError(f"with_timeout(): fn must be callable, got {type(fn).__name__}")
     errors = errors if errors is not None else []
     label = name or f"with_timeout({seconds:g} s)"
-    state = Fluent(name=label)
+    state = StateFluent(name=label)
     engine = _Concurrent("pursue", errors, state)
     with task_scope(label, "with_timeout") as scope:
         if not engine.run([fn], label, deadline=seconds):

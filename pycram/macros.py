@@ -131,10 +131,10 @@ def expression(form: str) -> Callable[..., Any]:
 
 
 def new_state(name: str) -> Any:
-    """A fresh, unset state Fluent for a block's `as` target."""
-    from pycram.fluent import Fluent
+    """A fresh, unset state fluent (holding the winning branch's `result`) for a block's `as` target."""
+    from pycram.language import StateFluent
 
-    return Fluent(None, name)
+    return StateFluent(None, name)
 
 
 def retry_function() -> Callable[[], Any]:

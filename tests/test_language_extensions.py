@@ -1,0 +1,138 @@
+"""Issue 18: results on state fluents, try_each_in_order, par_loop (and the later additions)."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from pycram.fluent import Fluent
+from pycram.language import (State, StateFluent, par, par_loop, plan, pursue, seq, try_all,
+                             try_each_in_order, try_in_order, with_timeout)
+from pycram.runtime import Evaporated, current_task, sleep
+
+TIMEOUT = 5.0
+
+
+class Boom(Exception):
+    pass
+
+
+def boom() -> None:
+    raise Boom()
+
+
+# -- 1. results ------------------------------------------------------------------------------------
+
+
+def test_seq_result_is_the_last_step_value() -> None:
+    state = seq(lambda: 1, lambda: 2)
+    assert isinstance(state, StateFluent) and state.result == 2
+
+
+def test_try_in_order_result_is_the_first_success() -> None:
+    state = try_in_order(boom, lambda: "b", lambda: "c")
+    assert state.get_value() is State.SUCCEEDED and state.result == "b"
+
+
+def test_par_result_lists_every_branch_in_order() -> None:
+    done = Fluent()
+
+    def slow() -> str:
+        done.wait_for(TIMEOUT)
+        return "slow"
+
+    def fast() -> str:
+        done.set_value(True)
+        return "fast"
+
+    state = par(slow, fast)
+    assert state.result == ["slow", "fast"]
+
+
+def test_pursue_and_try_all_result_is_the_winner() -> None:
+    never = Fluent()
+    assert pursue(lambda: never.wait_for(), lambda: "won").result == "won"
+    assert try_all(boom, lambda: "won", lambda: never.wait_for()).result == "won"
+
+
+def test_failed_expression_has_no_result() -> None:
+    assert seq(lambda: 1, boom).result is None
+    assert par(lambda: 1, boom).result is None
+
+
+def test_result_is_set_before_the_state_is_decided() -> None:
+    seen = []
+    state = StateFluent()
+
+    def watcher() -> None:
+        state.wait_for(TIMEOUT)
+        seen.append(state.result)
+
+    t = threading.Thread(target=watcher)
+    t.start()
+    try_all(lambda: 42, state=state)
+    t.join(TIMEOUT)
+    assert seen == [42]
+
+
+def test_with_timeout_result() -> None:
+    assert with_timeout(5, lambda: "x").result == "x"
+
+
+def test_block_syntax_state_has_the_result() -> None:
+    @plan
+    def run() -> StateFluent:
+        with par as s:
+            1
+            2
+        return s
+
+    assert run().get_value() is State.SUCCEEDED
+
+
+# -- try_each_in_order / par_loop ------------------------------------------------------------------
+
+
+def test_par_loop_runs_concurrently_and_collects_results() -> None:
+    barrier = threading.Barrier(3, timeout=TIMEOUT)
+
+    def body(item: int) -> int:
+        barrier.wait()  # passes only if all three run at once
+        return item * 2
+
+    state = par_loop([1, 2, 3], body)
+    assert state.get_value() is State.SUCCEEDED and state.result == [2, 4, 6]
+
+
+def test_par_loop_failure_evaporates_the_others() -> None:
+    never = Fluent()
+    finished = []
+
+    def body(item: int) -> None:
+        if item == 1:
+            raise Boom()
+        never.wait_for()
+        finished.append(item)
+
+    errors: list = []
+    state = par_loop([1, 2, 3], body, errors=errors)
+    assert state.get_value() is State.FAILED and finished == []
+    assert [type(e) for e in errors] == [Boom]
+
+
+def test_item_branches_are_named_after_items() -> None:
+    names = []
+    try_each_in_order(["a"], lambda item: names.append(current_task().name))
+    assert names == ["1:'a'"]
+
+
+def test_bad_items_and_body_raise_clear_errors() -> None:
+    with pytest.raises(TypeError, match="items must be iterable"):
+        par_loop(3, lambda x: x)
+    with pytest.raises(TypeError, match="body must be a callable"):
+        try_each_in_order([1], 3)
+
+
+def test_try_each_in_order_empty_fails() -> None:
+    assert try_each_in_order([], lambda x: x).get_value() is State.FAILED
