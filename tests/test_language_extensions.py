@@ -136,3 +136,84 @@ def test_bad_items_and_body_raise_clear_errors() -> None:
 
 def test_try_each_in_order_empty_fails() -> None:
     assert try_each_in_order([], lambda x: x).get_value() is State.FAILED
+
+
+# -- 2. fluents ------------------------------------------------------------------------------------
+
+
+def test_on_change_is_called_with_each_new_value_and_removable() -> None:
+    f = Fluent(0)
+    seen = []
+    handle = f.on_change(seen.append)
+    f.set_value(1)
+    f.set_value(2)
+    handle.remove()
+    handle.remove()  # idempotent
+    f.set_value(3)
+    assert seen == [1, 2]
+
+
+def test_on_change_of_a_network_follows_its_inputs() -> None:
+    f = Fluent(0)
+    network = f > 2
+    seen = []
+    network.on_change(seen.append)
+    f.set_value(1)
+    f.set_value(5)
+    assert seen == [None, True]
+
+
+def test_on_change_exceptions_are_logged_not_propagated(caplog: pytest.LogCaptureFixture) -> None:
+    f = Fluent(0)
+    seen = []
+
+    def bad(value: object) -> None:
+        raise ValueError("bridge down")
+
+    f.on_change(bad)
+    f.on_change(seen.append)
+    f.set_value(1)  # does not raise
+    assert seen == [1]
+    assert "bridge down" in caplog.text
+
+
+def test_on_change_callback_runs_outside_the_fluent_lock() -> None:
+    f = Fluent(0)
+    waited = []
+    # a callback that waits on the same fluent would deadlock if the fluent's lock were held
+    f.on_change(lambda value: waited.append(f.wait_for(0.5)))
+    f.set_value(1)
+    assert waited == [True]
+
+
+def test_on_change_rejects_non_callables() -> None:
+    with pytest.raises(TypeError, match="needs a callable"):
+        Fluent().on_change(3)
+
+
+def test_changes_only_pulses_only_on_a_new_value() -> None:
+    f = Fluent(1, changes_only=True)
+    pulses = f.pulsed()
+    seen = []
+    f.on_change(seen.append)
+    f.set_value(1)
+    assert pulses.peek() is None and seen == []
+    f.set_value(2)
+    assert pulses.peek() is True and seen == [2]
+    plain = Fluent(1)
+    plain_pulses = plain.pulsed()
+    plain.set_value(1)
+    assert plain_pulses.peek() is True
+
+
+def test_peek_does_not_consume_a_pulse() -> None:
+    f = Fluent(0)
+    pulses = f.pulsed()
+    f.set_value(1)
+    assert pulses.peek() is True
+    assert pulses.peek() is True
+    runs = []
+    from pycram.fluent import STOP, whenever
+
+    whenever(pulses, lambda: runs.append(1) or STOP)
+    assert runs == [1]
