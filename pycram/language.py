@@ -40,6 +40,7 @@ from pycram.block_forms import BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
 from pycram.runtime.evaporation import Evaporated, check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
+from pycram.runtime.task_variables import TaskVariable
 
 __all__ = [
     "State",
@@ -56,6 +57,7 @@ __all__ = [
     "try_each_in_order",
     "par_loop",
     "whenever",
+    "TaskVariable",
     "Fluent",
     "Behavior",
 ]

@@ -217,3 +217,42 @@ def test_peek_does_not_consume_a_pulse() -> None:
 
     whenever(pulses, lambda: runs.append(1) or STOP)
     assert runs == [1]
+
+
+# -- 3. task variables -----------------------------------------------------------------------------
+
+from pycram.language import TaskVariable  # noqa: E402
+
+
+def test_task_variable_is_inherited_by_branches_across_threads() -> None:
+    speed = TaskVariable("speed", default=1.0)
+    seen = []
+    with speed.bound(0.5):
+        par(lambda: seen.append(speed.get()), lambda: seq(lambda: seen.append(speed.get())))
+    assert seen == [0.5, 0.5]
+    assert speed.get() == 1.0
+
+
+def test_task_variable_binding_in_a_child_is_not_seen_by_parent_or_siblings() -> None:
+    v = TaskVariable("v", default="outer")
+    seen = []
+
+    def first() -> None:
+        v.set("inner")
+        seen.append(v.get())
+
+    seq(first, lambda: seen.append(v.get()))
+    assert seen == ["inner", "outer"] and v.get() == "outer"
+
+
+def test_task_variable_restored_after_failure_and_nesting() -> None:
+    v = TaskVariable("v")
+    with v.bound(1):
+        with pytest.raises(Boom):
+            with v.bound(2):
+                assert v.get() == 2
+                raise Boom()
+        assert v.get() == 1
+    with pytest.raises(LookupError, match="'v' has no value"):
+        v.get()
+    assert v.get(default=7) == 7
