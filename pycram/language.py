@@ -40,6 +40,7 @@ from pycram.block_forms import BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
 from pycram.runtime.evaporation import Evaporated, check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
+from pycram.runtime.tags import Tags, find_task, find_tasks, tag, with_tags
 from pycram.runtime.task_variables import TaskVariable
 
 __all__ = [
@@ -58,6 +59,11 @@ __all__ = [
     "par_loop",
     "whenever",
     "TaskVariable",
+    "Tags",
+    "with_tags",
+    "tag",
+    "find_task",
+    "find_tasks",
     "Fluent",
     "Behavior",
 ]

@@ -54,3 +54,20 @@ def test_try_each_in_order_3_failure_lists_every_failure() -> None:
     assert state.get_value() is State.FAILED and state.result is None
     assert values == [1, 2, 3]
     assert [e.args[0] for e in errors] == [1, 2, 3]
+
+
+# -- with-tags ------------------------------------------------------------------------------------
+
+from pycram.language import seq, tag, with_tags  # noqa: E402
+from pycram.runtime import sleep  # noqa: E402
+
+
+def test_with_tags_1_tags_introduce_no_hidden_parallelism() -> None:
+    bag: list[str] = []
+
+    def step(name: str):
+        return tag(name, lambda: (bag.append(name), sleep(random.random() * 0.01)))
+
+    with with_tags():
+        seq(*(step(name) for name in "ABCDE"))
+    assert bag == list("ABCDE")

@@ -256,3 +256,60 @@ def test_task_variable_restored_after_failure_and_nesting() -> None:
     with pytest.raises(LookupError, match="'v' has no value"):
         v.get()
     assert v.get(default=7) == 7
+
+
+# -- 4. tags ---------------------------------------------------------------------------------------
+
+from pycram.language import Tags, find_task, find_tasks, tag, with_tags  # noqa: E402
+from pycram.runtime import TaskStatus  # noqa: E402
+
+
+def test_tagged_task_is_found_by_other_branches_and_evaporated() -> None:
+    never = Fluent()
+    after = []
+
+    def worker() -> None:
+        tag("inner", lambda: never.wait_for())()
+        after.append("worker went on")  # only the tagged task was evaporated
+
+    with with_tags() as tags:
+        state = par(worker, lambda: tags.wait_task("inner", TIMEOUT).evaporate())
+    assert state.get_value() is State.SUCCEEDED
+    assert tags["inner"].status.get_value() is TaskStatus.EVAPORATED
+    assert after == ["worker went on"]
+
+
+def test_tag_registers_at_any_depth_and_waits_for_the_end() -> None:
+    with with_tags() as tags:
+        state = par(lambda: seq(tag("deep", lambda: 41 + 1)),
+                    lambda: tags.wait_task("deep", TIMEOUT).status.IS(TaskStatus.SUCCEEDED).wait_for(TIMEOUT))
+    assert state.get_value() is State.SUCCEEDED and tags["deep"].result == 42
+    assert "deep" in tags and tags.names() == ["deep"]
+
+
+def test_tags_errors_name_the_problem() -> None:
+    tags = Tags()
+    with pytest.raises(KeyError, match="no task tagged 'x'"):
+        tags["x"]
+    with pytest.raises(TimeoutError, match="'x'"):
+        tags.wait_task("x", 0.01)
+    with pytest.raises(TypeError, match="non-empty string"):
+        tag("", lambda: None)
+
+
+def test_find_task_by_path_and_pattern() -> None:
+    paths = []
+
+    def look() -> None:
+        me = current_task()
+        paths.append(me.path)
+        root = me
+        while root.parent is not None:
+            root = root.parent
+        assert find_task(me.path, root) is me
+        assert me in find_tasks("*/lookup-here", root)
+
+    par(tag("lookup-here", look))
+    with pytest.raises(LookupError, match="no task matches"):
+        find_task("*/no-such-task")
+    assert paths and paths[0].endswith("/lookup-here")
