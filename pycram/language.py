@@ -57,6 +57,7 @@ __all__ = [
     "with_timeout",
     "try_each_in_order",
     "par_loop",
+    "partial_order",
     "whenever",
     "TaskVariable",
     "Tags",
@@ -500,3 +501,8 @@ def __getattr__(name: str) -> Any:
 
         return plan
     raise AttributeError(f"module 'pycram.language' has no attribute {name!r}")
+
+
+# -- expressions built on the ones above (imported last: they import this module) ------------------
+
+from pycram.partial_order import partial_order  # noqa: E402

@@ -108,7 +108,7 @@ except ImportError:  # pragma: no cover - only before block_forms exists
 
 EXPRESSION_FORMS: tuple[str, ...] = ("seq", "par", "pursue", "try_all", "try_in_order")
 """Block forms whose statements become branches of a language expression."""
-FORMS: tuple[str, ...] = EXPRESSION_FORMS + ("failure_handling", "whenever")
+FORMS: tuple[str, ...] = EXPRESSION_FORMS + ("failure_handling", "whenever", "partial_order")
 """Every block form the transform knows."""
 PYCRAM_MODULES: tuple[str, ...] = ("pycram.language", "pycram.fluent", "pycram")
 """Modules whose form objects are recognised (a module opts in by importing from one)."""
@@ -493,6 +493,8 @@ class _Transformer:
                     return self.whenever(form, scope)
                 if form.name == "failure_handling":
                     return self.failure_handling(form, scope)
+                if form.name == "partial_order":
+                    return self.partial_order(form, scope)
                 return self.expression(form, scope)
         for name in ("body", "orelse", "finalbody"):
             value = getattr(stmt, name, None)
@@ -698,6 +700,22 @@ class _Transformer:
             )
         )
         out += self._located([call], node)
+        return out
+
+    def partial_order(self, form: _Form, scope: _Scope) -> list[ast.stmt]:
+        """`with partial_order(orderings[, errors]) as s:` — each statement is step 1, 2, ...;
+        generated as `expression("partial_order")([b1, b2, ...], orderings, errors=..., state=s)`."""
+        orderings = form.args[0] if form.args else None
+        rest = form.args[1:]
+        keywords = [k for k in form.keywords if k.arg != "orderings"]
+        orderings = orderings or next((k.value for k in form.keywords if k.arg == "orderings"), None)
+        if orderings is None:
+            raise self.error(form.node, "`with partial_order(orderings) as s:` needs the orderings, e.g. [(1, 2)]")
+        stripped = _Form(form.name, form.node, rest, keywords, form.target)
+        out = self.expression(stripped, scope)
+        call = out[-1].value  # type: ignore[attr-defined]
+        call.args = [ast.List(elts=call.args, ctx=ast.Load()), orderings]
+        self._located([out[-1]], form.node)
         return out
 
     def failure_handling(self, form: _Form, scope: _Scope) -> list[ast.stmt]:

@@ -71,3 +71,47 @@ def test_with_tags_1_tags_introduce_no_hidden_parallelism() -> None:
     with with_tags():
         seq(*(step(name) for name in "ABCDE"))
     assert bag == list("ABCDE")
+
+
+# -- partial-order --------------------------------------------------------------------------------
+
+from pycram.language import partial_order  # noqa: E402
+
+
+def _worker(name: str, times: dict, clock=itertools.count()):
+    def work() -> None:
+        sleep(random.random() * 0.02)
+        times[name] = next(clock)  # a global order of the end times
+
+    return tag(name, work)
+
+
+def test_partial_order_1_one_task_directly_depends_on_another() -> None:
+    times: dict = {}
+    state = partial_order([_worker("worker-1", times), _worker("worker-2", times)], [("worker-1", "worker-2")])
+    assert state.get_value() is State.SUCCEEDED
+    assert times["worker-1"] < times["worker-2"]
+
+
+def test_partial_order_2_sequential_ordering_of_three_tasks() -> None:
+    times: dict = {}
+    partial_order([_worker(f"worker-{i}", times) for i in (1, 2, 3)],
+                  [("worker-1", "worker-3"), ("worker-3", "worker-2")])
+    assert times["worker-1"] < times["worker-3"] < times["worker-2"]
+
+
+def test_partial_order_3_task_constrained_by_two_parallel_tasks() -> None:
+    times: dict = {}
+    partial_order([_worker(f"worker-{i}", times) for i in (1, 2, 3)],
+                  [("worker-1", "worker-3"), ("worker-2", "worker-3")])
+    assert times["worker-1"] < times["worker-3"] and times["worker-2"] < times["worker-3"]
+
+
+def test_partial_order_4_ring_dependencies_are_rejected_instead_of_deadlocking() -> None:
+    # CRAM: "Ring dependencies in orderings will always lead to deadlocks" (the test expects a
+    # hang). PyCRAM refuses the cycle before anything runs.
+    ran = []
+    with pytest.raises(ValueError, match="cycle"):
+        partial_order([tag("worker-1", lambda: ran.append(1)), tag("worker-2", lambda: ran.append(2))],
+                      [("worker-1", "worker-2"), ("worker-2", "worker-1")])
+    assert ran == []

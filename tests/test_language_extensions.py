@@ -313,3 +313,60 @@ def test_find_task_by_path_and_pattern() -> None:
     with pytest.raises(LookupError, match="no task matches"):
         find_task("*/no-such-task")
     assert paths and paths[0].endswith("/lookup-here")
+
+
+# -- 5. partial orders -----------------------------------------------------------------------------
+
+from pycram.language import partial_order  # noqa: E402
+
+
+def test_partial_order_failure_evaporates_waiting_and_running_steps() -> None:
+    never = Fluent()
+    started = []
+    errors: list = []
+    state = partial_order(
+        {"fails": boom, "waits": lambda: never.wait_for(), "later": lambda: started.append("later")},
+        [("fails", "later"), ("waits", "later")],
+        errors=errors,
+    )
+    assert state.get_value() is State.FAILED and started == [] and [type(e) for e in errors] == [Boom]
+
+
+def test_partial_order_fluent_constraint_and_results() -> None:
+    door = Fluent()
+    order = []
+    state = partial_order({"enter": lambda: order.append("enter") or "in", "open": lambda: door.set_value(True)},
+                          [(door, "enter")])
+    assert state.result == ["in", None] and order == ["enter"]
+
+
+def test_partial_order_bad_input_is_named() -> None:
+    with pytest.raises(ValueError, match="unknown step 'c'"):
+        partial_order({"a": lambda: 1}, [("a", "c")])
+    with pytest.raises(ValueError, match="pair"):
+        partial_order({"a": lambda: 1}, [("a",)])
+    with pytest.raises(TypeError, match="step 'a' must be a callable"):
+        partial_order({"a": 1}, [])
+
+
+def test_partial_order_block_syntax() -> None:
+    log = []
+
+    @plan
+    def run() -> StateFluent:
+        with partial_order([(2, 1)]) as s:
+            log.append("step 1")
+            log.append("step 2")
+        return s
+
+    state = run()
+    assert state.get_value() is State.SUCCEEDED
+    assert log == ["step 2", "step 1"]
+
+
+def test_partial_order_block_needs_the_syntax() -> None:
+    from pycram.block_forms import BlockSyntaxNotEnabled
+
+    with pytest.raises(BlockSyntaxNotEnabled):
+        with partial_order([(1, 2)]):
+            pass
