@@ -370,3 +370,164 @@ def test_partial_order_block_needs_the_syntax() -> None:
     with pytest.raises(BlockSyntaxNotEnabled):
         with partial_order([(1, 2)]):
             pass
+
+
+# -- 6. suspension ---------------------------------------------------------------------------------
+
+from pycram.language import (is_suspended, on_suspension, retry_after_suspension, suspend,  # noqa: E402
+                             wake_up, with_task_suspended)
+from pycram.runtime import check_evaporation, format_task_tree  # noqa: E402
+
+
+def _spawn_tagged(name: str, fn):
+    """Run `par(tags.tag(name, fn))` in a thread; returns (tags, thread, box)."""
+    tags = Tags()
+    box: dict = {}
+    thread = threading.Thread(target=lambda: box.setdefault("state", par(tags.tag(name, fn))), daemon=True)
+    thread.start()
+    return tags, thread, box
+
+
+def test_retry_after_suspension_reruns_the_body_after_wake_up() -> None:
+    go, running = Fluent(), Fluent()
+    runs = []
+    cleaned = []
+
+    def body() -> str:
+        runs.append(len(runs) + 1)
+        running.set_value(True)
+        try:
+            go.wait_for()
+        finally:
+            cleaned.append(len(runs))
+        return f"run {len(runs)}"
+
+    tags, thread, box = _spawn_tagged("t", lambda: retry_after_suspension(body))
+    task = tags.wait_task("t", TIMEOUT)
+    assert running.wait_for(TIMEOUT)
+    with with_task_suspended(task):
+        assert cleaned == [1]  # the first run was evaporated, its clean-up ran
+        go.set_value(True)
+    thread.join(TIMEOUT)
+    assert runs == [1, 2] and task.result == "run 2"
+    attempts = task.children[0].children
+    assert [t.status.get_value() for t in attempts] == [TaskStatus.EVAPORATED, TaskStatus.SUCCEEDED]
+
+
+def test_suspensions_count_and_evaporation_wakes_a_suspended_task() -> None:
+    never = Fluent()
+    tags, thread, box = _spawn_tagged("t", lambda: never.wait_for())
+    task = tags.wait_task("t", TIMEOUT)
+    suspend(task)
+    suspend(task)
+    wake_up(task)
+    assert is_suspended(task) and task.status.get_value() is TaskStatus.SUSPENDED
+    assert "‖ t [tag] suspended" in format_task_tree(task.parent.parent)
+    task.evaporate()
+    thread.join(TIMEOUT)
+    assert not thread.is_alive() and task.status.get_value() is TaskStatus.EVAPORATED
+    wake_up(task)
+    assert not is_suspended(task)
+
+
+def test_check_evaporation_is_a_suspension_point_and_hooks_run() -> None:
+    events = []
+    started, release = Fluent(), threading.Event()
+
+    def busy() -> None:
+        with on_suspension(lambda: events.append("suspended"), lambda: events.append("woken")):
+            started.set_value(True)
+            release.wait(TIMEOUT)  # plain Python: not a suspension point
+            check_evaporation()  # blocks here while suspended
+            events.append("went on")
+
+    tags, thread, box = _spawn_tagged("t", busy)
+    task = tags.wait_task("t", TIMEOUT)
+    started.wait_for(TIMEOUT)
+    suspend(task, sync=False)
+    release.set()
+    assert _status_is(task, TaskStatus.SUSPENDED)
+    assert events == ["suspended"]
+    wake_up(task)
+    thread.join(TIMEOUT)
+    assert events == ["suspended", "woken", "went on"]
+
+
+def _status_is(task, status) -> bool:
+    return task.status.IS(status).wait_for(TIMEOUT)
+
+
+def test_sync_suspend_times_out_naming_the_busy_task() -> None:
+    release = threading.Event()
+    tags, thread, box = _spawn_tagged("busy", lambda: release.wait(TIMEOUT))
+    task = tags.wait_task("busy", TIMEOUT)
+    try:
+        with pytest.raises(TimeoutError, match="busy"):
+            with with_task_suspended(task, timeout=0.05):
+                pass
+        assert not is_suspended(task)  # with_task_suspended woke it up again
+    finally:
+        release.set()
+        thread.join(TIMEOUT)
+    assert task.status.get_value() is TaskStatus.SUCCEEDED
+
+
+def test_suspend_rejects_non_tasks() -> None:
+    with pytest.raises(TypeError, match="needs a Task"):
+        suspend("head")
+    with pytest.raises(TypeError, match="needs a Task"):
+        with_task_suspended(None)
+
+
+# -- suspension of process-module executions -------------------------------------------------------
+
+from pycram.process_module import ProcessModule  # noqa: E402
+
+
+class RecordingModule(ProcessModule):
+    """Test double: `_execute` waits for `finish`; every hook call is logged."""
+
+    def __init__(self, suspension: str) -> None:
+        super().__init__(f"test-{suspension}")
+        self.suspension = suspension  # type: ignore[misc]
+        self.log: list[str] = []
+        self.started = Fluent(0)
+        self.finish = Fluent()
+
+    def _execute(self, designator: object) -> str:
+        self.log.append("execute")
+        self.started.set_value(self.started.get_value() + 1)
+        self.finish.wait_for()
+        return "moved"
+
+    def _cancel(self, designator: object) -> None:
+        self.log.append("cancel")
+
+    def _pause(self, designator: object) -> None:
+        self.log.append("pause")
+
+    def _resume(self, designator: object) -> None:
+        self.log.append("resume")
+
+
+@pytest.mark.parametrize("mode, expected", [
+    ("pause", ["execute", "pause", "resume"]),
+    ("cancel", ["execute", "cancel", "execute"]),
+])
+def test_process_module_execution_paused_or_cancelled_on_suspension(mode: str, expected: list) -> None:
+    module = RecordingModule(mode)
+    tags, thread, box = _spawn_tagged("move", lambda: module.execute("goal"))
+    task = tags.wait_task("move", TIMEOUT)
+    assert (module.started >= 1).wait_for(TIMEOUT)
+    with with_task_suspended(task):
+        assert module._current is None if mode == "cancel" else module._current is not None
+    assert (module.started >= (2 if mode == "cancel" else 1)).wait_for(TIMEOUT)
+    module.finish.set_value(True)
+    thread.join(TIMEOUT)
+    assert module.log == expected and task.result == "moved"
+
+
+def test_process_module_rejects_an_unknown_suspension_mode() -> None:
+    module = RecordingModule("halt")
+    with pytest.raises(ValueError, match="'pause' or 'cancel'"):
+        module.execute("goal")

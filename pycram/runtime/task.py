@@ -54,6 +54,7 @@ class TaskStatus(Enum):
     SUCCEEDED = "succeeded"
     FAILED = "failed"
     EVAPORATED = "evaporated"
+    SUSPENDED = "suspended"  #: blocked by `pycram.runtime.suspension` until woken up; not done
 
     @property
     def done(self) -> bool:
@@ -467,6 +468,7 @@ _STATUS_MARK = {
     TaskStatus.SUCCEEDED: "✔",
     TaskStatus.FAILED: "✘",
     TaskStatus.EVAPORATED: "~",
+    TaskStatus.SUSPENDED: "‖",
 }
 
 
