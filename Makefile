@@ -6,7 +6,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench docs check wheel clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,5 +22,20 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/language.py
 
+# The documentation site, built into site/ with warnings as errors (offline: no fonts or CDN).
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+
+# Lint, format, types and docs (not yet part of .ci/run: the tree-wide clean-up is pending).
+check: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/mypy
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+
+# Build the wheel, install it into a fresh virtual environment, run its CLI and a small plan.
+wheel: $(STAMP)
+	PYTHON=$(PY) scripts/check_wheel.sh
+
 clean:
-	rm -rf $(VENV)
+	rm -rf $(VENV) site dist

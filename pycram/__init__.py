@@ -9,7 +9,7 @@ abstraction), `pycram.sim` (the MuJoCo kitchen), `pycram.trace` (run recording).
 
 from typing import Any
 
-__version__ = "0.1.0"
+from pycram._version import __version__
 
 _LAZY = {
     "perform": "pycram.designator",

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 __all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE"]
 
+#: The error text when block syntax is used without being switched on; ``{form}`` is the block's form.
 NOT_ENABLED_MESSAGE = (
     "`with {form}:` is PyCRAM block syntax, which is not switched on for this code. "
     "Switch it on in one of three ways: decorate the enclosing function with "

@@ -2,13 +2,16 @@
 
     pycram run FILE.py [ARGS...]        run a plan script (block syntax on), recorded by default
     pycram demo [--robot pr2|tiago]...  the thesis demo in the simulated kitchen, recorded by default
-    pycram runs                         recorded runs, newest first, one line each
+    pycram runs                         recorded runs, newest first, one line each (with why they failed)
     pycram show [RUN]                   a run's task tree with statuses, durations, failures
     pycram graph [RUN] -o tree.svg      the task tree as an SVG picture
     pycram timeline [RUN] -o tl.png     which branches ran when (Gantt chart)
 
 The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
-`pycram.trace.db`). Recording for `run`/`demo` is on unless `--no-record` or `PYCRAM_RECORD=0`.
+`pycram.trace.db`); a database named with `--db` must exist for the inspecting commands, and
+one that cannot be read gives a one-line error and exit code 1. Recording for `run`/`demo` is
+on unless `--no-record` or `PYCRAM_RECORD=0`; records the database could not take are counted
+and reported at the end of the run (the plan's outcome does not depend on them).
 Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the commands that
 need them.
 """
@@ -34,6 +37,22 @@ app = typer.Typer(
 )
 console = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from pycram._version import __version__
+
+        console.print(f"pycram {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(False, "--version", help="Print PyCRAM's version and exit.",
+                                 callback=_print_version, is_eager=True),
+) -> None:
+    """PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs."""
 
 #: Runs of this many identical successful siblings are shown as one line / box / row (×N);
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
@@ -63,6 +82,34 @@ def _trace_errors(fn: Any, *args: Any, **kwargs: Any) -> Any:
         _fail(str(e))
 
 
+def _reading(db: Optional[str], fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """`_trace_errors` for the inspecting commands: a database named with `--db` must exist
+    (reading never creates one), and any database failure is a one-line error."""
+    from sqlalchemy import exc as sa_exc
+
+    from pycram.trace.db import database_error, resolve_url, sqlite_file
+
+    if db is not None and db.strip():
+        _trace_errors(resolve_url, db)  # a malformed URL is reported as such
+        path = sqlite_file(db)
+        if path is not None and not path.exists():
+            where = (f"the folder {path.parent} does not exist" if not path.parent.is_dir()
+                     else f"{path} does not exist")
+            _fail(f"no such database: {where} (`pycram run` and `pycram demo` create it when they record)")
+    try:
+        return _trace_errors(fn, *args, **kwargs)
+    except sa_exc.SQLAlchemyError as e:  # a failure no query layer translated
+        _fail(str(database_error(resolve_url(db), e, "read")))
+
+
+def _write_errors(fn: Any, *args: Any) -> Any:
+    """`fn(*args)` writing a picture: an unwritable output path is a one-line error."""
+    try:
+        return fn(*args)
+    except OSError as e:
+        _fail(f"cannot write {e.filename or 'the picture'}: {e.strerror or e}")
+
+
 def _local(when: _dt.datetime | None) -> str:
     return when.astimezone().strftime("%Y-%m-%d %H:%M:%S") if when is not None else "–"
 
@@ -83,20 +130,38 @@ def runs_command(
     plan: Optional[str] = typer.Option(None, "--plan", help="Only runs whose plan name contains this."),
     db: Optional[str] = DbOption,
 ) -> None:
-    """List recorded runs, newest first: id, start, plan, robot, outcome, duration."""
+    """List recorded runs, newest first: id, start, plan, robot, outcome, wall-clock duration
+    and why a run failed."""
+    from rich.table import Table
+
     from pycram.trace import query
     from pycram.trace.display import STATUS_STYLE, format_duration
 
-    found = _trace_errors(query.runs, db, limit or None, plan)
+    found = _reading(db, query.runs, db, limit or None, plan)
     if not found:
         err.print("no runs recorded yet (run `pycram run FILE.py` or `pycram demo`)")
         return
+    table = Table(box=None, pad_edge=False, header_style="bold")
+    for name in ("id", "started", "plan", "robot", "outcome"):
+        table.add_column(name, no_wrap=name != "plan")
+    table.add_column("took", no_wrap=True, justify="right")
+    table.add_column("reason", overflow="fold")
     for run in found:
         state = run.state
         style = STATUS_STYLE.get(state, "white")
-        console.print(f"{run.id}  {_local(run.started_at)}  {escape(run.plan or '–')}  "
-                      f"{escape(run.robot or '–')}  [{style}]{state}[/{style}]  {format_duration(run.elapsed)}",
-                      soft_wrap=True)
+        table.add_row(str(run.id), _local(run.started_at), escape(run.plan or "–"), escape(run.robot or "–"),
+                      f"[{style}]{state}[/{style}]", format_duration(run.elapsed),
+                      escape(_reason(run)))
+    console.print(table)
+
+
+def _reason(run: Any) -> str:
+    """Why the run did not succeed (its recorded error), "" for a successful run."""
+    if run.error:
+        return run.error
+    if run.state == "unfinished":
+        return "the process ended without finishing the record (killed?)"
+    return ""
 
 
 @app.command("show")
@@ -109,30 +174,42 @@ def show_command(
 ) -> None:
     """Print a run's task tree with statuses, durations and failures.
 
-    Runs of 3 or more consecutive identical successful sibling tasks (e.g. a motion repeated by
-    a `whenever` loop) are shown as one line with a count, unless --expand.
+    Every process-module execution is shown (a blocking one under the task that performed it).
+    A failure shows its error where it was raised; enclosing tasks it failed say "passed on".
+    Tree times are on the plan's clock (the header says: simulated or wall clock); the run's
+    duration and start are wall-clock. Runs of 3 or more consecutive identical successful
+    sibling tasks (e.g. a motion repeated by a `whenever` loop) are shown as one line with a
+    count, unless --expand.
     """
     from pycram.trace import query
-    from pycram.trace.display import STATUS_STYLE, format_duration, task_tree
+    from pycram.trace.display import STATUS_STYLE, clock_label, format_duration, task_tree
 
-    info = _trace_errors(query.get_run, run, db)
-    records = _trace_errors(query.tasks, info.id, db)
-    executions = _trace_errors(query.executions, info.id, url=db)
+    info = _reading(db, query.get_run, run, db)
+    records, execution_records = _reading(db, query.tree_records, info.id, db)
+    executions = _reading(db, query.executions, info.id, url=db)
     state = info.state
     style = STATUS_STYLE.get(state, "white")
     title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
-             f"[{style}]{state}[/{style}] · {format_duration(info.elapsed)} · started {_local(info.started_at)}")
-    tree, tasks_shown = task_tree(title, records, expand=expand, max_nodes=max_nodes)
+             f"[{style}]{state}[/{style}] · took {format_duration(info.elapsed)} (wall-clock) · "
+             f"started {_local(info.started_at)}\n[grey50]times in the tree: {escape(clock_label(info.clock))}[/grey50]")
+    shown_records = records + execution_records
+    tree, shown = task_tree(title, shown_records, expand=expand, max_nodes=max_nodes)
     console.print(tree)
-    failed = sum(1 for r in records if r.status == "failed")
-    summary = f"{len(records)} tasks, {failed} failed"
+    failed = [r for r in records if r.status == "failed"]
+    raised = sum(1 for r in failed if not r.propagated)
+    summary = f"{len(records)} tasks, {len(failed)} failed"
+    if raised < len(failed):
+        summary += f" ({raised} where the error was raised, {len(failed) - raised} passing it on)"
     if executions:
         summary += f", {len(executions)} process-module executions"
-    if tasks_shown < len(records):
-        summary += f" ({len(records) - tasks_shown} not shown; raise --max-nodes)"
+    if shown < len(shown_records):
+        summary += f" ({len(shown_records) - shown} not shown; raise --max-nodes)"
     console.print(summary)
     if info.error:
         console.print(f"[red]{escape(info.error)}[/red]")
+    if info.lost_records:
+        console.print(f"[yellow]{info.lost_records} trace records of this run could not be written: "
+                      "the tree may be incomplete[/yellow]")
 
 
 @app.command("graph")
@@ -145,7 +222,7 @@ def graph_command(
     """Draw a run's task tree as an SVG picture (identical successful siblings: one box ×N)."""
     from pycram.trace.pictures import write_tree_svg
 
-    path = _trace_errors(write_tree_svg, run, output, db, 0 if expand else _COLLAPSE)
+    path = _reading(db, _write_errors, write_tree_svg, run, output, db, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 
@@ -161,7 +238,7 @@ def timeline_command(
     siblings share a row) as a PNG picture."""
     from pycram.trace.pictures import write_timeline_png
 
-    path = _trace_errors(write_timeline_png, run, output, db, max_rows, 0 if expand else _COLLAPSE)
+    path = _reading(db, _write_errors, write_timeline_png, run, output, db, max_rows, 0 if expand else _COLLAPSE)
     console.print(f"wrote {path}")
 
 
@@ -213,6 +290,9 @@ def run_command(
             _robot_from_active(recorder)
             run_id = recorder.finish(outcome, error)
             err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+            if recorder.lost_records:
+                err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
+                          soft_wrap=True)
     raise typer.Exit(code)
 
 

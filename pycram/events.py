@@ -49,7 +49,10 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
+#: Topic published once per ``perform`` call; fields ``designator``, ``solution``, ``error``.
 DESIGNATOR_PERFORMED = "designator.performed"
+#: Topic published once per started process-module execution; fields ``module``, ``designator``,
+#: ``outcome``, ``start``, ``end`` (active clock [s]), ``error``.
 PROCESS_MODULE_EXECUTED = "process_module.executed"
 
 Callback = Callable[..., None]

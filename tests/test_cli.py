@@ -86,7 +86,10 @@ def _invoke(*args: str):
     return result
 
 
-def test_run_records_by_default_and_inspection_commands(db, plan_file, tmp_path):
+def test_run_records_by_default_and_inspection_commands(db, plan_file, tmp_path, monkeypatch):
+    import pycram.cli
+
+    monkeypatch.setattr(pycram.cli.console, "width", 200)  # one line per tree line and per run
     result = _invoke("run", str(plan_file), "x", "--y")
     assert result.exit_code == 0, result.output
     assert "script args ['x', '--y']" in result.output
@@ -96,9 +99,11 @@ def test_run_records_by_default_and_inspection_commands(db, plan_file, tmp_path)
     result = _invoke("runs")
     assert result.exit_code == 0
     lines = [line for line in result.output.splitlines() if line.strip()]
-    assert len(lines) == 2
-    assert lines[0].startswith("2 ") and "plan.py" in lines[0] and "failed" in lines[0]
-    assert lines[1].startswith("1 ") and "succeeded" in lines[1]
+    assert len(lines) == 3
+    assert lines[0].split() == ["id", "started", "plan", "robot", "outcome", "took", "reason"]
+    assert lines[1].startswith("2 ") and "plan.py" in lines[1] and "failed" in lines[1]
+    assert lines[1].rstrip().endswith("SystemExit: 3")  # the reason column
+    assert lines[2].startswith("1 ") and "succeeded" in lines[2]
 
     result = _invoke("show")  # the newest run
     assert result.exit_code == 0
@@ -131,7 +136,7 @@ def test_no_record_flag_and_environment(db, plan_file, monkeypatch):
     result = _invoke("runs")
     assert "no runs recorded" in result.output
     assert _invoke("run", str(plan_file), "--record").exit_code == 0  # the flag beats the env
-    assert _invoke("runs").output.startswith("1 ")
+    assert _invoke("runs").output.splitlines()[1].startswith("1 ")
 
 
 def test_unknown_run_and_bad_database_are_clear_errors(db):
@@ -219,7 +224,7 @@ def test_console_script_subprocess(tmp_path, plan_file):
     assert out.returncode == 0, out.stderr
     assert "recorded as run 1" in out.stderr
     out = subprocess.run([*command, "runs"], capture_output=True, text=True, env=env, cwd=REPO, timeout=60)
-    assert out.returncode == 0 and out.stdout.startswith("1 "), out.stderr
+    assert out.returncode == 0 and out.stdout.splitlines()[1].startswith("1 "), out.stderr
 
 
 def test_repeated_siblings_are_collapsed_in_displays_not_in_the_data(db, tmp_path, monkeypatch):
@@ -273,8 +278,8 @@ def test_db_option_names_the_database(tmp_path, plan_file, monkeypatch):
     assert _invoke("run", str(plan_file), "--db", f"sqlite:///{other}", "--plan", "by option",
                    "--robot", "pr2").exit_code == 0
     assert other.exists() and not (tmp_path / "env.sqlite3").exists()
-    line = _invoke("runs", "--db", str(other)).output.splitlines()[0]  # a bare path works too
-    fields = line.split("  ")
+    line = _invoke("runs", "--db", str(other)).output.splitlines()[1]  # a bare path works too
+    fields = [field.strip() for field in line.split("  ") if field.strip()]
     assert fields[0] == "1" and fields[2:5] == ["by option", "pr2", "succeeded"]
     assert "no runs recorded" in _invoke("runs").output  # $PYCRAM_DB_URL: nothing there
     assert not (tmp_path / "env.sqlite3").exists()  # reading created nothing

@@ -65,6 +65,7 @@ class DemoResult:
     files: list[Path] = field(default_factory=list)
     tree_text: str = ""  # the plan's task tree as plain text, one line per task
     plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
+    trace_loss: str | None = None  # "N trace records could not be written: why", if any were lost
 
     @property
     def speed_factor(self) -> float:
@@ -152,9 +153,11 @@ def run_demo(options: DemoOptions) -> DemoResult:
     finally:
         result.wall_time = time.monotonic() - started_wall
         if recorder is not None:
-            result.run_id = recorder.finish("succeeded" if result.exit_code == 0 else "failed")
+            ok = result.exit_code == 0
+            result.run_id = recorder.finish("succeeded" if ok else "failed", None if ok else result.message)
+            result.trace_loss = recorder.loss_report()
     if recorder is not None:
-        result.files.extend(_write_run_pictures(result.run_id, output, recorder))
+        result.files.extend(_write_run_pictures(result, recorder))
     return result
 
 
@@ -306,12 +309,23 @@ def _start_recorder(options: DemoOptions, plan_name: str) -> Any:
     return start_recording(url=options.db, plan=plan_name)
 
 
-def _write_run_pictures(run_id: Any, output: Path, recorder: Any) -> list[Path]:
+def _write_run_pictures(result: DemoResult, recorder: Any) -> list[Path]:
+    """The task-tree SVG and timeline PNG of the recorded run; drawn from the plan's task in
+    memory when the trace database cannot be read (a broken database never fails the demo)."""
     try:
-        from pycram.trace.pictures import write_run_pictures
+        from pycram.trace.db import TraceDatabaseError
+        from pycram.trace.pictures import write_run_pictures, write_task_pictures
+        from pycram.trace.query import RunNotFound
     except ImportError:
         return []
-    return list(write_run_pictures(run_id, output, url=recorder.url))
+    try:
+        return list(write_run_pictures(result.run_id, result.output, url=recorder.url))
+    except (TraceDatabaseError, RunNotFound) as error:
+        log.warning("cannot read run %s back from the trace database (%s); drawing the pictures "
+                    "from memory", result.run_id, error)
+    if result.plan_task is None:
+        return []
+    return list(write_task_pictures(result.plan_task, result.output))
 
 
 def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions) -> str:
@@ -386,9 +400,10 @@ class _ProgressLine:
         self._live.__exit__(*exc)
 
 
-def _task_tree_display(result: DemoResult) -> Any:
+def _task_tree_display(result: DemoResult, url: str | None) -> Any:
     """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
-    on one line), or as plain text when the trace extra is not installed."""
+    on one line, with the blocking process-module executions when the run was recorded), or as
+    plain text when the trace extra is not installed."""
     if result.plan_task is None:
         return "(the plan did not start)"
     try:
@@ -396,8 +411,24 @@ def _task_tree_display(result: DemoResult) -> Any:
         from pycram.trace.query import records_from_task
     except ImportError:
         return result.tree_text
-    tree, _ = task_tree("[bold]Task tree[/bold]", records_from_task(result.plan_task))
+    records = records_from_task(result.plan_task)
+    if result.run_id is not None:
+        records += _recorded_executions(result.run_id, url, records)
+    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", records)
     return tree
+
+
+def _recorded_executions(run_id: Any, url: str | None, records: list) -> list:
+    """The recorded process-module executions below the plan's tasks (none if unreadable)."""
+    from pycram.trace import query
+
+    ids = {r.task_id for r in records}
+    try:
+        executions = [x for x in query.executions(run_id, url=url) if x.task_id in ids]
+    except (query.TraceDatabaseError, query.RunNotFound) as error:
+        log.warning("cannot read the process-module executions of run %s: %s", run_id, error)
+        return []
+    return query.execution_nodes(records, executions)
 
 
 @functools.cache
@@ -438,13 +469,16 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
         return 2
     console.print()
-    console.print(_task_tree_display(result))
+    console.print(_task_tree_display(result, options.db))
     console.print(f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
                   f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s")
     console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")
     console.print(f"pictures in {result.output.resolve()}: " + ", ".join(p.name for p in result.files))
     if result.run_id is not None:
         console.print(f"recorded as run {result.run_id} (see `pycram show {result.run_id}`)")
+    if result.trace_loss:
+        console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]",
+                      highlight=False)
     colour = "green" if result.exit_code == 0 else "red"
     verdict = "SUCCESS" if result.exit_code == 0 else "FAILURE"
     console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")

@@ -47,6 +47,7 @@ __all__ = [
 
 logger = logging.getLogger("pycram.designator")
 
+#: One designator property: a ``(key, value)`` pair.
 Property = tuple[Any, Any]
 
 

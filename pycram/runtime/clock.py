@@ -17,9 +17,10 @@ import itertools
 import threading
 import time
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Callable, Iterator
 
-__all__ = ["Clock", "WallClock", "ManualClock", "current_clock", "use_clock", "set_clock"]
+__all__ = ["Clock", "WallClock", "ManualClock", "current_clock", "use_clock", "set_clock",
+           "add_clock_listener", "remove_clock_listener"]
 
 
 class Clock:
@@ -30,7 +31,12 @@ class Clock:
     `wait(condition, deadline)` in a loop that re-checks its predicate and `now() >= deadline`,
     then `unregister(handle)`. `wait` is called with `condition` held and must release it while
     blocking (as `threading.Condition.wait` does); spurious wake-ups are allowed.
+
+    `kind` says what its times mean to a reader of a trace: "wall-clock", "simulated" ("custom"
+    for a subclass that does not say).
     """
+
+    kind = "custom"
 
     def now(self) -> float:
         """The current time [s]."""
@@ -50,6 +56,8 @@ class Clock:
 
 class WallClock(Clock):
     """The monotonic wall clock (`time.monotonic`); deadlines use the native condition time-out."""
+
+    kind = "wall-clock"
 
     def now(self) -> float:
         return time.monotonic()
@@ -72,7 +80,11 @@ class ManualClock(Clock):
     `advance_to(t)` is thread-safe and notifies every registered waiter whose deadline is at or
     before `t`. A timed wait on a `ManualClock` that nobody advances blocks until something else
     wakes the waiter (a fluent change or evaporation) — it never busy-waits.
+
+    Its `kind` is "simulated": its time is what a simulation (or a test) says it is.
     """
+
+    kind = "simulated"
 
     def __init__(self, start: float = 0.0) -> None:
         self._now = float(start)
@@ -131,6 +143,23 @@ class ManualClock(Clock):
 
 _WALL_CLOCK = WallClock()
 _active_clock: Clock = _WALL_CLOCK
+_clock_listeners: tuple[Callable[[Clock], None], ...] = ()
+_listeners_lock = threading.Lock()
+
+
+def add_clock_listener(listener: Callable[[Clock], None]) -> None:
+    """Call `listener(new_clock)` whenever `set_clock` changes the active clock (in the thread
+    that changed it; keep it short and never block -- a trace recorder notes the clock kind)."""
+    global _clock_listeners
+    with _listeners_lock:
+        _clock_listeners = (*_clock_listeners, listener)
+
+
+def remove_clock_listener(listener: Callable[[Clock], None]) -> None:
+    """Stop calling `listener` (no error if it was not added)."""
+    global _clock_listeners
+    with _listeners_lock:
+        _clock_listeners = tuple(x for x in _clock_listeners if x != listener)
 
 
 def current_clock() -> Clock:
@@ -143,6 +172,9 @@ def set_clock(clock: Clock | None) -> Clock:
     global _active_clock
     previous = _active_clock
     _active_clock = clock if clock is not None else _WALL_CLOCK
+    if _active_clock is not previous:
+        for listener in _clock_listeners:
+            listener(_active_clock)
     return previous
 
 

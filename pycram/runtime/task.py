@@ -49,6 +49,8 @@ __all__ = [
 
 
 class TaskStatus(Enum):
+    """Life cycle of a task: CREATED -> RUNNING -> SUCCEEDED / FAILED / EVAPORATED."""
+
     CREATED = "created"
     RUNNING = "running"
     SUCCEEDED = "succeeded"

@@ -14,6 +14,7 @@ import mujoco
 
 from . import collision
 
+#: Height of the kitchen counters' tops [m].
 COUNTER_HEIGHT = 0.9  # [m]
 
 
@@ -46,6 +47,8 @@ WALLS = (
     Box("wall_left", (-1.2, 1.0, 1.1), (0.05, 2.7, 1.1), (0.93, 0.92, 0.88, 1)),
     Box("fridge", (1.75, -1.25, 0.9), (0.35, 0.35, 0.9), (0.75, 0.78, 0.8, 1)),
 )
+#: The kitchen's cookers (name, centre of the hob [m], radius [m]); the demo carries the item
+#: from cooker #2 to cooker #1.
 COOKERS = (
     Cooker("cooker #1", (-0.72, 1.9, COUNTER_HEIGHT), 0.11),
     Cooker("cooker #2", (0.1, -1.2, COUNTER_HEIGHT), 0.11),

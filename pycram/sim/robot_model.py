@@ -17,10 +17,12 @@ from . import collision
 from .assets import urdf_text
 from .errors import UnknownNameError
 
+#: Names of the robots the simulator can load.
 ROBOTS = ("pr2", "tiago")
 
 #: Names of the base joints added on the mount body.
 BASE_JOINTS = ("base_x", "base_y", "base_yaw")
+#: Name of the MuJoCo camera mounted on each robot's head.
 HEAD_CAMERA = "head_camera"
 
 

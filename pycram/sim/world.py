@@ -44,6 +44,7 @@ from .types import Outcome, Pose, Pose2D, VisibleItem
 
 _log = logging.getLogger(__name__)
 
+#: Where the robot's base starts: (x [m], y [m], yaw [rad]).
 DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)  # [m, m, rad] on the free floor between the counters
 #: Clocks of closed worlds -> the clock that was active before each (to skip them when restoring).
 _CLOSED_CLOCKS: "weakref.WeakKeyDictionary[ManualClock, Any]" = weakref.WeakKeyDictionary()

@@ -7,7 +7,8 @@ starts, a query runs or a picture is drawn (the `db` extra).
   record the task tree, performed designators, process-module executions and watched fluents
   of a run; `recording_enabled(default)` reads `$PYCRAM_RECORD`; `watch(fluent, name)` records a
   fluent in every active recorder (no-op when nothing records).
-- `pycram.trace.query`: runs, tasks, failures and durations across runs.
+- `pycram.trace.query`: runs, tasks, failures (each counted once, where it was raised) and
+  durations across runs; the process-module executions of a task tree.
 - `pycram.trace.pictures`: task-tree SVG, timeline (Gantt) PNG, `write_run_pictures`.
 - `pycram.trace.db`: URLs (`$PYCRAM_DB_URL`, default SQLite file), schema, `TraceDatabaseError`.
 """

@@ -9,10 +9,17 @@ Guarantees
   (`$PYCRAM_HOME`, else `$XDG_DATA_HOME/pycram`, else `~/.local/share/pycram`), whose folder
   is created on demand (when recording; reading a missing SQLite file creates nothing).
   A bare file path (given or in `$PYCRAM_DB_URL`) means that SQLite file.
+- Supported database kinds: SQLite (`sqlite:///relative.sqlite3`, `sqlite:////absolute.sqlite3`,
+  or a bare file path) and PostgreSQL (`postgresql://user:password@host:5432/database`, driven
+  by psycopg 3, which the `db` extra ships). Other kinds (MySQL, ...) are refused, saying so.
 - `connect(url)` returns an engine whose connection was tested and whose schema exists. It
   raises `TraceDatabaseError` naming the URL (password hidden) and what is wrong for
-  malformed URLs, unknown database kinds, missing drivers and unreachable servers.
-- Schema creation is idempotent and safe when several processes create it at once.
+  malformed URLs (a non-numeric port, `sqlite:/x` with too few slashes), unsupported
+  database kinds, missing drivers, unreachable servers and files that are not databases.
+- Schema creation is idempotent and safe when several processes create it at once. A
+  database written by an older PyCRAM is migrated on connect: missing columns are added
+  (`ALTER TABLE ... ADD COLUMN`, NULL in old rows); when that is impossible (a read-only file),
+  readers still work (see `present_columns`).
 - SQLite databases use write-ahead logging (WAL) and `synchronous=NORMAL`: a committed batch
   survives the writing process being killed (SIGKILL); readers never block the writer.
 """
@@ -21,7 +28,9 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import threading
+import weakref
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +53,16 @@ __all__ = [
     "designators_table",
     "executions_table",
     "fluent_samples_table",
+    "present_columns",
+    "SUPPORTED_KINDS",
 ]
 
-SCHEMA_VERSION = 1
+#: 2: `pycram_tasks.error_origin`, `pycram_runs.clock` and `pycram_runs.lost_records` (added to
+#: older databases on connect).
+SCHEMA_VERSION = 2
+
+#: Database kinds (SQLAlchemy backend names) that can hold run traces.
+SUPPORTED_KINDS = ("sqlite", "postgresql")
 
 
 class TraceDatabaseError(RuntimeError):
@@ -64,11 +80,26 @@ def default_folder() -> Path:
     return Path.home() / ".local" / "share" / "pycram"
 
 
+#: `kind:` at the start of a URL (two letters at least, so that `C:\\x.db` stays a path).
+_SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]+):")
+
+
 def _path_as_url(url: str) -> str:
     """A bare filesystem path (no `://`, ending in .sqlite/.sqlite3/.db or containing a path
-    separator) as a SQLite URL; anything else unchanged."""
-    if "://" not in url and (url.endswith((".sqlite", ".sqlite3", ".db")) or os.sep in url):
-        return f"sqlite:///{Path(url).expanduser().resolve()}"
+    separator) as a SQLite URL; anything else unchanged.
+
+    Raises `TraceDatabaseError` for a URL whose kind is not followed by `://` (e.g.
+    `sqlite:/relative.db`), instead of taking it for a path in a folder named `sqlite:`.
+    """
+    if "://" not in url:
+        scheme = _SCHEME.match(url)
+        if scheme is not None:
+            raise TraceDatabaseError(
+                f"invalid database URL {url!r}: a URL needs '://' after its kind {scheme.group(1)!r} "
+                "(sqlite:///relative/path.sqlite3 for a file below the current folder, "
+                "sqlite:////absolute/path.sqlite3 for an absolute one, or just the file's path)")
+        if url.endswith((".sqlite", ".sqlite3", ".db")) or os.sep in url:
+            return f"sqlite:///{Path(url).expanduser().resolve()}"
     return url
 
 
@@ -94,7 +125,7 @@ def sqlite_file(url: str | None) -> Path | None:
     SQLite and unparsable URLs."""
     try:
         parsed = sa.make_url(resolve_url(url))
-    except sa_exc.ArgumentError:
+    except (sa_exc.ArgumentError, TraceDatabaseError, ValueError):
         return None
     if parsed.get_backend_name() != "sqlite":
         return None
@@ -113,8 +144,10 @@ def display_url(url: str | URL) -> str:
         return str(url)
 
 
+#: SQLAlchemy metadata holding the trace tables (all named ``pycram_*``).
 metadata = sa.MetaData()
 
+#: One row per recorded run: plan, robot, start/end, outcome.
 runs_table = sa.Table(
     "pycram_runs", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -132,8 +165,13 @@ runs_table = sa.Table(
     sa.Column("clock_origin", sa.Float),  # active clock at the start [s]
     sa.Column("error", sa.Text),
     sa.Column("info", sa.Text),  # JSON object of extra metadata
+    # the kind of clock task and execution times were taken from: "simulated", "wall-clock",
+    # both joined by "+" in order of appearance; NULL in runs recorded before schema 2
+    sa.Column("clock", sa.String(64)),
+    sa.Column("lost_records", sa.Integer),  # trace rows that could not be written (NULL: not known)
 )
 
+#: One row per task of a run's task tree: name, parent, status, times, error.
 tasks_table = sa.Table(
     "pycram_tasks", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -150,10 +188,14 @@ tasks_table = sa.Table(
     sa.Column("duration", sa.Float),
     sa.Column("error_type", sa.String(255)),
     sa.Column("error_message", sa.Text),
+    # task_id of the task the error was raised in: this task's own id where it originated,
+    # a descendant's where it only passed through; NULL without error and before schema 2
+    sa.Column("error_origin", sa.Integer),
     sa.UniqueConstraint("run_id", "task_id", name="uq_pycram_tasks_run_task"),
 )
 sa.Index("ix_pycram_tasks_name", tasks_table.c.name)
 
+#: One row per performed designator: its properties and what it resolved to.
 designators_table = sa.Table(
     "pycram_designators", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -169,6 +211,7 @@ designators_table = sa.Table(
 )
 sa.Index("ix_pycram_designators_run", designators_table.c.run_id)
 
+#: One row per process-module execution: module, designator, outcome, times.
 executions_table = sa.Table(
     "pycram_executions", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -186,6 +229,7 @@ executions_table = sa.Table(
 )
 sa.Index("ix_pycram_executions_run", executions_table.c.run_id)
 
+#: Sampled values of watched fluents, with the active clock's time [s].
 fluent_samples_table = sa.Table(
     "pycram_fluent_samples", metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
@@ -201,7 +245,10 @@ sa.Index("ix_pycram_fluent_samples_run_name", fluent_samples_table.c.run_id, flu
 def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
     cursor = dbapi_connection.cursor()
     try:
-        cursor.execute("PRAGMA journal_mode=WAL")
+        try:
+            cursor.execute("PRAGMA journal_mode=WAL")
+        except Exception as e:  # a read-only file cannot switch its journal; reading still works
+            log.debug("SQLite: cannot switch to write-ahead logging: %s", e)
         cursor.execute("PRAGMA synchronous=NORMAL")
         cursor.execute("PRAGMA foreign_keys=ON")
     finally:
@@ -209,7 +256,15 @@ def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
 
 
 _HINT = ("expected e.g. sqlite:////absolute/path/runs.sqlite3 or "
-         "postgresql+psycopg://user:password@host:5432/database")
+         "postgresql://user:password@host:5432/database")
+_SUPPORTED = ("run traces can be kept in SQLite (sqlite:///path/runs.sqlite3 or a file path) "
+              "or PostgreSQL (postgresql://user:password@host:5432/database)")
+
+
+def _hide_password(url: str) -> str:
+    """`url` with the password of `scheme://user:password@host` replaced by ***."""
+    return re.sub(r"(://[^/:@]*:)[^/@]*@", r"\1***@", url)
+
 
 _engines: dict[str, Engine] = {}
 _engines_lock = threading.Lock()
@@ -219,9 +274,23 @@ def _parse(url: str) -> URL:
     try:
         parsed = sa.make_url(url)
     except sa_exc.ArgumentError as e:
-        raise TraceDatabaseError(f"invalid database URL {url!r}: {e}; {_HINT}") from None
+        raise TraceDatabaseError(f"invalid database URL {_hide_password(url)!r}: {e}; {_HINT}") from None
+    except ValueError:  # SQLAlchemy's int() of the port
+        host = url.split("://", 1)[-1].split("/", 1)[0].rsplit("@", 1)[-1]
+        port = host.rsplit(":", 1)[-1] if ":" in host else ""
+        raise TraceDatabaseError(f"invalid database URL {_hide_password(url)!r}: the port {port!r} is not a "
+                                 f"number; {_HINT}") from None
     if parsed.drivername in ("postgresql", "postgres"):  # psycopg (3) is the driver we ship
         parsed = parsed.set(drivername="postgresql+psycopg")
+    backend = parsed.get_backend_name()
+    if backend not in SUPPORTED_KINDS:
+        shown = display_url(parsed)
+        try:
+            parsed.get_dialect()
+        except sa_exc.NoSuchModuleError:
+            raise TraceDatabaseError(f"unknown database kind {parsed.drivername!r} in URL {shown}; "
+                                     f"{_SUPPORTED}") from None
+        raise TraceDatabaseError(f"database kind {backend!r} (URL {shown}) is not supported: {_SUPPORTED}") from None
     return parsed
 
 
@@ -242,6 +311,8 @@ def create_engine(url: str | None) -> Engine:
         kwargs["connect_args"] = {"timeout": 30.0, "check_same_thread": False}
     else:
         kwargs["pool_pre_ping"] = True
+        if "connect_timeout" not in parsed.query:  # [s]: a vanished server is an error, not a hang
+            kwargs["connect_args"] = {"connect_timeout": 10}
     try:
         engine = sa.create_engine(parsed, **kwargs)
     except sa_exc.NoSuchModuleError:
@@ -249,7 +320,8 @@ def create_engine(url: str | None) -> Engine:
             f"unknown database kind {parsed.drivername!r} in URL {shown}; {_HINT}") from None
     except ModuleNotFoundError as e:
         raise TraceDatabaseError(
-            f"the database driver for {shown} is not installed ({e}); install pycram[db]") from None
+            f"the database driver for {shown} is not installed ({e}); the 'db' extra (pip install "
+            "'pycram[db]') ships the drivers for sqlite:// and postgresql:// (psycopg 3)") from None
     except sa_exc.ArgumentError as e:
         raise TraceDatabaseError(f"invalid database URL {shown}: {e}; {_HINT}") from None
     if parsed.get_backend_name() == "sqlite":
@@ -276,10 +348,9 @@ def connect(url: str | None = None, *, create_schema: bool = True, cached: bool 
         else:
             with engine.connect():
                 pass
-    except sa_exc.DBAPIError as e:
+    except sa_exc.SQLAlchemyError as e:
         engine.dispose()
-        reason = str(getattr(e, "orig", e)).strip().splitlines()[0] if str(getattr(e, "orig", e)).strip() else type(e).__name__
-        raise TraceDatabaseError(f"cannot use database {display_url(engine.url)}: {reason}") from None
+        raise database_error(engine.url, e) from None
     if cached:
         with _engines_lock:
             engine = _engines.setdefault(text, engine)
@@ -304,14 +375,66 @@ def empty_engine() -> Engine:
         return _empty
 
 
+def database_error(url: str | URL, error: BaseException, doing: str = "use") -> TraceDatabaseError:
+    """A `TraceDatabaseError` "cannot {doing} database URL: first line of the driver's message"
+    for a SQLAlchemy or driver `error` (password hidden)."""
+    text = str(getattr(error, "orig", None) or error).strip()
+    reason = text.splitlines()[0] if text else type(error).__name__
+    return TraceDatabaseError(f"cannot {doing} database {display_url(url)}: {reason}")
+
+
 def ensure_schema(engine: Engine) -> None:
-    """Create the trace tables and indexes that do not exist yet (idempotent, concurrent-safe)."""
+    """Create the trace tables and indexes that do not exist yet and add the columns an older
+    schema lacks (idempotent, concurrent-safe). A failed migration (e.g. a read-only file) is
+    logged, not raised: reading such a database still works (`present_columns`)."""
     for attempt in range(3):
         try:
             metadata.create_all(engine, checkfirst=True)
-            return
+            break
         except (sa_exc.IntegrityError, sa_exc.ProgrammingError, sa_exc.OperationalError) as e:
             # another process created a table between our check and our CREATE
             if attempt == 2 or "already exists" not in str(e).lower() and "duplicate" not in str(e).lower():
                 raise
             log.debug("schema creation raced with another process; retrying: %s", e)
+    _add_missing_columns(engine)
+
+
+_present: weakref.WeakKeyDictionary[Engine, dict[str, frozenset[str]]] = weakref.WeakKeyDictionary()
+
+
+def present_columns(engine: Engine, table: sa.Table) -> frozenset[str]:
+    """The names of the columns `table` has in the database of `engine` (cached per engine):
+    all of them after a migration, fewer in an old database that could not be migrated."""
+    known = _present.setdefault(engine, {})
+    columns = known.get(table.name)
+    if columns is None:
+        columns = frozenset(c["name"] for c in sa.inspect(engine).get_columns(table.name))
+        known[table.name] = columns
+    return columns
+
+
+def _add_missing_columns(engine: Engine) -> None:
+    """ALTER TABLE ... ADD COLUMN for every column of `metadata` an existing table lacks."""
+    for table in metadata.sorted_tables:
+        for attempt in range(2):
+            _present.get(engine, {}).pop(table.name, None)
+            missing = [c for c in table.columns if c.name not in present_columns(engine, table)]
+            if not missing:
+                break
+            try:
+                with engine.begin() as conn:
+                    for column in missing:
+                        kind = column.type.compile(dialect=engine.dialect)
+                        conn.exec_driver_sql(f"ALTER TABLE {table.name} ADD COLUMN "
+                                             f"{engine.dialect.identifier_preparer.quote(column.name)} {kind}")
+                log.info("trace database %s: added %s to %s", display_url(engine.url),
+                         ", ".join(c.name for c in missing), table.name)
+            except sa_exc.DBAPIError as e:
+                text = str(e).lower()
+                if attempt == 0 and ("duplicate" in text or "already exists" in text):
+                    continue  # another process added them first: look again
+                log.warning("cannot add the columns %s to %s in %s (an older schema; reading still "
+                            "works): %s", ", ".join(c.name for c in missing), table.name,
+                            display_url(engine.url), str(getattr(e, "orig", e)).strip())
+                break
+        _present.get(engine, {}).pop(table.name, None)

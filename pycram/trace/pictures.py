@@ -6,6 +6,8 @@
 - `timeline_png(records, path)` / `write_timeline_png(run_id, path)`: one row per task, a bar
   from its start to its end colored by status (matplotlib, Agg backend, no display needed), so
   concurrent branches, retries and evaporations are visible at a glance.
+- Pictures of a recorded run show every process-module execution, the blocking ones (which
+  are no task of their own) as children of the task that performed them.
 - Both draw a run of identical successful siblings (a `whenever` loop repeating a motion) as one
   box / one row "name ×N" (`pycram.trace.collapse`; pass `min_run=0` for one per task). The
   stored trace is never changed.
@@ -307,6 +309,14 @@ def _title(run: Any) -> str:
     return " · ".join(parts)
 
 
+def _run_records(run_id: int, url: str | None) -> list[TaskRecord]:
+    """The tasks of a recorded run and its process-module executions that are not tasks."""
+    from pycram.trace import query
+
+    tasks, executions = query.tree_records(run_id, url)
+    return tasks + executions
+
+
 def write_tree_svg(run_id: int | None, path: str | Path, url: str | None = None, min_run: int = MIN_RUN) -> Path:
     """Write the task tree of run `run_id` (newest when None) as SVG to `path` (see `tree_svg`)."""
     from pycram.trace import query
@@ -314,7 +324,7 @@ def write_tree_svg(run_id: int | None, path: str | Path, url: str | None = None,
     run = query.get_run(run_id, url)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(tree_svg(query.tasks(run.id, url), title=_title(run), min_run=min_run), encoding="utf-8")
+    path.write_text(tree_svg(_run_records(run.id, url), title=_title(run), min_run=min_run), encoding="utf-8")
     return path
 
 
@@ -324,7 +334,7 @@ def write_timeline_png(run_id: int | None, path: str | Path, url: str | None = N
     from pycram.trace import query
 
     run = query.get_run(run_id, url)
-    return timeline_png(query.tasks(run.id, url), path, title=_title(run), max_rows=max_rows, min_run=min_run)
+    return timeline_png(_run_records(run.id, url), path, title=_title(run), max_rows=max_rows, min_run=min_run)
 
 
 def write_run_pictures(run_id: int | None, folder: str | Path, url: str | None = None) -> list[Path]:

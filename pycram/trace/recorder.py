@@ -20,7 +20,17 @@ Guarantees
 - Fluents are observed through a child fluent that the watched fluent pulses (no polling);
   samples are rate limited per fluent to `max_rate_hz`; the last value of a burst is written
   once its window passed (so the final value is never lost).
-- Database errors in the writer are logged, never raised into the plan.
+- Database errors in the writer are logged, never raised into the plan. A batch that cannot
+  be written is kept and retried with the next one (a restarted server loses nothing); rows
+  are dropped only beyond `BACKLOG_LIMIT`, or when the last attempt in `finish()` fails.
+  `lost_records` counts the dropped rows, `write_errors` the failed attempts, `last_error`
+  says why; `finish()` logs a warning naming the count, and the run row keeps it (when the
+  final write succeeded) in `lost_records`.
+- Each task row says where its error originated (`error_origin`: the task id of the deepest
+  task that ended with the very same exception object; its own id where it was raised), so
+  a failure re-raised by enclosing tasks is counted once (`query.failed_tasks`).
+- The run row's `clock` names the kind of the clock ("simulated", "wall-clock") that task and
+  execution times were read from (the recorder follows `set_clock`).
 - While the run lasts, `last_seen_at` is refreshed at least every `heartbeat_interval` (2 s),
   also when the plan is idle: a run not seen for 10 s reads as "unfinished" (killed).
 - `pycram.trace.watch(fluent, name)` adds a fluent to every active recorder (for plan scripts
@@ -47,12 +57,16 @@ from typing import Any, Iterable, Literal
 from pycram import events
 from pycram.fluent import Fluent
 from pycram.runtime import Task, add_task_listener, current_clock, current_task, remove_task_listener
+from pycram.runtime.clock import Clock, add_clock_listener, remove_clock_listener
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Recorder", "start_recording", "recording_enabled", "watch", "active_recorders"]
+__all__ = ["Recorder", "start_recording", "recording_enabled", "watch", "active_recorders", "error_origin",
+           "BACKLOG_LIMIT"]
 
 _TEXT_LIMIT = 4000
+#: Rows kept for a retry while the database fails; older ones are dropped (and counted) beyond.
+BACKLOG_LIMIT = 100_000
 _current_thread = threading.current_thread
 
 
@@ -104,6 +118,24 @@ def _error_fields(error: BaseException | None) -> tuple[str | None, str | None]:
     except Exception:
         message = ""
     return type(error).__name__, _short(message)
+
+
+def error_origin(task: Task) -> int | None:
+    """The id of the task in which the exception that ended `task` was raised: follow the
+    children that ended with the very same exception object (a failure re-raised by a `seq`,
+    a `par`, a `try_in_order` or a plain `raise errors[0]`) down to the deepest one. None for a
+    task without exception."""
+    exception = task.exception
+    if exception is None:
+        return None
+    node = task
+    while True:
+        for child in reversed(list(node.children)):
+            if child.exception is exception:
+                node = child
+                break
+        else:
+            return node.id
 
 
 def _designator_type(designator: Any) -> str | None:
@@ -212,7 +244,12 @@ class Recorder:
         self._started_wall = 0.0
         self._finished = False
         self._lock = threading.Lock()
+        #: Failed attempts to write a batch (each is retried with the next one).
         self.write_errors = 0
+        #: Trace rows given up (see the module guarantees); final once `finish()` returned.
+        self.lost_records = 0
+        #: Why the last write failed (the driver's first line), None if none failed.
+        self.last_error: str | None = None
 
     # -- life cycle -------------------------------------------------------------------------------
 
@@ -221,22 +258,31 @@ class Recorder:
 
         Raises `TraceDatabaseError` if the database cannot be used. Returns self.
         """
-        from pycram.trace.db import connect, runs_table
+        from sqlalchemy import exc as sa_exc
+
+        from pycram.trace.db import connect, database_error, runs_table
 
         if self._engine is not None:
             return self
         engine = connect(self.url)
         self._started_wall = time.monotonic()
-        self.clock_origin = current_clock().now()
+        clock = current_clock()
+        self.clock_origin = clock.now()
         now = _now_utc()
-        with engine.begin() as conn:
-            result = conn.execute(runs_table.insert().values(
-                uuid=self.run_uuid, plan=_short(self.plan or "", 255) or None, robot=self.robot,
-                host=_short(socket.gethostname(), 255), pid=os.getpid(), command=_short(self.command),
-                started_at=now, last_seen_at=now, clock_origin=self.clock_origin,
-                info=json.dumps(self.info, default=str) if self.info else None))
-            self.run_id = int(result.inserted_primary_key[0])
+        try:
+            with engine.begin() as conn:
+                result = conn.execute(runs_table.insert().values(
+                    uuid=self.run_uuid, plan=_short(self.plan or "", 255) or None, robot=self.robot,
+                    host=_short(socket.gethostname(), 255), pid=os.getpid(), command=_short(self.command),
+                    started_at=now, last_seen_at=now, clock_origin=self.clock_origin,
+                    info=json.dumps(self.info, default=str) if self.info else None))
+                self.run_id = int(result.inserted_primary_key[0])
+        except sa_exc.SQLAlchemyError as e:  # e.g. a read-only file: say so before the plan runs
+            engine.dispose()
+            raise database_error(engine.url, e, "write to") from None
         self._engine = engine
+        self._put(("clock", clock.kind))
+        add_clock_listener(self._on_clock)
         self._writer = threading.Thread(target=self._writer_main, name=f"pycram-recorder-{self.run_id}", daemon=True)
         self._writer.start()
         add_task_listener(self)
@@ -304,6 +350,7 @@ class Recorder:
                 return self.run_id
             self._finished = True
         remove_task_listener(self)
+        remove_clock_listener(self._on_clock)
         for unsubscribe in self._unsubscribe:
             unsubscribe()
         for watch in list(self._watches.values()):
@@ -321,9 +368,21 @@ class Recorder:
             if self._writer.is_alive():
                 log.warning("trace writer of run %s did not finish within 60 s", self.run_id)
         _live_recorders.discard(self)
-        self._engine.dispose()
+        try:
+            self._engine.dispose()
+        except Exception as e:  # a broken connection must not turn the run into a failure
+            log.debug("disposing the engine of run %s: %s", self.run_id, e)
+        if self.lost_records:
+            log.warning("run %s: %s (database %s)", self.run_id, self.loss_report(), _display(self.url))
         log.info("run %s recorded (%s, %.2f s)", self.run_id, self.outcome, duration)
         return self.run_id
+
+    def loss_report(self) -> str | None:
+        """"N trace records could not be written: why" once records were lost, else None."""
+        if not self.lost_records:
+            return None
+        records = "1 trace record" if self.lost_records == 1 else f"{self.lost_records} trace records"
+        return f"{records} could not be written: {self.last_error or 'unknown error'}"
 
     def __enter__(self) -> Recorder:
         return self.start()
@@ -343,6 +402,10 @@ class Recorder:
     def _on_execution(self, module: Any, designator: Any, outcome: Any, start: float | None,
                       end: float | None, error: BaseException | None = None) -> None:
         self._put(("x", current_task(), module, designator, outcome, start, end, error))
+
+    def _on_clock(self, clock: Clock) -> None:
+        # queued in order with the task events: the writer knows which clock each one read
+        self._put(("clock", clock.kind))
 
     # -- writer thread ----------------------------------------------------------------------------
 
@@ -378,21 +441,47 @@ class Recorder:
             controls = [item for item in items if isinstance(item, tuple) and item[0] in ("flush", "stop")]
             flushes = [item[1] for item in controls if item[0] == "flush"]
             stop = any(item[0] == "stop" for item in controls)
+            state.add(items)
             try:
-                state.write(items)
-            except Exception:
-                self.write_errors += 1
-                log.exception("trace writer: could not write %d events of run %s", len(items), self.run_id)
+                state.commit()
+            except Exception as e:  # the database failed: keep the rows for the next attempt
+                self._write_failed(e, state)
+                if stop:
+                    self.lost_records += state.give_up()
+            else:
+                if self.last_error is not None and self.write_errors and state.failing:
+                    log.warning("trace writer: run %s is written again after %d failed attempts",
+                                self.run_id, self.write_errors)
+                state.failing = False
             for done in flushes:
                 done.set()
 
+    def _write_failed(self, error: Exception, state: _WriterState) -> None:
+        from sqlalchemy import exc as sa_exc
+
+        self.write_errors += 1
+        text = str(getattr(error, "orig", None) or error).strip()
+        self.last_error = (text.splitlines()[0] if text else type(error).__name__)
+        if not isinstance(error, sa_exc.SQLAlchemyError):
+            log.exception("trace writer: could not write a batch of run %s", self.run_id)
+        elif not state.failing:  # once per streak of failures: the writer retries every batch
+            log.warning("trace writer: cannot write to %s (%s); keeping %d rows of run %s for a retry",
+                        _display(self.url), self.last_error, state.backlog_size(), self.run_id)
+        state.failing = True
+        self.lost_records += state.trim(BACKLOG_LIMIT)
+
 
 _TASK_COLUMNS = ("run_id", "task_id", "parent_id", "name", "kind", "path", "thread", "status", "start", "end",
-                 "duration", "error_type", "error_message")
+                 "duration", "error_type", "error_message", "error_origin")
 
 
 class _WriterState:
-    """Turns queued events into rows (runs only in the writer thread)."""
+    """Turns queued events into rows and commits them (runs only in the writer thread).
+
+    `add(items)` takes a batch of events; `commit()` writes everything not yet written in one
+    transaction -- the rows of earlier batches whose commit failed included -- and raises what
+    the database raised (then nothing of it was written, and everything stays pending).
+    """
 
     def __init__(self, recorder: Recorder) -> None:
         self.recorder = recorder
@@ -401,6 +490,15 @@ class _WriterState:
         self.thread_names: dict[int, str] = {}  # thread ident -> name (refreshed per batch)
         self.in_scope: dict[int, bool] = {}
         self.last_heartbeat = time.monotonic()
+        self.failing = False  # the last commit failed
+        # pending: what the next commit writes
+        self.tasks: dict[int, Task] = {}  # tasks that started or ended, first seen first
+        self.rows: list[tuple[Any, dict[str, Any]]] = []  # (table, row) of designators, executions, samples
+        self.run_update: dict[str, Any] = {}
+        # clocks: the kind of the active clock, and the kinds task/execution times were read from
+        self.clock_kind: str | None = None
+        self.clock_kinds: list[str] = []
+        self.clock_written = ""
         dialect = recorder._engine.dialect
         mark = "?" if dialect.paramstyle == "qmark" else "%s"
         q = dialect.identifier_preparer.quote
@@ -416,8 +514,9 @@ class _WriterState:
         exception = task.exception
         if exception is not None and status != "succeeded":
             error_type, error_message = _error_fields(exception)
+            origin = error_origin(task)
         else:
-            error_type = error_message = None
+            error_type = error_message = origin = None
         runner = task._runner
         thread = self.thread_names.get(runner.ident) if runner is not None else None
         name = task.name
@@ -425,7 +524,7 @@ class _WriterState:
         return (self.run_id, task.id, parent.id if parent is not None else None,
                 name if len(name) <= 512 else name[:511] + "…", task.kind, task.path, thread, status,
                 start, end, end - start if start is not None and end is not None else None,
-                error_type, error_message)
+                error_type, error_message, origin)
 
     def _wanted(self, task: Task) -> bool:
         scope = self.recorder.scope
@@ -448,17 +547,66 @@ class _WriterState:
             self.in_scope[task_id] = answer
         return answer
 
-    def write(self, items: Iterable[Any]) -> None:
-        from pycram.trace.db import designators_table, executions_table, fluent_samples_table, runs_table
+    def _saw_clock(self) -> None:
+        kind = self.clock_kind
+        if kind is not None and kind not in self.clock_kinds:
+            self.clock_kinds.append(kind)
+
+    def add(self, items: Iterable[Any]) -> None:
+        """Turn a batch of queued events into pending rows (nothing is written yet)."""
+        from pycram.trace.db import designators_table, executions_table, fluent_samples_table
+
+        run_id = self.run_id
+        tasks, rows = self.tasks, self.rows
+        for item in items:
+            if not isinstance(item, tuple):
+                if item.id not in tasks and self._wanted(item):
+                    tasks[item.id] = item
+                    self._saw_clock()
+                continue
+            tag = item[0]
+            if tag == "f":
+                _, name, value, t = item
+                rows.append((fluent_samples_table, {"run_id": run_id, "name": name, "time": t,
+                                                    "value": _text(value), "number": _number(value)}))
+            elif tag == "d":
+                _, task, t, designator, solution, error = item
+                error_type, error_message = _error_fields(error)
+                rows.append((designators_table, {
+                    "run_id": run_id, "task_id": task.id if task is not None else None, "time": t,
+                    "designator_class": type(designator).__name__, "designator_type": _designator_type(designator),
+                    "designator": _text(designator), "solution": _text(_solution_text(solution)),
+                    "error_type": error_type, "error_message": error_message}))
+            elif tag == "x":
+                _, task, module, designator, outcome, start, end, error = item
+                error_type, error_message = _error_fields(error)
+                rows.append((executions_table, {
+                    "run_id": run_id, "task_id": task.id if task is not None else None,
+                    "module": _short(str(getattr(module, "name", module)), 255),
+                    "designator_type": _designator_type(designator), "designator": _text(designator),
+                    "outcome": _text(outcome), "start": start, "end": end,
+                    "duration": (end - start) if start is not None and end is not None else None,
+                    "error_type": error_type, "error_message": error_message}))
+                self._saw_clock()
+            elif tag == "clock":
+                self.clock_kind = item[1]
+            elif tag == "r":
+                _, plan, robot, info = item
+                self.run_update.update(plan=_short(plan, 255) if plan else None, robot=robot,
+                                       info=json.dumps(info, default=str) if info else None)
+            elif tag == "end":
+                _, outcome, duration, error = item
+                self.run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc(),
+                                       lost_records=self.recorder.lost_records)
+
+    def commit(self) -> None:
+        """Write every pending row in one transaction; raises what the database raised."""
+        from pycram.trace.db import runs_table
 
         self.thread_names = {t.ident: t.name for t in threading.enumerate() if t.ident is not None}
+        run_id = self.run_id
         inserts: dict[int, tuple] = {}
         updates: dict[int, tuple] = {}
-        designators: list[dict[str, Any]] = []
-        executions: list[dict[str, Any]] = []
-        samples: list[dict[str, Any]] = []
-        run_update: dict[str, Any] = {}
-        run_id = self.run_id
 
         def ensure(task: Task) -> None:  # insert the task (and unrecorded ancestors, e.g. thread roots)
             chain = []
@@ -471,46 +619,9 @@ class _WriterState:
             for node in reversed(chain):
                 inserts[node.id] = self._task_row(node)
 
-        touched: dict[int, Task] = {}  # tasks that started or ended in this batch, first seen first
-        for item in items:
-            if not isinstance(item, tuple):
-                if item.id not in touched and self._wanted(item):
-                    touched[item.id] = item
-                continue
-            tag = item[0]
-            if tag == "f":
-                _, name, value, t = item
-                samples.append({"run_id": run_id, "name": name, "time": t, "value": _text(value),
-                                "number": _number(value)})
-            elif tag == "d":
-                _, task, t, designator, solution, error = item
-                error_type, error_message = _error_fields(error)
-                designators.append({
-                    "run_id": run_id, "task_id": task.id if task is not None else None, "time": t,
-                    "designator_class": type(designator).__name__, "designator_type": _designator_type(designator),
-                    "designator": _text(designator), "solution": _text(_solution_text(solution)),
-                    "error_type": error_type, "error_message": error_message})
-            elif tag == "x":
-                _, task, module, designator, outcome, start, end, error = item
-                error_type, error_message = _error_fields(error)
-                executions.append({
-                    "run_id": run_id, "task_id": task.id if task is not None else None,
-                    "module": _short(str(getattr(module, "name", module)), 255),
-                    "designator_type": _designator_type(designator), "designator": _text(designator),
-                    "outcome": _text(outcome), "start": start, "end": end,
-                    "duration": (end - start) if start is not None and end is not None else None,
-                    "error_type": error_type, "error_message": error_message})
-            elif tag == "r":
-                _, plan, robot, info = item
-                run_update.update(plan=_short(plan, 255) if plan else None, robot=robot,
-                                  info=json.dumps(info, default=str) if info else None)
-            elif tag == "end":
-                _, outcome, duration, error = item
-                run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc())
-
-        # One row per task per batch, read after the whole batch was taken from the queue: a
+        # One row per task per commit, read after the whole batch was taken from the queue: a
         # task's event is queued after its state was set, so the row holds at least that state.
-        for task in touched.values():
+        for task in self.tasks.values():
             if task.id in inserts:
                 continue  # inserted as an ancestor of an earlier task, from its current state
             if task.id in self.written:
@@ -518,27 +629,49 @@ class _WriterState:
             else:
                 ensure(task)
 
+        clock = "+".join(self.clock_kinds)
+        if clock != self.clock_written:
+            self.run_update["clock"] = clock
         now = time.monotonic()
         heartbeat_due = now - self.last_heartbeat >= min(1.0, self.recorder.heartbeat_interval)
-        if not (inserts or updates or designators or executions or samples or run_update or heartbeat_due):
+        if not (inserts or updates or self.rows or self.run_update or heartbeat_due):
             return
-        if heartbeat_due or run_update:
-            run_update.setdefault("last_seen_at", _now_utc())
-            self.last_heartbeat = now
+        if heartbeat_due or self.run_update:
+            self.run_update["last_seen_at"] = _now_utc()
+        rows: dict[Any, list[dict[str, Any]]] = {}
+        for table, row in self.rows:
+            rows.setdefault(table, []).append(row)
         with self.recorder._engine.begin() as conn:
             if inserts:  # plain DB-API executemany: no per-row SQLAlchemy processing
                 conn.exec_driver_sql(self.sql_insert, list(inserts.values()))
             if updates:
                 conn.exec_driver_sql(self.sql_update, [row[7:] + (run_id, row[1]) for row in updates.values()])
-            if designators:
-                conn.execute(designators_table.insert(), designators)
-            if executions:
-                conn.execute(executions_table.insert(), executions)
-            if samples:
-                conn.execute(fluent_samples_table.insert(), samples)
-            if run_update:
-                conn.execute(runs_table.update().where(runs_table.c.id == run_id).values(**run_update))
+            for table, table_rows in rows.items():
+                conn.execute(table.insert(), table_rows)
+            if self.run_update:
+                conn.execute(runs_table.update().where(runs_table.c.id == run_id).values(**self.run_update))
+        self.last_heartbeat = now
         self.written.update(inserts)
+        self.clock_written = clock
+        self.tasks, self.rows, self.run_update = {}, [], {}
+
+    def backlog_size(self) -> int:
+        """How many rows the next commit would write (tasks counted once each)."""
+        return len(self.tasks) + len(self.rows) + (1 if set(self.run_update) - {"last_seen_at", "clock"} else 0)
+
+    def trim(self, limit: int) -> int:
+        """Drop the oldest pending rows beyond `limit`; returns how many were dropped."""
+        excess = len(self.rows) - limit
+        if excess <= 0:
+            return 0
+        del self.rows[:excess]
+        return excess
+
+    def give_up(self) -> int:
+        """Forget everything pending (the last attempt failed); returns how many rows that was."""
+        lost = self.backlog_size()
+        self.tasks, self.rows, self.run_update = {}, [], {}
+        return lost
 
 
 def _solution_text(solution: Any) -> Any:
