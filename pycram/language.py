@@ -60,6 +60,13 @@ __all__ = [
     "try_each_in_order",
     "par_loop",
     "partial_order",
+    "Policy",
+    "PolicyRun",
+    "PolicyConditionMet",
+    "PolicyInitFailed",
+    "define_policy",
+    "with_policy",
+    "timeout_policy",
     "whenever",
     "TaskVariable",
     "suspend",
@@ -514,3 +521,5 @@ def __getattr__(name: str) -> Any:
 # -- expressions built on the ones above (imported last: they import this module) ------------------
 
 from pycram.partial_order import partial_order  # noqa: E402
+from pycram.policy import (Policy, PolicyConditionMet, PolicyInitFailed, PolicyRun, define_policy,  # noqa: E402
+                           timeout_policy, with_policy)

@@ -531,3 +531,84 @@ def test_process_module_rejects_an_unknown_suspension_mode() -> None:
     module = RecordingModule("halt")
     with pytest.raises(ValueError, match="'pause' or 'cancel'"):
         module.execute("goal")
+
+
+# -- 7. policies -----------------------------------------------------------------------------------
+
+from pycram.language import (PolicyConditionMet, PolicyInitFailed, define_policy,  # noqa: E402
+                             timeout_policy, with_policy)
+
+
+def _recording_policy(log: list, init_ok: bool = True):
+    return define_policy(
+        "watch",
+        init=lambda run, limit: (log.append(("init", limit)), run.vars.setdefault("limit", limit), init_ok)[-1],
+        check=lambda run, limit: (log.append("check"), run.vars["sensor"] > run.vars["limit"])[-1]
+        if "sensor" in run.vars else _wait_sensor(run, limit),
+        recover=lambda run, limit: log.append("recover"),
+        clean_up=lambda run, limit: log.append("clean_up"),
+    )
+
+
+_sensor = Fluent(0)
+
+
+def _wait_sensor(run, limit):
+    run.vars["sensor"] = _sensor
+    return _sensor > limit  # a Fluent network: the monitor waits on it
+
+
+def test_policy_condition_met_evaporates_body_then_recovers_and_cleans_up() -> None:
+    log: list = []
+    never = Fluent()
+    cleaned = []
+
+    def body() -> None:
+        try:
+            _sensor.set_value(5)  # trips the check
+            never.wait_for()
+        finally:
+            cleaned.append("body clean-up")
+
+    _sensor.set_value(0)
+    with pytest.raises(PolicyConditionMet, match="'watch' condition met"):
+        with_policy(_recording_policy(log), body, 3)
+    assert cleaned == ["body clean-up"]
+    assert log == [("init", 3), "recover", "clean_up"]
+
+
+def test_policy_body_ending_first_returns_its_result() -> None:
+    log: list = []
+    _sensor.set_value(0)
+    assert with_policy(_recording_policy(log), lambda: "done", 3) == "done"
+    assert log == [("init", 3), "clean_up"]
+
+
+def test_policy_body_failure_propagates_and_cleans_up() -> None:
+    log: list = []
+    _sensor.set_value(0)
+    with pytest.raises(Boom):
+        with_policy(_recording_policy(log), boom, 3)
+    assert log == [("init", 3), "clean_up"]
+
+
+def test_policy_init_failure_runs_nothing_else() -> None:
+    log: list = []
+    ran = []
+    with pytest.raises(PolicyInitFailed, match="'watch'"):
+        with_policy(_recording_policy(log, init_ok=False), lambda: ran.append(1), 3)
+    assert ran == [] and log == [("init", 3)]
+
+
+def test_timeout_policy() -> None:
+    never = Fluent()
+    with pytest.raises(PolicyConditionMet, match="'timeout'"):
+        with_policy(timeout_policy, lambda: never.wait_for(), 0.05)
+    assert with_policy(timeout_policy, lambda: 7, 5.0) == 7
+
+
+def test_policy_bad_input() -> None:
+    with pytest.raises(TypeError, match="check must be callable"):
+        define_policy("x", check=3)
+    with pytest.raises(TypeError, match="needs a Policy"):
+        with_policy("timeout", lambda: 1, 1.0)
