@@ -40,6 +40,7 @@ from pycram.block_forms import BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
 from pycram.runtime.evaporation import Evaporated, check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
+from pycram.runtime.detached import detached_children
 from pycram.runtime.suspension import (is_suspended, on_suspension, retry_after_suspension, suspend,
                                        wake_up, with_task_suspended)
 from pycram.runtime.tags import Tags, find_task, find_tasks, tag, with_tags
@@ -75,6 +76,7 @@ __all__ = [
     "on_suspension",
     "retry_after_suspension",
     "is_suspended",
+    "detached_children",
     "Tags",
     "with_tags",
     "tag",

@@ -612,3 +612,42 @@ def test_policy_bad_input() -> None:
         define_policy("x", check=3)
     with pytest.raises(TypeError, match="needs a Policy"):
         with_policy("timeout", lambda: 1, 1.0)
+
+
+# -- 8. detached children when their starter ends --------------------------------------------------
+
+from pycram.language import detached_children  # noqa: E402
+
+
+@pytest.mark.parametrize("rule", ["evaporate", "wait"])
+def test_detached_children_rule_at_block_end(rule: str) -> None:
+    module = RecordingModule("pause")
+    seen = {}
+
+    def starter() -> None:
+        with detached_children(rule):
+            execution = module.execute_nowait("goal")
+            assert (module.started >= 1).wait_for(TIMEOUT)
+            if rule == "wait":
+                module.finish.set_value(True)
+        seen["done"] = execution.done  # the block ended only after the execution ended
+        seen["log"] = list(module.log)
+
+    state = par(starter)
+    assert state.get_value() is State.SUCCEEDED and seen["done"]
+    assert seen["log"] == (["execute", "cancel"] if rule == "evaporate" else ["execute"])
+
+
+def test_detached_children_default_rule_unchanged_and_bad_rule() -> None:
+    module = RecordingModule("pause")
+
+    def starter() -> None:
+        module.execute_nowait("goal")
+        assert (module.started >= 1).wait_for(TIMEOUT)
+        threading.Timer(0.05, lambda: module.finish.set_value(True)).start()
+
+    assert par(starter).get_value() is State.SUCCEEDED
+    assert module.log == ["execute"]  # waited for, not evaporated
+    with pytest.raises(ValueError, match="must be one of"):
+        with detached_children("kill"):
+            pass
