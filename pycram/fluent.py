@@ -36,7 +36,7 @@ from enum import Enum
 from typing import Any, Callable, Iterator
 
 from pycram.block_forms import BlockForm
-from pycram.runtime.evaporation import notify_waiters, wait_until
+from pycram.runtime.evaporation import Evaporated, current_runner, notify_waiters, wait_until
 
 __all__ = ["Fluent", "Behavior", "whenever", "Whenever", "STOP", "ChangeCallback"]
 
@@ -146,26 +146,36 @@ class Fluent:
         return ChangeCallback(self, callback)
 
     def pulse(self) -> None:
-        """Wake every waiter on this fluent and on the networks and pulse fluents built from it."""
-        for ref in self._children:
-            child = ref()
-            if child is not None:
-                with _pulse_lock:
-                    child._pulses += 1
-                child.pulse()
-        cv = self._cv
-        if cv is not None:
-            notify_waiters(cv)
-        if self._callbacks:
-            self._run_callbacks()
+        """Wake every waiter on this fluent and on the networks and pulse fluents built from it,
+        then call the `on_change` callbacks (also if waking raised `Evaporated`)."""
+        try:
+            for ref in self._children:
+                child = ref()
+                if child is not None:
+                    with _pulse_lock:
+                        child._pulses += 1
+                    child.pulse()
+            cv = self._cv
+            if cv is not None:
+                notify_waiters(cv)  # may raise Evaporated (where an asynchronous one was due)
+        finally:
+            if self._callbacks:
+                self._run_callbacks()
 
     def _run_callbacks(self) -> None:
-        value = self.get_value()
-        for callback in self._callbacks:
-            try:
-                callback(value)
-            except Exception:
-                log.exception("on_change callback %r of fluent %s failed", callback, self.name)
+        runner = current_runner()
+        token = runner.enter_runtime()  # an asynchronous Evaporated waits until the callbacks ran
+        try:
+            value = self.get_value()
+            for callback in self._callbacks:
+                try:
+                    callback(value)
+                except Exception:
+                    log.exception("on_change callback %r of fluent %s failed", callback, self.name)
+        finally:
+            due = runner.leave_runtime(token)
+        if due:
+            raise Evaporated()
 
     def add_child(self, fluent: Fluent) -> None:
         """Make `fluent` be pulsed whenever this fluent is. Held weakly: it dies with its users.

@@ -298,8 +298,10 @@ class _Concurrent:
         except Evaporated:
             group.wait_all()  # evaporates the branches, waits for them, re-raises
             raise
-        group.evaporate()
-        group.wait_all()
+        try:
+            group.evaporate()  # may raise a re-delivered Evaporated: the wait below still runs
+        finally:
+            group.wait_all()
         if self.outcome is None and in_time:
             # every branch ended without deciding (e.g. all evaporated from outside)
             self._decide(State.SUCCEEDED if self.kind == "par" and self.failed == 0 else State.FAILED)

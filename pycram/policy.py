@@ -22,8 +22,9 @@ given to `with_policy`::
    on a fluent, `sleep`, ... — or return a `Fluent`, which is then waited for (condition met
    once it is not None). Nothing polls.
 3. If the condition is met first, `body` is evaporated (its clean-up runs, its branches end),
-   then `recover` runs, and `PolicyConditionMet` is raised. If `body` ends first, the check
-   is evaporated and `with_policy` returns body's result or raises body's exception.
+   then `recover` runs, and `PolicyConditionMet` is raised. If `body` ends by itself — first,
+   or in a tie with the check, before its evaporation reached it — the check is evaporated
+   and `with_policy` returns body's result or raises body's exception.
 4. `clean_up` runs in every case once init succeeded (in a `finally`).
 
 `timeout_policy` (parameter: seconds [s] of the active clock) is built with it.
@@ -35,7 +36,7 @@ from typing import Any, Callable
 
 from pycram.fluent import Fluent
 from pycram.language import State, pursue
-from pycram.runtime import sleep
+from pycram.runtime import TaskStatus, current_task, sleep
 
 __all__ = ["Policy", "PolicyRun", "PolicyConditionMet", "PolicyInitFailed", "define_policy", "with_policy",
            "timeout_policy"]
@@ -134,13 +135,17 @@ def with_policy(policy: Policy, body: Callable[[], Any], *params: Any) -> Any:
             body_branch.__pycram_name__ = "body"  # type: ignore[attr-defined]
         errors: list = []
         state = pursue(monitor, body_branch, errors=errors, name=f"with_policy {policy.name}")
-        if state.get_value() is State.FAILED:
+        body_task = current_task().children[-1].children[1]  # the pursue's second branch
+        body_status = body_task.status.get_value()
+        if body_status is TaskStatus.SUCCEEDED:  # the body ended by itself (maybe in a tie): its result
+            return body_task.result
+        if body_status is TaskStatus.FAILED:
+            raise body_task.exception  # type: ignore[misc]
+        if state.get_value() is State.FAILED:  # the check raised
             raise errors[0]
-        if state.result is _MET:
-            if policy.recover is not None:
-                policy.recover(run, *params)
-            raise PolicyConditionMet(policy, params)
-        return state.result
+        if policy.recover is not None:
+            policy.recover(run, *params)
+        raise PolicyConditionMet(policy, params)
     finally:
         if policy.clean_up is not None:
             policy.clean_up(run, *params)

@@ -428,8 +428,8 @@ class TaskGroup:
         try:
             wait_until(self._cv, self._all_ended)
         except Evaporated:
-            self.evaporate()
-            with shielded():
+            with shielded():  # evaporate() itself may re-deliver the evaporation: never skip the wait
+                self.evaporate()
                 wait_until(self._cv, self._all_ended)
             raise
 
