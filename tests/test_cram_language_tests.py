@@ -58,7 +58,7 @@ def test_try_each_in_order_3_failure_lists_every_failure() -> None:
 
 # -- with-tags ------------------------------------------------------------------------------------
 
-from pycram.language import Tags, seq, tag, with_tags  # noqa: E402
+from pycram.language import Tags, find_tasks, seq, tag, with_tags  # noqa: E402
 from pycram.runtime import sleep  # noqa: E402
 
 
@@ -292,3 +292,47 @@ def test_tasks_suspend_4_suspending_the_child_leaves_the_parent_alone() -> None:
     wake_up(b)
     thread.join(TIMEOUT)
     assert a.status.get_value() is S.SUCCEEDED and b.status.get_value() is S.SUCCEEDED
+
+
+# -- walker-tests.lisp: tag handling ---------------------------------------------------------------
+# CRAM's walker finds the :tag forms in plan code statically. PyCRAM has no code walker; the
+# same questions are answered from the task tree after (or while) the plan runs.
+
+
+def _tags_in(tags) -> set:
+    return set(tags.names())
+
+
+def test_walk_with_tag_handler_simple() -> None:
+    with with_tags() as tags:
+        par(tag("tag1", lambda: [1, 2]), tag("tag2", lambda: [3, 4]))
+    assert _tags_in(tags) == {"tag1", "tag2"}
+
+
+def test_walk_with_tag_handler_nested_tags_and_paths() -> None:
+    with with_tags() as tags:
+        par(tag("tag1", lambda: [1, 2]),
+            tag("tag2", lambda: seq(tag("tag3", tag("tag4", lambda: None)), tag("tag5", lambda: None))))
+    assert _tags_in(tags) == {"tag1", "tag2", "tag3", "tag4", "tag5"}
+    tag4 = tags["tag4"]
+    assert tag4.parent is tags["tag3"] and tags["tag2"].path.endswith("/par/tag2")  # a branch: no extra level
+    root = tag4
+    while root.parent is not None:
+        root = root.parent
+    assert find_tasks("*/tag3/tag4", root) == [tag4]
+
+
+def test_walk_with_tag_handler_bodies() -> None:
+    with with_tags() as tags:
+        seq(tag("t1", lambda: [1, 2]), tag("t2", lambda: None))
+    assert tags["t1"].result == [1, 2] and tags["t2"].result is None
+
+
+def test_correct_parents() -> None:
+    with with_tags() as tags:
+        par(tag("a", lambda: seq(lambda: None, tag("b", lambda: par(lambda: None)))))
+    root = tags["a"]
+    while root.parent is not None:
+        root = root.parent
+    for task in root.walk():
+        assert all(child.parent is task for child in task.children)

@@ -422,7 +422,7 @@ def test_suspensions_count_and_evaporation_wakes_a_suspended_task() -> None:
     suspend(task)
     wake_up(task)
     assert is_suspended(task) and task.status.get_value() is TaskStatus.SUSPENDED
-    assert "‖ t [tag] suspended" in format_task_tree(task.parent.parent)
+    assert "‖ t [branch] suspended" in format_task_tree(task.parent.parent)
     task.evaporate()
     thread.join(TIMEOUT)
     assert not thread.is_alive() and task.status.get_value() is TaskStatus.EVAPORATED

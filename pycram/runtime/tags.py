@@ -1,7 +1,8 @@
 """Tags: names for sub-tasks that other tasks can refer to (CRAM's `with-tags` / `:tag`), and
 looking tasks up in the task tree by path.
 
-`tag(name, fn)` returns a callable that runs `fn` as a child task named `name` (kind "tag").
+`tag(name, fn)` returns a callable that runs `fn` as a child task named `name` (kind "tag");
+used directly as a branch of `par`/`pursue`/... the branch task itself is the tagged task.
 Inside `with with_tags() as tags:` every tagged task started by the block — in any thread,
 at any depth — is registered in `tags`, where other tasks find it::
 
@@ -104,10 +105,18 @@ def _tagged(name: str, fn: Callable[[], Any], tags: Tags | None) -> Callable[[],
         raise TypeError(f"tag({name!r}): fn must be a callable taking no arguments, got {type(fn).__name__}: {fn!r}")
 
     def run_tagged() -> Any:
+        registry = tags if tags is not None else _registry.get()
+        here = current_task()
+        if here.kind == "branch" and here.name == name and not here.children and "tag" not in here.info:
+            # a branch of a concurrent expression, named after the tag already: it is the tagged
+            # task (evaporating it ends only this branch, as with any branch)
+            here.info["tag"] = name
+            if registry is not None:
+                registry.register(name, here)
+            return fn()
         scope = task_scope(name, "tag")
         task = scope.task
         task.info["tag"] = name
-        registry = tags if tags is not None else _registry.get()
         if registry is not None:
             registry.register(name, task)
         try:
