@@ -2,6 +2,7 @@
 
     pycram run FILE.py [ARGS...]        run a plan script (block syntax on), recorded by default
     pycram demo [--robot pr2|tiago]...  the thesis demo in the simulated kitchen, recorded by default
+    pycram scene --env apartment --seed 3 -o scene.png   a labelled picture of a random scene
     pycram runs                         recorded runs, newest first, one line each (with why they failed)
     pycram show [RUN]                   a run's task tree with statuses, durations, failures
     pycram graph [RUN] -o tree.svg      the task tree as an SVG picture
@@ -49,10 +50,16 @@ def _print_version(value: bool) -> None:
 
 @app.callback()
 def _options(
+    ctx: typer.Context,
     version: bool = typer.Option(False, "--version", help="Print PyCRAM's version and exit.",
                                  callback=_print_version, is_eager=True),
 ) -> None:
     """PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs."""
+    # `pycram run` leaves logging to the script (its basicConfig must not be a no-op); the
+    # other commands show the library's warnings.
+    if ctx.invoked_subcommand != "run":
+        logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+
 
 #: Runs of this many identical successful siblings are shown as one line / box / row (×N);
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
@@ -364,12 +371,40 @@ def demo_command(
     raise typer.Exit(int(code or 0))
 
 
-@app.callback()
-def _configure_logging(ctx: typer.Context) -> None:
-    # `pycram run` leaves logging to the script (its basicConfig must not be a no-op); the
-    # other commands show the library's warnings.
-    if ctx.invoked_subcommand != "run":
-        logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+#: The objects `pycram scene` places by default (a breakfast).
+_SCENE_OBJECTS = "cup,bowl,spoon,cereal,milk,plate"
+
+
+@app.command("scene")
+def scene_command(
+    env: str = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen."),
+    seed: int = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene)."),
+    objects: str = typer.Option(_SCENE_OBJECTS, "--objects",
+                                help="Comma-separated object types to place at random ('' for none)."),
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
+) -> None:
+    """A labelled picture of a scene: plan and overview with surfaces, containers and objects."""
+    try:
+        from pycram.demos.scene_picture import VIEW_SIZE, write_scene_picture
+        from pycram.sim import World
+    except ModuleNotFoundError as e:
+        _fail(f"`pycram scene` needs the 'sim' and 'db' extras (pip install 'pycram[all]'): {e}")
+    from pycram.world.scenes import PlacementError
+
+    types = [t.strip() for t in objects.split(",") if t.strip()]
+    try:
+        world = World(robot, environment=env, seed=seed, objects=types or None, offscreen_size=VIEW_SIZE)
+    except (KeyError, PlacementError) as e:
+        _fail(str(e).strip("'\""))
+    try:
+        path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
+        for p in world.placements:
+            where = p.support + (f" (in {p.container})" if p.container else "")
+            console.print(f"  {escape(p.name):<10} {escape(where)}")
+    finally:
+        world.close()
+    console.print(f"wrote {escape(str(path))}")
 
 
 def main(argv: list[str] | None = None) -> int:

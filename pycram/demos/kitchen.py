@@ -176,7 +176,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         operator_resolver,
     )
     from pycram.runtime import format_task_tree
-    from pycram.sim import COUNTER_HEIGHT, ItemSpec, Pose2D, World
+    from pycram.sim import ItemSpec, Pose2D, World
     from pycram.sim.render import write_animation
 
     output = result.output
@@ -185,6 +185,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
                    (*SLOTS[options.item_at], None) if options.item_at else (5.0, 5.0, None), (0.85, 0.2, 0.15, 1))
     items = [mug] if options.item_at else []
     world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+    counter_height = world.environment.surface("cooker #1").height
     thief = None
     frames: list = []
     try:
@@ -194,7 +195,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         operator = Operator(helper, gripper_of)
         robot.add_process_module("operator", operator)
         robot.process_module_resolvers.append(operator_resolver(operator))
-        facts = KitchenFacts(mug.half_height, COUNTER_HEIGHT, Pose2D(*START_POSE))
+        facts = KitchenFacts(mug.half_height, counter_height, Pose2D(*START_POSE))
         thief = Thief(world, helper, plan.phase, plan.goal, gripper_of(plan.GRIPPER), options.steal, rng)
         if recorder is not None:
             recorder.set_run_info(robot=options.robot)
@@ -216,7 +217,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         result.tree_text = format_task_tree(run.task) if run.task is not None else ""
         result.failed_grasps = failed_grasps(run.task)
         result.recoveries = recoveries(run.task)
-        result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, COUNTER_HEIGHT) if items else False
+        result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
         world.snapshot(output / "end.png")
         result.files.append(output / "end.png")
         frames = world.stop_recording() if options.animation else []

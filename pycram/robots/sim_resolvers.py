@@ -41,8 +41,8 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Optional, Sequence
 
-from pycram.sim.kitchen import COUNTERS, FREE_FLOOR
 from pycram.sim.types import Pose2D, yaw_to_quat
+from pycram.world.environment import FURNITURE_TOPS
 
 __all__ = [
     "make_motion_resolver",
@@ -115,26 +115,19 @@ def base_goal_in_map(world: Any, pose: Any, frame: Any = None) -> Pose2D:
     return pose
 
 
-def free_floor(world: Any) -> tuple[float, float, float, float]:
-    """The region (x_min, y_min, x_max, y_max) [m, map] of ``world``'s environment where the
-    base may stand: goals of ``moving`` and the base poses of ``to_reach`` must lie in it.
-
-    The one place resolvers learn the environment's extent (today the simulated kitchen's
-    ``FREE_FLOOR`` for every world; meant to read the world's environment description).
-    """
-    return FREE_FLOOR
-
-
 def on_free_floor(world: Any, x: float, y: float) -> bool:
-    """``True`` iff (x, y) [m, map] lies on :func:`free_floor` of ``world``."""
-    x0, y0, x1, y1 = free_floor(world)
-    return x0 <= x <= x1 and y0 <= y <= y1
+    """``True`` iff the base may stand at (x, y) [m, map]: on the floor of ``world``'s environment
+    and off its furniture (``Environment.is_free_floor``). Goals of ``moving`` and the base poses
+    of ``to_reach`` must lie there; this is the one place resolvers ask."""
+    return bool(world.environment.is_free_floor(x, y))
 
 
 def describe_free_floor(world: Any) -> str:
-    """``the free floor x in [-0.45, 3.0] m, y in [-0.9, 3.5] m`` (for messages)."""
-    x0, y0, x1, y1 = free_floor(world)
-    return f"the free floor x in [{x0:g}, {x1:g}] m, y in [{y0:g}, {y1:g}] m"
+    """``the free floor of thesis-kitchen (x in [-0.45, 3] m, y in [-0.9, 3.5] m, off the furniture)``
+    (for messages)."""
+    env = world.environment
+    areas = "; ".join(f"x in [{x0:g}, {x1:g}] m, y in [{y0:g}, {y1:g}] m" for x0, y0, x1, y1 in env.floor)
+    return f"the free floor of {env.name} ({areas}, off the furniture)"
 
 
 def approach_target(description: Any, base: Pose2D, target: Sequence[float],
@@ -256,38 +249,36 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
 # --------------------------------------------------------------------------- locations
 
 
-def _counter_normal(x: float, y: float) -> Optional[tuple[float, float]]:
-    """Outward normal (towards the free floor) of the counter edge in front of (x, y), or None
-    when (x, y) is on no counter of the simulated kitchen."""
-    fx0, fy0, fx1, fy1 = FREE_FLOOR
+def _counter_normal(environment: Any, x: float, y: float) -> Optional[tuple[float, float]]:
+    """Outward normal (towards the free floor) of the counter or table edge nearest to (x, y),
+    or None when (x, y) is on no counter or table of ``environment`` (its description)."""
     best: Optional[tuple[float, tuple[float, float]]] = None
-    for box in COUNTERS:
-        (cx, cy, _), (hx, hy, _) = box.center, box.half
-        if not (abs(x - cx) <= hx + 1e-6 and abs(y - cy) <= hy + 1e-6):
+    for surface in environment.surfaces_of_kind(*FURNITURE_TOPS):
+        if not surface.contains(x, y, -1e-6):
             continue
-        for n in ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
-            edge_x = cx + n[0] * hx if n[0] else x
-            edge_y = cy + n[1] * hy if n[1] else y
-            probe_x, probe_y = edge_x + 0.3 * n[0], edge_y + 0.3 * n[1]
-            if not (fx0 <= probe_x <= fx1 and fy0 <= probe_y <= fy1):
+        for (ax, ay), _, n in surface.edges():
+            distance = (ax - x) * n[0] + (ay - y) * n[1]  # to the edge's line, along its normal
+            edge_x, edge_y = x + distance * n[0], y + distance * n[1]
+            if not environment.is_free_floor(edge_x + 0.3 * n[0], edge_y + 0.3 * n[1]):
                 continue
-            distance = math.hypot(edge_x - x, edge_y - y)
             if best is None or distance < best[0]:
                 best = (distance, n)
     return None if best is None else best[1]
 
 
 def base_pose_to_reach(description: Any, point: Sequence[float], arm: str,
-                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0) -> Pose2D:
+                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0,
+                       environment: Any = None) -> Pose2D:
     """The base pose from which ``arm`` reaches ``point`` [m, map].
 
-    The base faces the counter the point lies on (heading against the counter edge's outward
-    normal); off the counters it faces the point from the ``current`` base position. The point
+    The base faces the counter or table of ``environment`` (a description) the point lies on
+    (heading against the edge's outward normal); off them, or without an environment, it faces
+    the point from the ``current`` base position. The point
     is then at ``description.REACH_POINT_IN_BASE[arm]`` (+ ``extra_standoff`` [m] ahead) in the
     base frame.
     """
     x, y, _ = _point(point)
-    normal = _counter_normal(x, y)
+    normal = None if environment is None else _counter_normal(environment, x, y)
     if normal is not None:
         yaw = math.atan2(-normal[1], -normal[0])
     elif current is not None:
@@ -306,7 +297,7 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
     Yields base poses (``Pose2D``, map frame) from which the arm (default
     ``description.DEFAULT_ARM``) reaches the point: the best one first, then the same with the
     base 5 cm further back, 5 cm closer and 10 cm further back -- each only if it lies on the
-    environment's free floor (:func:`free_floor`). Raises ``NoSolutionError`` saying why when
+    environment's free floor (:func:`on_free_floor`). Raises ``NoSolutionError`` saying why when
     none does (the point is outside the environment, or too far from the floor). Returns
     ``None`` for other location designators.
     """
@@ -320,14 +311,14 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
             raise ValueError(f"the point to reach must be finite [m], got {point}")
         arm = physical_arm(d, desig.prop_value("arm") or d.DEFAULT_ARM)
         current = world.base_pose.get_value()
-        candidates = [base_pose_to_reach(d, point, arm, current, extra)
+        candidates = [base_pose_to_reach(d, point, arm, current, extra, world.environment)
                       for extra in (0.0, 0.05, -0.05, 0.10)]
         poses = [pose for pose in candidates if on_free_floor(world, pose.x, pose.y)]
         if not poses:
             from pycram.designators.core import NoSolutionError
 
             where = ("outside the environment" if not on_free_floor(world, point[0], point[1])
-                     and _counter_normal(point[0], point[1]) is None else "out of reach")
+                     and _counter_normal(world.environment, point[0], point[1]) is None else "out of reach")
             best = candidates[0]
             raise NoSolutionError(
                 f"Cannot resolve {desig!r}: the point {point} [m, map] is {where}: the "

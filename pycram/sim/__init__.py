@@ -1,4 +1,4 @@
-"""The simulated world: a MuJoCo kitchen with a PR2 or TIAGo whose sensors feed fluents.
+"""The simulated world: a MuJoCo environment with a PR2 or TIAGo whose sensors feed fluents.
 
 Import this package only when a simulation is wanted: it imports numpy and mujoco (and chooses
 a headless OpenGL backend first when no display is set). Quick start::
@@ -16,7 +16,6 @@ configure_gl()
 from .errors import CommandFailed, SimulationError, UnknownNameError, WorldClosedError  # noqa: E402
 from .handle import CommandHandle  # noqa: E402
 from .items import DEFAULT_ITEMS, ItemSpec  # noqa: E402
-from .kitchen import COOKERS, COUNTER_HEIGHT, cooker_positions  # noqa: E402
 from .robot_model import HEAD_CAMERA, ROBOTS  # noqa: E402
 from .scene import Scene, build_scene  # noqa: E402
 from .types import GripperState, JointStates, Outcome, Pose, Pose2D, VisibleItem, yaw_to_quat  # noqa: E402
@@ -24,7 +23,7 @@ from .world import World  # noqa: E402
 
 __all__ = [
     "World", "CommandHandle", "Outcome", "Pose", "Pose2D", "VisibleItem", "GripperState", "JointStates",
-    "ItemSpec", "DEFAULT_ITEMS", "COOKERS", "COUNTER_HEIGHT", "cooker_positions", "HEAD_CAMERA", "ROBOTS",
+    "ItemSpec", "DEFAULT_ITEMS", "HEAD_CAMERA", "ROBOTS",
     "Scene", "build_scene", "yaw_to_quat",
     "SimulationError", "UnknownNameError", "WorldClosedError", "CommandFailed",
 ]

@@ -17,8 +17,9 @@ from .types import GripperState, JointStates, Pose, Pose2D
 
 _log = logging.getLogger(__name__)
 
-#: Where items taken "aside" by fault injection are put (on the floor, out of the kitchen) [m].
-ASIDE_AREA = (4.5, 4.0)
+#: Items taken "aside" by fault injection are put on the floor this far [m] beyond the
+#: environment's plan (east of everything, out of the way).
+ASIDE_DISTANCE = 1.5
 #: A closing gripper grasps an item only while its fingers are at least this far apart [m]:
 #: fully closed fingers have nothing between them, whatever touches their outsides.
 MIN_GRASP_OPENING = 0.003
@@ -104,15 +105,23 @@ class Engine:
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
         self.item_geoms = {it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name)
                            for it in scene.items}
-        self.geom_item = {g: name for name, g in self.item_geoms.items()}
+        #: every geom of each item (items of several parts: bowls, plates)
+        self.item_part_geoms = {name: [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == b]
+                                for name, b in self.item_bodies.items()}
+        self.geom_item = {g: name for name, gs in self.item_part_geoms.items() for g in gs}
         self.item_qpos = {it.name: int(self.model.jnt_qposadr[self.model.body_jntadr[b]])
                           for it, b in zip(scene.items, self.item_bodies.values())}
         self.item_dof = {it.name: int(self.model.jnt_dofadr[self.model.body_jntadr[b]])
                          for it, b in zip(scene.items, self.item_bodies.values())}
-        # robot joints reported in joint states: everything but the items' free joints
+        # robot joints reported in joint states: everything but the items' free joints and furniture
+        furniture_joints = {c.joint_name for c in scene.environment.containers}
         self.robot_joints = [(self.model.joint(j).name, int(self.model.jnt_qposadr[j]), int(self.model.jnt_dofadr[j]))
                              for j in range(self.model.njnt)
-                             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE]
+                             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
+                             and self.model.joint(j).name not in furniture_joints]
+        from .furniture import Furniture  # (furniture's controllers import this module)
+
+        self.furniture = Furniture(self)
         self.obstacles = {f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])
                           for i in range(self._count_obstacles())}
         self.obstacles_used: set[str] = set()
@@ -276,10 +285,11 @@ class Engine:
         mujoco.mj_forward(self.model, self.data)
 
     def aside_position(self, item: str) -> tuple[float, float, float]:
-        """A free spot on the floor away from the kitchen for `item`."""
+        """A free spot on the floor for `item`, beyond the environment (east of it)."""
         self._aside_count += 1
         spec = self.scene.item(item)
-        return (ASIDE_AREA[0], ASIDE_AREA[1] + 0.3 * self._aside_count, spec.half_height + 0.002)
+        _, y0, x1, _ = self.scene.environment.plan_bounds
+        return (x1 + ASIDE_DISTANCE, y0 + 0.3 * self._aside_count, spec.half_height + 0.002)
 
     def place_obstacle(self, name: str, x: float, y: float) -> None:
         self.data.mocap_pos[self.obstacles[name]] = (x, y, 0.0)

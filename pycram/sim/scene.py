@@ -1,4 +1,4 @@
-"""One call builds a scene: the kitchen, one robot and the items, compiled into a MuJoCo model.
+"""One call builds a scene: an environment, one robot and the items, compiled into a MuJoCo model.
 
 `build_scene` is cheap (well under a second) and can be repeated in one process.
 """
@@ -14,7 +14,10 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from . import kitchen
+from pycram import environments
+from pycram.world.environment import Environment
+
+from .environment_builder import add_environment
 from .errors import UnknownNameError
 from .items import DEFAULT_ITEMS, ItemSpec, add_item
 from .robot_model import BASE_JOINTS, HEAD_CAMERA, add_robot, build_robot_spec, load_description, pad_site, tool_site
@@ -36,6 +39,7 @@ class Scene:
     model: mujoco.MjModel
     description: ModuleType
     items: tuple[ItemSpec, ...]
+    environment: Environment
     robot_geoms: frozenset[int] = field(default_factory=frozenset)
     base_geoms: frozenset[int] = field(default_factory=frozenset)
     environment_geoms: frozenset[int] = field(default_factory=frozenset)
@@ -117,20 +121,26 @@ def _subtree_bodies(model: mujoco.MjModel, root: int) -> set[int]:
 
 
 def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
-                offscreen_size: tuple[int, int] = (640, 480)) -> Scene:
-    """Compile the kitchen with `robot` ("pr2" or "tiago") and `items` (default: `DEFAULT_ITEMS`).
+                offscreen_size: tuple[int, int] = (640, 480),
+                environment: str | Environment = environments.DEFAULT_ENVIRONMENT) -> Scene:
+    """Compile `environment` (a name or a description) with `robot` ("pr2" or "tiago") and
+    `items` (default: `DEFAULT_ITEMS` in the thesis kitchen, none elsewhere).
 
-    Offscreen renders are limited to `offscreen_size` [px]. Raises `UnknownNameError` for an
-    unknown robot.
+    An item without a z stands on the highest open surface below it (the floor when there is
+    none). Offscreen renders are limited to `offscreen_size` [px]. Raises `UnknownNameError`
+    for an unknown robot or environment.
     """
     t0 = time.perf_counter()
+    env = environments.load(environment)
     desc = load_description(robot)
-    items = tuple(DEFAULT_ITEMS if items is None else items)
+    if items is None:  # the default items belong to the thesis kitchen
+        items = DEFAULT_ITEMS if env.name == environments.DEFAULT_ENVIRONMENT else ()
+    items = tuple(items)
     names = [it.name for it in items]
     if len(set(names)) != len(names):
         raise ValueError(f"item names must be unique: {names}")
     spec = build_robot_spec(desc)  # the robot's spec becomes the scene's (no attach, no renaming)
-    spec.modelname = f"kitchen_{robot}"
+    spec.modelname = f"{env.name}_{robot}"
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
@@ -139,9 +149,9 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     spec.visual.global_.offheight = offscreen_size[1]
     spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
     spec.visual.headlight.diffuse = [0.5, 0.5, 0.5]
-    kitchen.add_kitchen(spec)
+    add_environment(spec, env)
     for it in items:
-        add_item(spec, it)
+        add_item(spec, it, it.resting_position(env.support_height(it.position[0], it.position[1])))
     add_robot(spec, desc)
     for gname, g in desc.GRIPPERS.items():
         for it in items:
@@ -156,7 +166,7 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     geoms_of = lambda bodies: frozenset(  # noqa: E731
         g for g in range(model.ngeom) if model.geom_bodyid[g] in bodies and model.geom_contype[g])
     env_geoms = frozenset(g for g in range(model.ngeom) if model.geom_contype[g] == 1)
-    scene = Scene(model=model, description=desc, items=items, robot_geoms=geoms_of(robot_bodies),
+    scene = Scene(model=model, description=desc, items=items, environment=env, robot_geoms=geoms_of(robot_bodies),
                   base_geoms=geoms_of(base_bodies), environment_geoms=env_geoms)
     _log.info("scene %s built in %.3f s (nq=%d, ngeom=%d)", spec.modelname,
               time.perf_counter() - t0, model.nq, model.ngeom)
@@ -177,7 +187,7 @@ def initial_state(scene: Scene, base: tuple[float, float, float]) -> mujoco.MjDa
     for e in range(model.neq):  # coupled gripper joints: half open
         if model.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT:
             j2 = int(model.eq_obj2id[e])
-            if model.joint(j2).name in gripper_joints:
+            if j2 >= 0 and model.joint(j2).name in gripper_joints:
                 q2 = 0.5 * float(model.jnt_range[j2, 1])
                 data.qpos[model.jnt_qposadr[j2]] = q2
                 data.qpos[model.jnt_qposadr[model.eq_obj1id[e]]] = model.eq_data[e, 0] + model.eq_data[e, 1] * q2

@@ -7,7 +7,8 @@ The simulation thread is the only thread that touches MuJoCo. Other threads
 - read sensor fluents, updated at `sensor_rate` [Hz] of simulated time (at most once per
   control tick of `control_period` [s], and also right after a command ends): `base_pose`,
   `joint_states`, `gripper_openings[g]`, `gripper_states[g]`, `tool_poses`, `item_poses`,
-  `sim_time`, and `camera_image` (on request).
+  `container_states` (joint position of each drawer and door), `sim_time`, and `camera_image`
+  (on request).
 
 While it runs, the world's `ManualClock` is the active PyCRAM clock: `pycram.sleep` and fluent
 time-outs follow simulated time. Headless it runs as fast as it can; `realtime=True` paces it to
@@ -28,14 +29,21 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from pycram.environments import DEFAULT_ENVIRONMENT
+from pycram.environments import load as load_environment
+from pycram.world.environment import Environment
+from pycram.world.objects import object_type
+from pycram.world.scenes import random_scene
+
 from ._runtime import Fluent, ManualClock, current_clock, set_clock
 from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
                           JointTrajectory, Reach)
 from .engine import Engine
+from .environment_builder import OBSTACLE_PARKING
+from .furniture import ContainerPush
 from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
-from .kitchen import OBSTACLE_PARKING
 from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
@@ -44,8 +52,8 @@ from .types import Outcome, Pose, Pose2D, VisibleItem
 
 _log = logging.getLogger(__name__)
 
-#: Where the robot's base starts: (x [m], y [m], yaw [rad]).
-DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)  # [m, m, rad] on the free floor between the counters
+#: The thesis kitchen's start pose [m, m, rad] (on the free floor between the counters).
+DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)
 #: Clocks of closed worlds -> the clock that was active before each (to skip them when restoring).
 _CLOSED_CLOCKS: "weakref.WeakKeyDictionary[ManualClock, Any]" = weakref.WeakKeyDictionary()
 _CLOCK_LOCK = threading.Lock()
@@ -55,7 +63,15 @@ REALTIME_SLACK = 0.05
 
 
 class World:
-    """The kitchen, a robot ("pr2" or "tiago") and items, simulated in a background thread.
+    """An environment (default: the thesis kitchen), a robot ("pr2" or "tiago") and items,
+    simulated in a background thread. The robot starts at `base_pose` (default: the
+    environment's place "start").
+
+    Items are given as `ItemSpec`s (`items`; by default the thesis kitchen's `DEFAULT_ITEMS`
+    there and none elsewhere) and/or as object type names (`objects`, e.g. ``["cup", "bowl",
+    "cup"]``), which are placed at random, non-overlapping spots on the environment's surfaces
+    and inside its containers, the same for the same `seed` (see `pycram.world.scenes`); they
+    are named after their type ("cup", "cup 2") and `placements` says where each started.
 
     Construction builds the scene (< 1 s) and starts the thread. `close()` (or leaving the
     `with` block) stops it and joins it; every command still running ends with reason "closed".
@@ -64,11 +80,23 @@ class World:
     """
 
     def __init__(self, robot: str = "pr2", items: Sequence[ItemSpec] | None = None, *,
-                 base_pose: tuple[float, float, float] = DEFAULT_BASE_POSE, realtime: bool = False,
+                 environment: str | Environment = DEFAULT_ENVIRONMENT,
+                 objects: Sequence[str] | None = None, seed: int = 0,
+                 base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
                  offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
-        self.scene = build_scene(robot, items, offscreen_size)
+        env = load_environment(environment)
+        #: Where the `objects` started (a random scene from `seed`; empty without objects).
+        self.placements = random_scene(env, objects, seed) if objects else []
+        if self.placements:
+            items = list(items or []) + [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw)
+                                         for p in self.placements]
+        self.scene = build_scene(robot, items, offscreen_size, env)
         self.description = self.scene.description
+        #: The environment's description (data: surfaces, containers, places, free floor).
+        self.environment = self.scene.environment
+        if base_pose is None:
+            base_pose = self.environment.start_pose
         self.robot = robot
         self.realtime, self.realtime_factor = realtime, realtime_factor
         self._steps_per_tick = max(1, round(control_period / self.scene.model.opt.timestep))
@@ -85,6 +113,8 @@ class World:
         self.gripper_states = {g: Fluent(eng.gripper_state(g), name=f"{g}_gripper_state") for g in eng.grippers}
         self.tool_poses = Fluent(self._tool_poses(), name="tool_poses")
         self.item_poses = Fluent(self._item_poses(), name="item_poses")
+        #: Joint position of every container by name [m for drawers, rad for doors], 0 when closed.
+        self.container_states = Fluent(eng.furniture.positions(eng.data), name="container_states")
         self.camera_image = Fluent(None, name="camera_image")
         # --- command plumbing
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()
@@ -263,6 +293,8 @@ class World:
             self.gripper_openings[g].set_value(state.opening)
         self.tool_poses.set_value(self._tool_poses())
         self.item_poses.set_value(self._item_poses())
+        if eng.furniture.containers:
+            self.container_states.set_value(eng.furniture.positions(eng.data))
 
     # ------------------------------------------------------------------ submitting
     def submit(self, ctrl: Controller, name: str) -> CommandHandle:
@@ -400,8 +432,8 @@ class World:
         def fn(eng: Engine) -> list[VisibleItem]:
             ids = self._get_renderers().segmentation(eng.data, HEAD_CAMERA, width, height)
             seen = []
-            for name, geom in eng.item_geoms.items():
-                rows, cols = np.nonzero(ids == geom)
+            for name, geoms in eng.item_part_geoms.items():
+                rows, cols = np.nonzero(np.isin(ids, geoms))
                 if len(rows) >= min_pixels:
                     seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), len(rows),
                                             (float(cols.mean()), float(rows.mean()))))
@@ -492,7 +524,7 @@ class World:
                   to: Sequence[float] | None = None) -> CommandHandle:
         """Take an item away, as a person would: out of `gripper` (the item it holds) or `item` by name.
 
-        The item goes to `to` [m] or aside onto the floor out of the kitchen. The gripper keeps
+        The item goes to `to` [m] or aside onto the floor beyond the environment. The gripper keeps
         its command, so a closed gripper closes fully. Value: the item's name (None if nothing).
         """
         if gripper is not None:
@@ -553,6 +585,29 @@ class World:
             eng.remove_obstacle(name, OBSTACLE_PARKING)
 
         return self._call("remove_obstacle", fn)
+
+    def set_container_stuck(self, container: str, stuck: bool = True) -> CommandHandle:
+        """Fault: make the drawer or door `container` stuck where it is (or free it again).
+
+        A stuck container does not move however hard it is pulled (it is held by a constraint).
+        """
+        self.environment.container(container)
+
+        def fn(eng: Engine) -> None:
+            eng.furniture.set_stuck(eng.data, container, stuck)
+
+        return self._call("set_container_stuck", fn)
+
+    def push_container(self, container: str, force: Sequence[float], duration: float,
+                       point: Sequence[float] | None = None) -> CommandHandle:
+        """A person's hand pushes or pulls `container` with `force` [N, map frame] for `duration`
+        [s of simulated time], at its handle (default) or at `point` [m, map frame] on it.
+
+        Value: the container's joint position at the end [m or rad]. The container moves only as
+        far as the force overcomes its friction; it keeps moving briefly (damped) afterwards.
+        """
+        self.environment.container(container)
+        return self.submit(ContainerPush(container, force, duration, point), f"push:{container}")
 
     # ------------------------------------------------------------------ conveniences
     def kitchen_base_pose(self, place: str) -> Pose2D:

@@ -35,10 +35,8 @@ def motion(**properties):
 
 def item_centre(world, xy):
     """Centre [m] of the mug standing on the counter at ``xy``."""
-    from pycram.sim import COUNTER_HEIGHT
-
     half = next(i for i in world.scene.items if i.name == "mug").half_height
-    return [xy[0], xy[1], COUNTER_HEIGHT + half]
+    return [xy[0], xy[1], world.environment.support_height(*xy) + half]
 
 
 def put_mug(world, xy):

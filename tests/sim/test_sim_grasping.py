@@ -10,8 +10,11 @@ import math
 
 import numpy as np
 
-from pycram.sim import COUNTER_HEIGHT, cooker_positions
+from pycram.environments import load as load_environment
 from sim_helpers import T, facing_quat, ok
+
+KITCHEN = load_environment("thesis-kitchen")
+COUNTER_HEIGHT = KITCHEN.surface("counter_back").height
 
 MUG_SPOT = (0.1, -1.15)  # on the back counter at cooker #2 [m]
 
@@ -95,7 +98,7 @@ def test_grasp_lift_drive_keeps_item_and_taking_it_closes_the_gripper(world):
     assert world.gripper_states[gripper].get_value().holding == "mug"
     assert world.gripper_openings[gripper].get_value() > 0.03
     # fault: the item is moved elsewhere (out of the gripper, onto cooker #1)
-    cooker = cooker_positions()["cooker #1"]
+    cooker = KITCHEN.surface("cooker #1").centroid
     spot = (cooker[0], cooker[1], cooker[2] + world.scene.item("mug").half_height + 0.001)
     ok(world.move_item("mug", spot))
     assert world.gripper_states[gripper].get_value().holding is None

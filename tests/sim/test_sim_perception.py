@@ -8,8 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from pycram.sim import COUNTER_HEIGHT, ItemSpec, World
+from pycram.environments import load as load_environment
+from pycram.sim import ItemSpec, World
 from sim_helpers import ViewMonitor, ok
+
+COUNTER_HEIGHT = load_environment("thesis-kitchen").surface("counter_back").height
 
 ROBOTS = ("pr2", "tiago")
 MUG_SPOT = (0.1, -1.15)  # on the back counter at cooker #2 [m]

@@ -14,7 +14,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from pycram.sim import COOKERS, COUNTER_HEIGHT, DEFAULT_ITEMS, Pose, build_scene
+from pycram.environments import load as load_environment
+from pycram.sim import DEFAULT_ITEMS, Pose, build_scene
 from pycram.sim.errors import UnknownNameError
 from sim_helpers import facing_quat, to_map
 
@@ -48,13 +49,15 @@ def test_counters_are_0_9_m_high_with_two_cooker_areas():
     model = build_scene("pr2").model
     for counter in ("counter_back", "counter_left"):
         assert abs(_box_top(model, counter) - 0.9) < 0.01, counter
-    assert abs(COUNTER_HEIGHT - 0.9) < 0.01
-    assert [c.name for c in COOKERS] == ["cooker #1", "cooker #2"]
+    kitchen = load_environment("thesis-kitchen")
+    cookers = kitchen.surfaces_of_kind("cooker")
+    assert [c.name for c in cookers] == ["cooker #1", "cooker #2"]
     tops = {"counter_back": None, "counter_left": None}
-    for cooker in COOKERS:
+    for cooker in cookers:
+        assert abs(cooker.height - 0.9) < 0.01
         site = model.site(cooker.name)
         x, y, z = model.site_pos[site.id] + model.body(int(site.bodyid[0])).pos
-        assert abs(z - COUNTER_HEIGHT) < 0.01
+        assert abs(z - 0.9) < 0.01
         # each cooker area lies on the top of one counter, a different one for each cooker
         on = [n for n in tops if all(abs(v - c) <= h for v, c, h in
                                      zip((x, y), model.geom(n).pos[:2], model.geom(n).size[:2]))]

@@ -11,8 +11,10 @@ import math
 
 import numpy as np
 
-from pycram.sim import COUNTER_HEIGHT
+from pycram.environments import load as load_environment
 from sim_helpers import T, Recorder, facing_quat, ok, to_map
+
+COUNTER_HEIGHT = load_environment("thesis-kitchen").surface("counter_back").height
 
 
 def test_world_publishes_sensors(world):

@@ -1,0 +1,147 @@
+"""Object types: what a cup, a bowl, a spoon, a cereal box, a milk carton and a plate are.
+
+Each `ObjectType` states its shape and size (as primitive parts a simulator or a picture can
+build), mass, colour, where such objects are usually found (surface kinds), and how it is
+grasped (`Grasp`: approach direction, finger opening, grasp height) — data that grasp planning
+reads. Conventions: the object's frame sits at its centre, z up; lengths in [m], mass in [kg].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+from .errors import UnknownNameError
+
+#: A colour: red, green, blue, alpha in [0, 1].
+RGBA = tuple[float, float, float, float]
+#: Horizontal approach directions in the object's frame; "side" means any horizontal direction
+#: (round objects), "top" straight down.
+APPROACHES = ("top", "side", "+x", "-x", "+y", "-y")
+
+
+@dataclass(frozen=True)
+class Part:
+    """A primitive of an object's shape, in the object's frame: a "box" (half sizes) or a
+    "cylinder" (radius, half height) at `pos` [m], turned by `yaw` [rad] about z."""
+
+    kind: Literal["box", "cylinder"]
+    pos: tuple[float, float, float]
+    size: tuple[float, ...]
+    yaw: float = 0.0
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """One way to grasp an object type.
+
+    `approach` is where the gripper comes from (`APPROACHES`); `opening` [m] is the distance
+    between the finger pads when they close on the object; `height` [m] is the grasp point above
+    the object's bottom; `radius` [m] moves the grasp point off the object's axis towards the
+    gripper (rim grasps of bowls and plates: the fingers pinch the wall); `across` says which
+    object axis the fingers close across for a top grasp ("x", "y", or "radial" for a rim).
+    """
+
+    approach: str
+    opening: float
+    height: float
+    radius: float = 0.0
+    across: str = ""
+
+    def __post_init__(self) -> None:
+        if self.approach not in APPROACHES:
+            raise ValueError(f"grasp approach {self.approach!r} is not one of {', '.join(APPROACHES)}")
+
+
+@dataclass(frozen=True)
+class ObjectType:
+    """A kind of household object.
+
+    `shape` is "box" (size: half sizes x, y, z), "cylinder" (radius, half height), "bowl" or
+    "plate" (radius, half height, wall thickness: a base with a wall around it). `found_on` are
+    the surface kinds such objects are put on or in ("counter", "table", "shelf", "drawer").
+    """
+
+    name: str
+    shape: Literal["box", "cylinder", "bowl", "plate"]
+    size: tuple[float, ...]
+    mass: float
+    rgba: RGBA
+    grasps: tuple[Grasp, ...]
+    found_on: tuple[str, ...] = ("counter", "table", "shelf", "drawer")
+    description: str = ""
+
+    @property
+    def half_height(self) -> float:
+        """Half the object's height [m]."""
+        return self.size[2] if self.shape == "box" else self.size[1]
+
+    @property
+    def height(self) -> float:
+        return 2.0 * self.half_height
+
+    @property
+    def footprint_radius(self) -> float:
+        """Radius [m] of the smallest circle around the object's shadow on a surface (any yaw)."""
+        return math.hypot(self.size[0], self.size[1]) if self.shape == "box" else self.size[0]
+
+    def parts(self) -> list[Part]:
+        """The object's shape as primitives (see `shape_parts`)."""
+        return shape_parts(self.shape, self.size)
+
+
+def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
+    """Primitive parts of a shape: one part for "box" and "cylinder"; a base disc and 12 wall
+    boxes around it for "bowl" and "plate" (size: radius, half height, wall thickness)."""
+    if shape == "box":
+        return [Part("box", (0.0, 0.0, 0.0), tuple(size))]
+    if shape == "cylinder":
+        return [Part("cylinder", (0.0, 0.0, 0.0), (size[0], size[1]))]
+    if shape in ("bowl", "plate"):
+        radius, half, wall = size
+        base = wall / 2 if shape == "bowl" else 0.6 * half  # a plate's base is most of its height
+        n = 12
+        parts = [Part("cylinder", (0.0, 0.0, -half + base), (radius, base))]
+        wall_half = half - base
+        r = radius - wall / 2
+        for i in range(n):
+            a = 2 * math.pi * i / n
+            parts.append(Part("box", (r * math.cos(a), r * math.sin(a), half - wall_half),
+                              (wall / 2, r * math.tan(math.pi / n) + 0.001, wall_half), a))
+        return parts
+    raise ValueError(f"shape {shape!r} is not one of: box, cylinder, bowl, plate")
+
+
+_ANY_SURFACE = ("counter", "table", "shelf", "drawer")
+
+#: Every object type by name.
+OBJECT_TYPES: dict[str, ObjectType] = {t.name: t for t in (
+    ObjectType("cup", "cylinder", (0.035, 0.045), 0.2, (0.80, 0.18, 0.15, 1.0),
+               (Grasp("side", 0.07, 0.05),), _ANY_SURFACE, "a drinking cup, 7 cm wide, 9 cm tall"),
+    ObjectType("bowl", "bowl", (0.07, 0.035, 0.008), 0.25, (0.95, 0.82, 0.25, 1.0),
+               (Grasp("top", 0.008, 0.06, radius=0.066, across="radial"),), _ANY_SURFACE,
+               "a cereal bowl, 14 cm wide, 7 cm tall; grasped at its rim"),
+    ObjectType("plate", "plate", (0.11, 0.012, 0.008), 0.35, (0.96, 0.96, 0.93, 1.0),
+               (Grasp("top", 0.008, 0.02, radius=0.106, across="radial"),), ("counter", "table", "shelf"),
+               "a dinner plate, 22 cm wide, with a 1 cm rim; grasped at its rim"),
+    ObjectType("spoon", "box", (0.075, 0.011, 0.005), 0.04, (0.70, 0.72, 0.75, 1.0),
+               (Grasp("top", 0.022, 0.005, across="y"),), ("counter", "table", "drawer"),
+               "a spoon (a flat bar, 15 cm long); grasped from above across its handle"),
+    ObjectType("cereal", "box", (0.035, 0.095, 0.14), 0.4, (0.92, 0.55, 0.12, 1.0),
+               (Grasp("+y", 0.07, 0.16), Grasp("-y", 0.07, 0.16), Grasp("top", 0.07, 0.26, across="x")),
+               ("counter", "table", "shelf"), "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side"),
+    ObjectType("milk", "box", (0.035, 0.035, 0.1), 0.5, (0.92, 0.94, 1.0, 1.0),
+               tuple(Grasp(a, 0.07, 0.1) for a in ("+x", "-x", "+y", "-y")),
+               ("counter", "table", "shelf"), "a milk carton, 7 x 7 x 20 cm"),
+)}
+
+
+def object_type(name: str) -> ObjectType:
+    """The object type called `name` (`UnknownNameError` listing the valid names otherwise)."""
+    if name not in OBJECT_TYPES:
+        raise UnknownNameError("object type", name, OBJECT_TYPES)
+    return OBJECT_TYPES[name]
+
+
+__all__ = ["ObjectType", "Grasp", "Part", "OBJECT_TYPES", "APPROACHES", "object_type", "shape_parts"]

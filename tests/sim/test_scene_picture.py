@@ -1,0 +1,46 @@
+"""`pycram scene`: a labelled picture of a random scene, and clear errors for bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+from typer.testing import CliRunner  # noqa: E402
+
+from pycram.cli import app  # noqa: E402
+
+runner = CliRunner()
+
+
+def test_scene_command_writes_a_labelled_picture(tmp_path):
+    import imageio.v3 as iio
+
+    out = tmp_path / "scene.png"
+    result = runner.invoke(app, ["scene", "--env", "apartment", "--seed", "3", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    for name in ("cup", "bowl", "spoon", "cereal", "milk", "plate"):
+        assert name in result.output  # where each object starts is listed
+    image = iio.imread(out)
+    assert image.shape[1] > 1200 and image.shape[0] > 500  # plan and overview side by side
+    assert np.asarray(image).std() > 20  # a picture, not a blank canvas
+
+
+def test_scene_command_on_the_thesis_kitchen_without_objects(tmp_path):
+    out = tmp_path / "kitchen.png"
+    result = runner.invoke(app, ["scene", "--env", "thesis-kitchen", "--objects", "", "--robot", "tiago",
+                                 "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert out.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--env", "garage"], "environment 'garage' does not exist. Available: apartment, thesis-kitchen"),
+    (["--objects", "cup,fork"], "object type 'fork' does not exist. Available: bowl, cereal, cup"),
+    (["--env", "thesis-kitchen", "--objects", ",".join(["cereal"] * 40)], "no free spot for 'cereal"),
+])
+def test_scene_command_names_bad_input(tmp_path, args, message):
+    result = runner.invoke(app, ["scene", *args, "-o", str(tmp_path / "x.png")])
+    assert result.exit_code == 1
+    assert message in " ".join(result.output.split())
+    assert not (tmp_path / "x.png").exists()
