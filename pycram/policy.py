@@ -90,6 +90,10 @@ class Policy:
         self.clean_up = clean_up
         self.description = description
 
+    def __call__(self, body: Callable[[], Any], *params: Any) -> Any:
+        """`policy(body, *params)` is `with_policy(policy, body, *params)`."""
+        return with_policy(self, body, *params)
+
     def __repr__(self) -> str:
         return f"<Policy {self.name}>"
 
@@ -161,3 +165,5 @@ timeout_policy = define_policy(
     check=_timeout_check,
     description="Evaporate the body when it has not ended after `seconds` [s] of the active clock.",
 )
+"""CRAM's timeout policy: `with_policy(timeout_policy, body, seconds)` raises
+`PolicyConditionMet` (after evaporating body) when body has not ended after `seconds` [s]."""

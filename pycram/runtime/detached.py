@@ -25,6 +25,7 @@ from pycram.runtime.evaporation import current_runner, shielded, wait_until
 __all__ = ["detached_children", "DETACHED_RULES"]
 
 DETACHED_RULES = ("wait", "evaporate")
+"""The rules `detached_children` accepts."""
 
 
 @contextmanager
