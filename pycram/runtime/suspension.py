@@ -85,14 +85,16 @@ class _Point(_evaporation.SuspensionPoint):
 _point = _Point()
 
 
-def is_suspended(task: Task) -> bool:
-    """True while `task` or one of its ancestors is suspended (whether or not it has blocked)."""
+def _self_and_ancestors(task: Task) -> Iterator[Task]:
     node: Task | None = task
     while node is not None:
-        if node in _counts:
-            return True
+        yield node
         node = node.parent
-    return False
+
+
+def is_suspended(task: Task) -> bool:
+    """True while `task` or one of its ancestors is suspended (whether or not it has blocked)."""
+    return any(node in _counts for node in _self_and_ancestors(task))
 
 
 def _chain(runner: Runner) -> list[Task]:
@@ -162,12 +164,7 @@ def _nudge(runners: list[Runner]) -> None:
 
 
 def _in_subtree(task: Task, root: Task) -> bool:
-    node: Task | None = task
-    while node is not None:
-        if node is root:
-            return True
-        node = node.parent
-    return False
+    return any(node is root for node in _self_and_ancestors(task))
 
 
 def _all_suspended(root: Task, watched: set[int], network: _fluent.Fluent) -> bool:
