@@ -27,7 +27,8 @@ given to `with_policy`::
    and `with_policy` returns body's result or raises body's exception.
 4. `clean_up` runs in every case once init succeeded (in a `finally`).
 
-`timeout_policy` (parameter: seconds [s] of the active clock) is built with it.
+`timeout_policy` (parameter: seconds [s] of the active clock) is built with it. Block form
+(with the block syntax): `with with_policy(timeout_policy, 5.0): ...` runs the block as body.
 """
 
 from __future__ import annotations
@@ -115,7 +116,10 @@ def with_policy(policy: Policy, body: Callable[[], Any], *params: Any) -> Any:
     if not isinstance(policy, Policy):
         raise TypeError(f"with_policy() needs a Policy (from define_policy), got {type(policy).__name__}: {policy!r}")
     if not callable(body):
-        raise TypeError(f"with_policy({policy.name!r}): body must be a callable taking no arguments, got {body!r}")
+        raise TypeError(
+            f"with_policy({policy.name!r}): body must be a callable taking no arguments, got {body!r}; "
+            f"the block form `with with_policy(policy, *params):` needs the block syntax (`@plan`, "
+            f"`pycram run FILE.py` or `import pycram.activate`)")
     run = PolicyRun(policy, params)
     if policy.init is not None and not policy.init(run, *params):
         raise PolicyInitFailed(policy, params)

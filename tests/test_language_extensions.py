@@ -651,3 +651,24 @@ def test_detached_children_default_rule_unchanged_and_bad_rule() -> None:
     with pytest.raises(ValueError, match="must be one of"):
         with detached_children("kill"):
             pass
+
+
+def test_with_policy_block_syntax() -> None:
+    never = Fluent()
+    log = []
+
+    @plan
+    def run(seconds: float) -> None:
+        with with_policy(timeout_policy, seconds):
+            log.append("body")
+            never.wait_for()
+
+    with pytest.raises(PolicyConditionMet, match="'timeout'"):
+        run(0.02)
+    assert log == ["body"]
+
+
+def test_with_policy_block_needs_the_syntax() -> None:
+    with pytest.raises(TypeError, match="needs the block syntax"):
+        with with_policy(timeout_policy, 1.0):
+            pass
