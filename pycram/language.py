@@ -20,6 +20,9 @@ Guarantees:
 * An expression never raises its branches' exceptions to the caller: they are appended to
   `errors` (when given) in the order the branches failed. Exactly the branches whose task ended
   FAILED contribute; evaporated branches contribute nothing.
+* The state fluent (a `StateFluent`) holds the winning branch's return value in `result` —
+  `seq`: the last step's, `par`: every branch's in order, the others: the winner's — set before
+  the value becomes SUCCEEDED; None on failure.
 * The state fluent is set as soon as the outcome is decided (branches may watch it) and never
   changes afterwards. Pass `state=` a fresh `Fluent` to get it before the branches start.
 * An expression returns only after every task it started — and all of theirs — has ended, on
@@ -240,6 +243,7 @@ class _Concurrent:
         self.failed = 0
         self.count = 0
         self.group: TaskGroup | None = None
+        self.result: Any = None  #: the winning branch's return value (par: all branches' in order)
 
     def on_end(self, task: Task) -> None:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
@@ -276,8 +280,6 @@ class _Concurrent:
                 self._decide(State.SUCCEEDED)
             elif status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
-
-    result: Any = None  #: the winning branch's return value (par: all branches' in order)
 
     def _decide(self, outcome: State) -> None:
         if self.outcome is None:
