@@ -19,7 +19,7 @@ by its number (1 = first statement).
 
 from __future__ import annotations
 
-from typing import Any, Callable, Hashable, Iterable, Mapping, Sequence
+from typing import Any, Hashable, Iterable, Mapping, Sequence
 
 from pycram.fluent import Fluent
 from pycram.language import Branch, _BlockUse, par
@@ -85,7 +85,8 @@ def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None
     for index, fn in enumerate(fns):
         if not callable(fn):
             which = repr(keys[index]) if keys else str(index + 1)
-            raise TypeError(f"{label}: step {which} must be a callable taking no arguments, got {type(fn).__name__}: {fn!r}")
+            raise TypeError(
+                f"{label}: step {which} must be a callable taking no arguments, got {type(fn).__name__}: {fn!r}")
     names = _step_names(steps)
     after: list[set[int]] = [set() for _ in fns]
     fluents: list[list[Fluent]] = [[] for _ in fns]
@@ -103,7 +104,8 @@ def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None
     labels = [str(k) for k in keys] if keys else [str(i + 1) for i in range(len(fns))]
     cycle = _cycle(after, labels)
     if cycle:
-        raise ValueError(f"{label}: the orderings form a cycle {' -> '.join(reversed(cycle))}; no step of it could ever start")
+        raise ValueError(
+            f"{label}: the orderings form a cycle {' -> '.join(reversed(cycle))}; no step of it could ever start")
     ended = [Fluent(name=f"{label}: step {labels[i]} ended") for i in range(len(fns))]
 
     def constrained(index: int) -> Branch:

@@ -10,7 +10,6 @@ from __future__ import annotations
 import itertools
 import random
 import threading
-import time
 
 import pytest
 
@@ -78,10 +77,13 @@ def test_with_tags_1_tags_introduce_no_hidden_parallelism() -> None:
 from pycram.language import partial_order  # noqa: E402
 
 
-def _worker(name: str, times: dict, clock=itertools.count()):
+_end_order = itertools.count()  # a global order of the workers' end times
+
+
+def _worker(name: str, times: dict):
     def work() -> None:
         sleep(random.random() * 0.02)
-        times[name] = next(clock)  # a global order of the end times
+        times[name] = next(_end_order)
 
     return tag(name, work)
 
@@ -119,9 +121,8 @@ def test_partial_order_4_ring_dependencies_are_rejected_instead_of_deadlocking()
 
 # -- task suspension (language-tests.lisp and task-tests.lisp) ------------------------------------
 
-from pycram.language import (on_suspension, par, pursue, suspend, wake_up,  # noqa: E402
-                             with_task_suspended)
-from pycram.runtime import TaskStatus, current_task  # noqa: E402
+from pycram.language import on_suspension, par, pursue, suspend, wake_up, with_task_suspended  # noqa: E402
+from pycram.runtime import TaskStatus  # noqa: E402
 
 S = TaskStatus
 

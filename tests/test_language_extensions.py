@@ -7,9 +7,20 @@ import threading
 import pytest
 
 from pycram.fluent import Fluent
-from pycram.language import (State, StateFluent, par, par_loop, plan, pursue, seq, try_all,
-                             try_each_in_order, try_in_order, with_timeout)
-from pycram.runtime import Evaporated, current_task, sleep
+from pycram.language import (
+    State,
+    StateFluent,
+    par,
+    par_loop,
+    plan,
+    pursue,
+    seq,
+    try_all,
+    try_each_in_order,
+    try_in_order,
+    with_timeout,
+)
+from pycram.runtime import current_task
 
 TIMEOUT = 5.0
 
@@ -84,8 +95,8 @@ def test_block_syntax_state_has_the_result() -> None:
     @plan
     def run() -> StateFluent:
         with par as s:
-            1
-            2
+            _ = 1
+            _ = 2
         return s
 
     assert run().get_value() is State.SUCCEEDED
@@ -374,8 +385,7 @@ def test_partial_order_block_needs_the_syntax() -> None:
 
 # -- 6. suspension ---------------------------------------------------------------------------------
 
-from pycram.language import (is_suspended, on_suspension, retry_after_suspension, suspend,  # noqa: E402
-                             wake_up, with_task_suspended)
+from pycram.language import is_suspended, on_suspension, retry_after_suspension, suspend, wake_up, with_task_suspended  # noqa: E402
 from pycram.runtime import check_evaporation, format_task_tree  # noqa: E402
 
 
@@ -535,8 +545,7 @@ def test_process_module_rejects_an_unknown_suspension_mode() -> None:
 
 # -- 7. policies -----------------------------------------------------------------------------------
 
-from pycram.language import (PolicyConditionMet, PolicyInitFailed, define_policy,  # noqa: E402
-                             timeout_policy, with_policy)
+from pycram.language import PolicyConditionMet, PolicyInitFailed, define_policy, timeout_policy, with_policy  # noqa: E402
 
 
 def _recording_policy(log: list, init_ok: bool = True):

@@ -28,13 +28,21 @@ import time
 from typing import Any
 
 import pytest
+import test_language_properties as base
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import test_language_properties as base
 from pycram.fluent import Fluent
-from pycram.language import (PolicyConditionMet, par_loop, partial_order, suspend, timeout_policy,
-                             try_each_in_order, wake_up, with_policy)
+from pycram.language import (
+    PolicyConditionMet,
+    par_loop,
+    partial_order,
+    suspend,
+    timeout_policy,
+    try_each_in_order,
+    wake_up,
+    with_policy,
+)
 from pycram.runtime import Task, TaskStatus, add_task_listener, current_task, remove_task_listener
 from pycram.runtime.workers import shutdown_idle_workers
 
@@ -171,9 +179,10 @@ class StatusHistory:
             if len(finals) != 1 or finals[0] != len(states) - 1:
                 out.append(f"{task.path}: status history {[s.name for s in history]}")
                 continue
-            for before, after in zip(states, states[1:]):
+            for before, after in zip(states, states[1:], strict=False):
                 if before is P and after is not R:
-                    out.append(f"{task.path}: SUSPENDED left to {after.name}, not RUNNING ({[s.name for s in history]})")
+                    names = [s.name for s in history]
+                    out.append(f"{task.path}: SUSPENDED left to {after.name}, not RUNNING ({names})")
         return out
 
 
