@@ -14,6 +14,9 @@ of `try_in_order`):
   follows a final status;
 * ordering: a `partial_order` step starts its body only after the steps ordered before it
   ended;
+* task variables: a leaf reads the value bound by its innermost enclosing `bound` block (in
+  whatever thread it runs);
+* tags: the task that ran a tagged body is tagged with that name;
 * a `with_policy` raised `PolicyConditionMet` only when its body task was EVAPORATED (a body
   that ended by itself in a tie with the check wins).
 
@@ -35,13 +38,16 @@ from hypothesis import strategies as st
 from pycram.fluent import Fluent
 from pycram.language import (
     PolicyConditionMet,
+    TaskVariable,
     par_loop,
     partial_order,
+    tag,
     suspend,
     timeout_policy,
     try_each_in_order,
     wake_up,
     with_policy,
+    with_tags,
 )
 from pycram.runtime import Task, TaskStatus, add_task_listener, current_task, remove_task_listener
 from pycram.runtime.workers import shutdown_idle_workers
@@ -49,20 +55,26 @@ from pycram.runtime.workers import shutdown_idle_workers
 S, F, E, R, P = (TaskStatus.SUCCEEDED, TaskStatus.FAILED, TaskStatus.EVAPORATED, TaskStatus.RUNNING,
                  TaskStatus.SUSPENDED)
 EXAMPLES = 120
+VARIABLE = TaskVariable("property-test variable", default=None)
 
 
 # -- plan descriptions ------------------------------------------------------------------------------
 # ("partial_order", children, orderings, raise_on_fail)   orderings: (i, j) with i < j (acyclic)
 # ("par_loop", children, raise_on_fail)   ("try_each", children, raise_on_fail)
-# ("policy", ms, child)
+# ("policy", ms, child)   ("bind", value, child): TaskVariable bound around child
+# ("tagged", name, child): tag(name, child)    ("var",): a leaf recording the variable's value
 
 
 @st.composite
 def plans(draw: Any, depth: int = 0, must_end: bool = True, in_fh: bool = False) -> tuple:
     if depth >= base.MAX_DEPTH or (depth > 0 and draw(st.integers(0, 9)) < 2 * depth):
-        return draw(base.leaves(must_end, in_fh))
+        return ("var",) if draw(st.integers(0, 5)) == 0 else draw(base.leaves(must_end, in_fh))
     kind = draw(st.sampled_from(["seq", "par", "pursue", "fh", "timeout", "partial_order", "par_loop", "try_each",
-                                 "policy"]))
+                                 "policy", "bind", "tagged"]))
+    if kind == "bind":
+        return (kind, draw(st.integers(0, 99)), draw(plans(depth + 1, must_end, in_fh)))
+    if kind == "tagged":
+        return (kind, draw(st.sampled_from(["a", "b", "c"])), draw(plans(depth + 1, must_end, in_fh)))
     if kind == "fh":
         return ("fh", draw(st.integers(0, 3)), draw(plans(depth + 1, must_end, True)))
     if kind in ("timeout", "policy"):
@@ -84,10 +96,40 @@ class Plan(base.Plan):
     def __init__(self, spec: tuple) -> None:
         self.order_checks: list[tuple[dict, tuple]] = []
         self.policies: list[dict] = []
+        self.bindings: list[Any] = [None]  # innermost binding while building (None: the default)
+        self.var_reads: list[tuple[Any, Any]] = []  # (expected, read) of every "var" leaf
+        self.tagged: list[tuple[str, list]] = []
         super().__init__(spec)
 
     def build(self, spec: tuple) -> Any:
         kind = spec[0]
+        if kind == "var":
+            expected = self.bindings[-1]
+
+            def read_var() -> None:
+                self.var_reads.append((expected, VARIABLE.get()))
+
+            return read_var
+        if kind == "bind":
+            self.bindings.append(spec[1])
+            child = self.build(spec[2])
+            self.bindings.pop()
+
+            def bind() -> None:
+                with VARIABLE.bound(spec[1]):
+                    child()
+
+            return bind
+        if kind == "tagged":
+            child = self.build(spec[2])
+            ran: list = []
+            self.tagged.append((spec[1], ran))
+
+            def tagged_child() -> None:
+                ran.append(current_task())
+                child()
+
+            return tag(spec[1], tagged_child)
         if kind == "partial_order":
             return self.partial_order([self.build(c) for c in spec[1]], spec[2], spec[3])
         if kind in ("par_loop", "try_each"):
@@ -220,7 +262,9 @@ def run_plan(spec: tuple, actions: list) -> list[str]:
     def main() -> None:
         result["root"] = current_task()
         try:
-            plan.fn()
+            with with_tags() as tags:
+                result["tags"] = tags
+                plan.fn()
         except BaseException as exc:
             result["raised"] = exc
 
@@ -247,6 +291,13 @@ def run_plan(spec: tuple, actions: list) -> list[str]:
         base.check_invocation(inv, problems)
     base.check_leaves(plan, problems)
     problems += history.problems()
+    for expected, read in plan.var_reads:
+        if expected != read:
+            problems.append(f"task variable: a leaf read {read!r}, the innermost binding is {expected!r}")
+    for name, ran in plan.tagged:
+        for task in ran:  # the tagged task is the one that ran the child, or its parent
+            if task.info.get("tag") != name:
+                problems.append(f"tag {name!r}: {task.path} ran the tagged body but is not tagged")
     for times, orderings in plan.order_checks:
         for a, b in orderings:
             if ("start", b) in times and not (("end", a) in times and times[("end", a)] <= times[("start", b)]):
