@@ -31,6 +31,7 @@ __all__ = [
     "Robot",
     "current_robot",
     "current_world",
+    "current_prospection",
     "use_robot",
     "use_world",
     "active_resolver_sets",
@@ -66,10 +67,14 @@ class ResolverSet:
     :class:`~pycram.designators.motion_types.MotionType` (keys, units, valid values): the
     vocabulary motion designators are checked against before anything moves. Empty: nothing is
     checked.
+    ``prospection`` is the :class:`pycram.world.prospection.Prospection` of the robot in its
+    world (``None`` when there is none); reasoning reaches it through
+    :func:`current_prospection`.
     """
 
     def __init__(self, name: str = "resolvers") -> None:
         self.name = name
+        self.prospection: Any = None
         self.motion_resolvers: list[Callable[..., Any]] = []
         self.object_resolvers: list[Callable[..., Any]] = []
         self.location_generators: list[Callable[..., Any]] = []
@@ -170,6 +175,20 @@ def use_world(world: Optional[ResolverSet]) -> Optional[ResolverSet]:
 def current_world() -> Optional[ResolverSet]:
     """The active world resolver set, or ``None``."""
     return _active_world
+
+
+def current_prospection() -> Any:
+    """The prospection of the active robot (else of the active world): the
+    :class:`pycram.world.prospection.Prospection` that reasoning asks "what if".
+
+    Raises ``LookupError`` naming what is active when neither has one.
+    """
+    for resolver_set in active_resolver_sets():
+        if resolver_set.prospection is not None:
+            return resolver_set.prospection
+    raise LookupError(f"no prospection available: {describe_active_robot()}, active world "
+                      f"{_active_world!r}; activate a robot whose world supports prospection "
+                      f"(e.g. a simulated one)")
 
 
 def active_resolver_sets() -> list[ResolverSet]:

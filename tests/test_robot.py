@@ -315,3 +315,21 @@ def test_process_module_lookup_by_name():
     assert robot.process_module('arm').name == 'arm'
     with pytest.raises(KeyError, match="available: \\['arm', 'head', 'navigation'\\]"):
         robot.process_module('arm_left')
+
+
+def test_current_prospection_is_the_active_robots_else_the_worlds():
+    from pycram.robot import ResolverSet, current_prospection
+
+    with pytest.raises(LookupError, match="no prospection available: no active robot"):
+        current_prospection()
+    world = ResolverSet("kitchen")
+    world.prospection = object()
+    robot = Robot("r")
+    with world:
+        assert current_prospection() is world.prospection
+        with robot:  # a robot without one: the world's still answers
+            assert current_prospection() is world.prospection
+            robot.prospection = object()
+            assert current_prospection() is robot.prospection
+    with pytest.raises(LookupError):
+        current_prospection()

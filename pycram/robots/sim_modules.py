@@ -32,9 +32,11 @@ from typing import Any, Callable, Optional
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule, ProcessModuleStatus
 from pycram.robot import Robot
+from pycram.world.navigation import NavigationFailure
 
 __all__ = [
     "SimMotionFailed",
+    "NavigationFailed",
     "SimProcessModule",
     "NavigationModule",
     "BaseStopModule",
@@ -66,7 +68,14 @@ class SimMotionFailed(Exception):
         super().__init__(f"{command} failed: {reason}: {message}")
         self.command = command
         self.reason = reason
+        self.message = message
         self.outcome = outcome
+
+
+class NavigationFailed(SimMotionFailed, NavigationFailure):
+    """The base found no collision-free path to its goal (``reason`` ``'no_path'``); a
+    :class:`pycram.world.navigation.NavigationFailure`, so plans can catch it without knowing
+    the backend. The message says why (goal in collision, no connection, off the map)."""
 
 
 def _fmt(values: Any) -> str:
@@ -136,11 +145,14 @@ class SimProcessModule(ProcessModule):
 
 
 class NavigationModule(SimProcessModule):
-    """Drives the base (``'cmd': 'navigate'`` with ``'pose'``: a ``Pose2D`` in the map frame).
+    """Drives the base (``'cmd': 'navigate'`` with ``'pose'``: a ``Pose2D`` in the map frame)
+    along a collision-free path around the environment and obstacles, re-planning when the
+    path gets blocked (see :mod:`pycram.sim.path_drive`).
 
-    Returns the reached ``Pose2D``. Fails with the outcome reason (``collision``: the base
-    touched something; ``blocked``: it could not follow its path; ``timeout``; ``cancelled``
-    by ``cancelling_movement``) and the pose where the base stopped.
+    Returns the reached ``Pose2D``. Fails with :class:`NavigationFailed` (reason ``no_path``)
+    when no path exists, otherwise with the outcome reason (``collision``: the base touched
+    something; ``blocked``: it could not follow its path; ``timeout``; ``cancelled`` by
+    ``cancelling_movement``) and the pose where the base stopped.
     """
 
     def __init__(self, world: Any, name: str = "navigation") -> None:
@@ -152,10 +164,16 @@ class NavigationModule(SimProcessModule):
         pose = solution["pose"]
         distance = math.hypot(pose.x - self.world.base_pose.get_value().x,
                               pose.y - self.world.base_pose.get_value().y)
-        return self._run_command(
-            lambda: self.world.move_base(pose), f"drive to {_fmt_pose2d(pose)}",
-            timeout=30.0 + 4.0 * distance,
-            describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})")
+        try:
+            return self._run_command(
+                lambda: self.world.move_base(pose), f"drive to {_fmt_pose2d(pose)}",
+                timeout=30.0 + 4.0 * distance,
+                describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})")
+        except SimMotionFailed as exc:
+            if exc.reason != "no_path":
+                raise
+            raise NavigationFailed(exc.command, exc.reason, exc.message,
+                                   exc.outcome) from None
 
 
 class BaseStopModule(SimProcessModule):
@@ -370,6 +388,8 @@ class SimRobot(Robot):
         super().__init__(name)
         self.world = world
         self.description = description
+        make_prospection = getattr(world, "prospection", None)
+        self.prospection = make_prospection() if callable(make_prospection) else None
 
     def shutdown(self) -> None:
         """Stop subscriptions and take all process modules offline (running motions finish)."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -48,44 +49,77 @@ def solve_ik(eng: Engine, arm: str, goal: Pose, use_orientation: bool = True,
     target_p = np.asarray(goal.position, float)
     target_q = np.asarray(goal.orientation, float)
     target_q = target_q / np.linalg.norm(target_q)
-    jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
     rng = np.random.default_rng(rng_seed)
     candidates = [eng.data.qpos[qadr].copy()] + [np.asarray(s, float) for s in seeds]
     candidates += [np.asarray(c, float) for c in eng.desc.ARM_CONFIGURATIONS[arm].values()]
     for _ in range(6):
         r = rng.uniform(np.where(limited, lo, -np.pi), np.where(limited, hi, np.pi))
         candidates.append(r)
-    site_quat, neg, dq_rot = np.zeros(4), np.zeros(4), np.zeros(4)
     best: IKSolution | None = None
     for seed in candidates:
-        q = np.clip(seed, lo, hi)
-        for _ in range(iterations):
-            scratch.qpos[qadr] = q
-            mujoco.mj_kinematics(m, scratch)
-            mujoco.mj_comPos(m, scratch)
-            e_p = target_p - scratch.site_xpos[site]
-            mujoco.mju_mat2Quat(site_quat, scratch.site_xmat[site])
-            mujoco.mju_negQuat(neg, site_quat)
-            mujoco.mju_mulQuat(dq_rot, target_q, neg)
-            e_r = np.zeros(3)
-            mujoco.mju_quat2Vel(e_r, dq_rot, 1.0)
-            pe, re = float(np.linalg.norm(e_p)), float(np.linalg.norm(e_r))
-            if pe < position_tolerance and (not use_orientation or re < orientation_tolerance):
-                sol = IKSolution(tuple(map(float, q)), pe, re)
-                return sol
-            mujoco.mj_jacSite(m, scratch, jacp, jacr, site)
-            if use_orientation:
-                J = np.vstack([jacp[:, dadr], 0.5 * jacr[:, dadr]])
-                e = np.concatenate([e_p, 0.5 * e_r])
-            else:
-                J, e = jacp[:, dadr], e_p
-            dq = J.T @ np.linalg.solve(J @ J.T + damping ** 2 * np.eye(len(e)), e)
-            step = np.max(np.abs(dq))
-            if step > 0.3:
-                dq *= 0.3 / step
-            q = np.clip(q + dq, lo, hi)
-        if best is None or pe < best.position_error:
-            best = IKSolution(tuple(map(float, q)), pe, re)
+        sol, converged = dls_ik(m, scratch, site, qadr, dadr, lo, hi, target_p,
+                                target_q if use_orientation else None, seed, iterations, damping,
+                                position_tolerance, orientation_tolerance)
+        if converged:
+            return sol
+        if best is None or sol.position_error < best.position_error:
+            best = sol
     _log.debug("IK for %s failed; best errors %.3f m / %.3f rad", arm, best.position_error if best else -1,
                best.orientation_error if best else -1)
     return None
+
+
+def dls_ik(model: mujoco.MjModel, data: mujoco.MjData, site: int, qadr: np.ndarray, dadr: np.ndarray,
+           lo: np.ndarray, hi: np.ndarray, target_p: np.ndarray, target_q: np.ndarray | None,
+           seed: Sequence[float], iterations: int = 400, damping: float = 0.02,
+           position_tolerance: float = 0.002, orientation_tolerance: float = 0.02,
+           stall_window: int = 0) -> tuple[IKSolution, bool]:
+    """Damped least squares from `seed` for the joints at qpos `qadr` / dofs `dadr`, clipped to
+    [`lo`, `hi`], moving `site` to `target_p` [m] (and `target_q` (w, x, y, z) unless None).
+
+    Works on `data` (a scratch `MjData` whose other joints are set by the caller; its arm joints
+    are left at the result). Returns the last iterate and whether it is within the tolerances.
+    With `stall_window` > 0, gives up when the error has not shrunk by 1 % over that many
+    iterations. Thread-safe as long as `data` belongs to the caller.
+    """
+    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    site_quat, neg, dq_rot, e_r = np.zeros(4), np.zeros(4), np.zeros(4), np.zeros(3)
+    rows = 6 if target_q is not None else 3
+    J = np.zeros((rows, len(dadr)))
+    e = np.zeros(rows)
+    damp = np.eye(rows) * damping ** 2
+    q = np.clip(np.asarray(seed, float), lo, hi)
+    pe = re = float("inf")
+    history: list[float] = []
+    for it in range(iterations):
+        data.qpos[qadr] = q
+        mujoco.mj_kinematics(model, data)
+        np.subtract(target_p, data.site_xpos[site], out=e[:3])
+        pe = math.sqrt(float(e[:3] @ e[:3]))
+        if target_q is not None:
+            mujoco.mju_mat2Quat(site_quat, data.site_xmat[site])
+            mujoco.mju_negQuat(neg, site_quat)
+            mujoco.mju_mulQuat(dq_rot, target_q, neg)
+            mujoco.mju_quat2Vel(e_r, dq_rot, 1.0)
+            re = math.sqrt(float(e_r @ e_r))
+            e[3:] = 0.5 * e_r
+        else:
+            re = 0.0
+        if pe < position_tolerance and re < orientation_tolerance:
+            return IKSolution(tuple(map(float, q)), pe, re), True
+        if stall_window:
+            err = pe + 0.1 * re
+            history.append(err)
+            if it >= stall_window and err > 0.99 * history[it - stall_window]:
+                break
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_jacSite(model, data, jacp, jacr if target_q is not None else None, site)
+        J[:3] = jacp[:, dadr]
+        if target_q is not None:
+            J[3:] = 0.5 * jacr[:, dadr]
+        dq = J.T @ np.linalg.solve(J @ J.T + damp, e)
+        step = float(np.abs(dq).max())
+        if step > 0.3:
+            dq *= 0.3 / step
+        q = np.clip(q + dq, lo, hi)
+    return IKSolution(tuple(map(float, q)), pe, re), False

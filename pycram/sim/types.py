@@ -49,7 +49,7 @@ class Outcome:
     value: Any = None
 
     REASONS = ("succeeded", "blocked", "collision", "cancelled", "preempted", "unreachable",
-               "timeout", "invalid", "closed", "error")
+               "timeout", "invalid", "closed", "error", "no_path")
 
     def __bool__(self) -> bool:
         return self.succeeded

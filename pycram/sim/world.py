@@ -25,7 +25,7 @@ import threading
 import time
 import weakref
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
@@ -44,11 +44,15 @@ from .furniture import ContainerPush
 from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
-from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames
+from .path_drive import PlannedDrive
+from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames, StateSnapshot
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
 from .scene import build_scene
 from .types import Outcome, Pose, Pose2D, VisibleItem
+
+if TYPE_CHECKING:
+    from .prospection import SimProspection
 
 _log = logging.getLogger(__name__)
 
@@ -116,6 +120,9 @@ class World:
         #: Joint position of every container by name [m for drawers, rad for doors], 0 when closed.
         self.container_states = Fluent(eng.furniture.positions(eng.data), name="container_states")
         self.camera_image = Fluent(None, name="camera_image")
+        #: the latest state copied by the simulation thread, for prospection (never its MjData)
+        self._state = StateSnapshot.of(eng.data)
+        self._prospection = None
         # --- command plumbing
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()
         self._lock = threading.Lock()
@@ -284,6 +291,7 @@ class World:
 
     def _publish(self) -> None:
         eng = self._engine
+        self._state = StateSnapshot.of(eng.data)  # first: whoever a fluent wakes sees this state
         self.sim_time.set_value(eng.time)
         self.base_pose.set_value(eng.base_pose())
         self.joint_states.set_value(eng.joint_states())
@@ -325,16 +333,32 @@ class World:
         return gripper
 
     # ------------------------------------------------------------------ robot commands
-    def drive_to(self, x: float, y: float, yaw: float) -> CommandHandle:
+    def drive_to(self, x: float, y: float, yaw: float, plan_path: bool = True) -> CommandHandle:
         """Drive the base to the map pose (x [m], y [m], yaw [rad]) with the base's limits.
 
-        Ends with "collision"/"blocked" (stopped where it is) or "timeout"; value: final `Pose2D`.
+        With `plan_path` the base follows a collision-free path around the environment and the
+        obstacles (the straight line where that is free; see `pycram.sim.path_drive`), stops and
+        re-plans when the path gets blocked, and ends with "no_path" when there is none; without,
+        it drives the straight line whatever is in the way. Ends with "collision"/"blocked"
+        (stopped where it is) or "timeout"; value: final `Pose2D`.
         """
-        return self.submit(BaseDrive(Pose2D(x, y, yaw)), "drive_to")
+        goal = Pose2D(x, y, yaw)
+        return self.submit(PlannedDrive(goal) if plan_path else BaseDrive(goal), "drive_to")
 
-    def move_base(self, pose: Pose2D) -> CommandHandle:
+    def move_base(self, pose: Pose2D, plan_path: bool = True) -> CommandHandle:
         """`drive_to` with a `Pose2D`."""
-        return self.drive_to(pose.x, pose.y, pose.yaw)
+        return self.drive_to(pose.x, pose.y, pose.yaw, plan_path)
+
+    def prospection(self) -> "SimProspection":
+        """The robot's prospection (`pycram.world.prospection.Prospection`) in this world: "what
+        if" questions answered on scratch copies of the latest published state (thread-safe;
+        never disturbs the simulation). The same object on every call."""
+        with self._lock:
+            if self._prospection is None:
+                from .prospection import SimProspection
+
+                self._prospection = SimProspection(self.scene, lambda: self._state)
+            return self._prospection
 
     def set_torso(self, height: float, duration: float | None = None) -> CommandHandle:
         """Move the torso lift joint to `height` [m]."""

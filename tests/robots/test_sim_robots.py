@@ -83,6 +83,15 @@ def test_load_builds_the_robot_with_its_modules(robot):
         robots.load(other, robot.world)
 
 
+def test_reasoning_reaches_the_worlds_prospection_through_the_active_robot(robot):
+    from pycram.robot import current_prospection
+    from pycram.world.prospection import Prospection
+
+    p = current_prospection()
+    assert isinstance(p, Prospection) and p is robot.world.prospection()
+    assert not p.in_collision(robot.world.base_pose.get_value())
+
+
 def test_arm_requests_go_to_the_right_module(robot):
     """Thesis ch. 4.2.2: PR2 dispatches on the arm; TIAGo serves any arm with its only one."""
     def module_for(**properties):
@@ -300,18 +309,59 @@ def test_unreachable_reaching_fails_with_a_clear_error(robot):
     assert world.running
 
 
-def test_blocked_drive_fails_naming_the_obstacle_and_where_it_stopped(robot):
-    world = robot.world
+class _PoseTrack(Fluent):
+    """Records every published base pose (in the simulation thread) while `active`."""
+
+    def __init__(self, source: Fluent) -> None:
+        super().__init__(None)
+        self.source, self.samples, self.active = source, [], True
+        source.add_child(self)
+
+    def pulse(self) -> None:
+        if self.active:
+            self.samples.append(self.source.get_value())
+        super().pulse()
+
+
+def _obstacle_ahead(robot, distance: float) -> str:
+    """Test set-up: the robot at START, an obstacle box `distance` [m] ahead; its name."""
     go_to_start(robot)
-    outcome = world.place_obstacle(START[0] + 1.2, START[1]).wait(T)  # test set-up
+    outcome = robot.world.place_obstacle(START[0] + distance, START[1]).wait(T)
     assert outcome is not None and outcome.succeeded
-    obstacle = outcome.value
+    return outcome.value
+
+
+def test_moving_goes_around_an_obstacle_on_the_straight_line(robot):
+    world = robot.world
+    obstacle = _obstacle_ahead(robot, 1.0)
+    watcher = _PoseTrack(world.base_pose)
+    samples = watcher.samples
+    try:
+        reached = motion(type="moving", pose=(START[0] + 2.0, START[1], 0.0))
+        assert reached.distance_to(world.base_pose.get_value()) < 0.02
+        assert abs(reached.x - (START[0] + 2.0)) < 0.02 and abs(reached.y - START[1]) < 0.02
+        # it left the straight line to pass the obstacle (0.15 m half width + the base)
+        assert max(abs(p.y - START[1]) for p in samples) > 0.3
+    finally:
+        watcher.active = False
+        world.remove_obstacle(obstacle).wait(T)
+    motion(type="moving", pose=START)
+
+
+def test_moving_to_an_occupied_goal_fails_with_a_navigation_failure(robot):
+    from pycram.world.navigation import NavigationFailure
+
+    world = robot.world
+    obstacle = _obstacle_ahead(robot, 2.0)
+    before = world.base_pose.get_value()
     try:
         with pytest.raises(ProcessModuleFailure) as info:
             motion(type="moving", pose=(START[0] + 2.0, START[1], 0.0))
+        assert isinstance(info.value.cause, NavigationFailure)
+        assert info.value.cause.reason == "no_path"
         message = str(info.value)
-        assert "drive to (x=2.800" in message and "stopped at (x=" in message
-        assert ("collision" in message and obstacle in message) or "blocked" in message
+        assert "drive to (x=2.800" in message and "goal_in_collision" in message
+        assert world.base_pose.get_value().distance_to(before) < 0.01  # it did not set off
     finally:
         world.remove_obstacle(obstacle).wait(T)
     motion(type="moving", pose=START)

@@ -1,0 +1,410 @@
+"""Prospection in the simulator: "what if" on scratch copies of the current state.
+
+`SimProspection` implements `pycram.world.prospection.Prospection` for one `World`. The
+simulation thread publishes a `StateSnapshot` (joint positions, mocap poses; a few hundred
+bytes, microseconds to copy) with every sensor update and right before a command's outcome is
+delivered. A question takes the latest snapshot and works on an `MjData` of its own, taken
+from a pool (one per concurrently asking thread, created on demand, reused afterwards):
+it never touches the simulation thread's `MjData` and never copies the world. The model is
+shared read-only (MuJoCo only reads it in kinematics, collision detection and ray casts).
+
+Costs on this machine (PR2 in the thesis kitchen, one thread, simulation paused): a collision
+check ~0.1 ms, a reachability check of 3 poses ~1-5 ms (more when it fails), a visibility
+check ~0.5 ms; with the simulation running beside it, about half as many per second (see
+`benchmarks/prospection.py`).
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence
+
+import mujoco
+import numpy as np
+
+from pycram.world.prospection import (Prospection, Reachability, ToolPose, Visibility, as_base_pose,
+                                      as_tool_pose)
+
+from .ik import dls_ik
+from .occupancy import descends
+from .recording import StateSnapshot
+from .robot_model import BASE_JOINTS, HEAD_CAMERA, tool_site
+from .scene import Scene
+
+#: Geom groups a camera sees (MuJoCo's default visualisation: groups 0, 1 and 2).
+VISIBLE_GROUPS = np.array([1, 1, 1, 0, 0, 0], np.uint8)
+#: Visibility rays start this far [m] ahead of the camera along its view axis, past the head.
+HEAD_CLEARANCE = 0.06
+#: Sample points per target geom for visibility.
+POINTS_PER_GEOM = 24
+#: Contacts penetrating less than this [m] do not count as collisions: mesh links collide as
+#: their convex hulls (larger than the links), and MuJoCo's soft contacts let the running robot
+#: brush surfaces this much (the thesis demo's grasps touch the counter by ~1 cm).
+COLLISION_TOLERANCE = 0.015
+#: IK: iterations per seed and the stall window (iterations without 1 % progress end a seed).
+IK_ITERATIONS = 100
+IK_STALL = 15
+#: IK: after this many solutions that all collide, the pose counts as "collision".
+MAX_COLLIDING_SOLUTIONS = 3
+
+
+class _Arm:
+    """Index data of one arm for IK on scratch data."""
+
+    def __init__(self, scene: Scene, arm: str) -> None:
+        m = scene.model
+        self.name = arm
+        self.joints = tuple(scene.description.ARMS[arm]["joints"])
+        jids = [scene.joint_id(j) for j in self.joints]
+        self.jids = jids
+        self.qadr = np.array([m.jnt_qposadr[j] for j in jids])
+        self.dadr = np.array([m.jnt_dofadr[j] for j in jids])
+        limited = np.array([bool(m.jnt_limited[j]) for j in jids])
+        self.lo = np.where(limited, m.jnt_range[jids, 0], -np.inf)
+        self.hi = np.where(limited, m.jnt_range[jids, 1], np.inf)
+        self.limited = limited
+        self.site = scene.site(tool_site(arm))
+        self.configurations = [np.asarray(c, float) for _, c in
+                               sorted(scene.description.ARM_CONFIGURATIONS[arm].items())]
+        rng = np.random.default_rng(0)
+        self.random_seeds = [rng.uniform(np.where(limited, self.lo, -np.pi), np.where(limited, self.hi, np.pi))
+                             for _ in range(2)]
+        self.reach = 0.0  # [m] from the first joint's anchor; measured by SimProspection
+
+    def seeds(self, current: np.ndarray, previous: Optional[np.ndarray]) -> list[np.ndarray]:
+        out = [] if previous is None else [previous]
+        return out + [current] + self.configurations + self.random_seeds
+
+
+class SimProspection(Prospection):
+    """Prospection for the robot of `scene`, on the states returned by `snapshot()`;
+    contacts penetrating less than `tolerance` [m] are not collisions.
+
+    `snapshot` must return the latest `StateSnapshot` published by the simulation thread (a
+    reference read is enough: snapshots are immutable once published).
+    """
+
+    def __init__(self, scene: Scene, snapshot: Callable[[], StateSnapshot],
+                 tolerance: float = COLLISION_TOLERANCE) -> None:
+        self.scene = scene
+        self.tolerance = tolerance
+        self.model = scene.model
+        self._snapshot = snapshot
+        self._pool: "queue.SimpleQueue[mujoco.MjData]" = queue.SimpleQueue()
+        m = self.model
+        desc = scene.description
+        self._base_qpos = [scene.joint_qpos(j) for j in BASE_JOINTS]
+        self._joint_qpos = {m.joint(j).name: int(m.jnt_qposadr[j]) for j in range(m.njnt)
+                            if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE}
+        self._is_robot = np.zeros(m.ngeom, bool)
+        self._is_robot[list(scene.robot_geoms)] = True
+        self._is_env = np.zeros(m.ngeom, bool)
+        self._is_env[list(scene.environment_geoms)] = True
+        self._arms = {a: _Arm(scene, a) for a in desc.ARMS}
+        self._camera = scene.camera(HEAD_CAMERA)
+        self._camera_body = int(m.cam_bodyid[self._camera])
+        head = desc.HEAD
+        self._head_jids = [scene.joint_id(head["pan_joint"]), scene.joint_id(head["tilt_joint"])]
+        self._head_qpos = [int(m.jnt_qposadr[j]) for j in self._head_jids]
+        self._head_dofs = [int(m.jnt_dofadr[j]) for j in self._head_jids]
+        width, height = head.get("resolution", (320, 240))
+        self._tan_y = math.tan(math.radians(head["fovy"]) / 2.0)
+        self._tan_x = self._tan_y * width / height
+        self._points: dict[int, np.ndarray] = {}
+        self._target_geoms: dict[str, list[int]] = {}
+        # geoms that move with the camera (the head it is mounted on): never occluders
+        tilt_body = int(m.jnt_bodyid[self._head_jids[1]])
+        head_bodies = {b for b in range(m.nbody) if descends(m, b, tilt_body)}
+        self._is_head = np.array([int(m.geom_bodyid[g]) in head_bodies for g in range(m.ngeom)], bool)
+        with self._data() as d:
+            self._measure_reach(d)
+
+    # ------------------------------------------------------------------ plumbing
+    @property
+    def arms(self) -> tuple[str, ...]:
+        return tuple(self._arms)
+
+    @contextmanager
+    def _data(self) -> Iterator[mujoco.MjData]:
+        try:
+            d = self._pool.get_nowait()
+        except queue.Empty:
+            d = mujoco.MjData(self.model)
+        try:
+            yield d
+        finally:
+            self._pool.put(d)
+
+    def _prepare(self, d: mujoco.MjData, base_pose: Any,
+                 joint_configuration: Optional[Mapping[str, float]]) -> None:
+        """`d` := the latest snapshot, the base at `base_pose`, joints as configured; kinematics."""
+        pose = as_base_pose(base_pose)
+        snap = self._snapshot()
+        d.qpos[:] = snap.qpos
+        d.mocap_pos[:] = snap.mocap_pos
+        d.mocap_quat[:] = snap.mocap_quat
+        for adr, v in zip(self._base_qpos, (pose.x, pose.y, pose.yaw)):
+            d.qpos[adr] = v
+        if joint_configuration:
+            for name, value in joint_configuration.items():
+                adr = self._joint_qpos.get(name)
+                if adr is None:
+                    raise ValueError(f"unknown joint {name!r} of {self.scene.robot}; valid joints: "
+                                     f"{sorted(self._joint_qpos)}")
+                d.qpos[adr] = float(value)
+        mujoco.mj_kinematics(self.model, d)
+
+    def _touching(self, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Collision detection on `d` (kinematics computed): contact geoms (g1, g2), whether g1
+        is the robot's one, and which contacts are robot-environment collisions."""
+        mujoco.mj_collision(self.model, d)
+        n = d.ncon
+        geoms = d.contact.geom[:n]
+        g1, g2 = geoms[:, 0], geoms[:, 1]
+        hit1 = self._is_robot[g1] & self._is_env[g2]
+        hit2 = self._is_robot[g2] & self._is_env[g1]
+        return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -self.tolerance)
+
+    def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
+        """Distinct (robot part, environment part) pairs that touch in `d` (kinematics computed)."""
+        g1, g2, hit1, sel = self._touching(d)
+        out: dict[tuple[str, str], None] = {}
+        for i in np.nonzero(sel)[0]:
+            a, b = (int(g1[i]), int(g2[i])) if hit1[i] else (int(g2[i]), int(g1[i]))
+            out[(self._geom_name(a), self._geom_name(b))] = None
+        return list(out)
+
+    def _geom_name(self, g: int) -> str:
+        name = self.model.geom(g).name
+        return name or self.model.body(int(self.model.geom_bodyid[g])).name
+
+    # ------------------------------------------------------------------ collision
+    def collisions(self, base_pose: Any,
+                   joint_configuration: Optional[Mapping[str, float]] = None) -> list[tuple[str, str]]:
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            return self._contacts(d)
+
+    def in_collision(self, base_pose: Any,
+                     joint_configuration: Optional[Mapping[str, float]] = None) -> bool:
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            return bool(self._touching(d)[3].any())
+
+    # ------------------------------------------------------------------ reachability
+    def _measure_reach(self, d: mujoco.MjData) -> None:
+        """Each arm's reach [m]: the farthest its tool gets from its first joint's anchor."""
+        rng = np.random.default_rng(1)
+        m = self.model
+        for arm in self._arms.values():
+            far = 0.0
+            for _ in range(300):
+                q = rng.uniform(np.where(arm.limited, arm.lo, -np.pi), np.where(arm.limited, arm.hi, np.pi))
+                d.qpos[arm.qadr] = q
+                mujoco.mj_kinematics(m, d)
+                far = max(far, float(np.linalg.norm(d.site_xpos[arm.site] - d.xanchor[arm.jids[0]])))
+            arm.reach = far * 1.05  # sampling under-estimates the true maximum a little
+
+    def reachable(self, arm: str, poses: Sequence[Any], base_pose: Any,
+                  joint_configuration: Optional[Mapping[str, float]] = None) -> Reachability:
+        if arm not in self._arms:
+            raise ValueError(f"unknown arm {arm!r} of {self.scene.robot}; valid arms: {list(self._arms)}")
+        goals = [as_tool_pose(p) for p in poses]
+        if not goals:
+            raise ValueError("reachable needs at least one tool pose")
+        a = self._arms[arm]
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            contacts = self._contacts(d)
+            if contacts:
+                return Reachability(arm, (), "collision", -1, f"the robot at the base pose touches "
+                                    f"{contacts[0][1]} with {contacts[0][0]}")
+            current = d.qpos[a.qadr].copy()
+            solutions: list[tuple[float, ...]] = []
+            previous: Optional[np.ndarray] = None
+            for i, goal in enumerate(goals):
+                result = self._solve(d, a, goal, current, previous)
+                if isinstance(result, tuple):
+                    reason, message = result
+                    return Reachability(arm, tuple(solutions), reason, i, f"pose {i}: {message}")
+                solutions.append(tuple(map(float, result)))
+                previous = result
+            return Reachability(arm, tuple(solutions))
+
+    def _solve(self, d: mujoco.MjData, a: _Arm, goal: ToolPose, current: np.ndarray,
+               previous: Optional[np.ndarray]) -> np.ndarray | tuple[str, str]:
+        """A collision-free IK solution for `goal`, or (reason, message)."""
+        m = self.model
+        target_p = np.asarray(goal.position, float)
+        target_q = None if goal.orientation is None else np.asarray(goal.orientation, float)
+        distance = float(np.linalg.norm(target_p - d.xanchor[a.jids[0]]))
+        if distance > a.reach:
+            return "out_of_reach", (f"{distance:.2f} m from the {a.name} shoulder, farther than its "
+                                    f"reach of {a.reach:.2f} m")
+        seeds = a.seeds(current, previous)
+        collided: Optional[list[tuple[str, str]]] = None
+        colliding = 0
+        for seed in seeds:
+            sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, a.lo, a.hi, target_p, target_q, seed,
+                                    IK_ITERATIONS, stall_window=IK_STALL)
+            if not converged:
+                continue
+            q = np.asarray(sol.positions)
+            d.qpos[a.qadr] = q
+            mujoco.mj_kinematics(m, d)
+            contacts = self._contacts(d)
+            if not contacts:
+                return q
+            collided = collided or contacts
+            colliding += 1
+            if colliding >= MAX_COLLIDING_SOLUTIONS:
+                break
+        if collided:
+            return "collision", f"every solution found touches {collided[0][1]} with {collided[0][0]}"
+        free_lo, free_hi = np.full_like(a.lo, -np.inf), np.full_like(a.hi, np.inf)
+        for seed in seeds[:2]:
+            sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, free_lo, free_hi, target_p, target_q,
+                                    seed, IK_ITERATIONS, stall_window=IK_STALL)
+            if converged:
+                q = np.asarray(sol.positions)
+                worst = int(np.argmax(np.maximum(a.lo - q, q - a.hi)))
+                return "joint_limit", (f"only outside the joint limits ({a.joints[worst]}={q[worst]:.2f} "
+                                       f"outside [{a.lo[worst]:.2f}, {a.hi[worst]:.2f}])")
+        return "out_of_reach", f"no arm configuration puts the tool there ({distance:.2f} m from the shoulder)"
+
+    # ------------------------------------------------------------------ visibility
+    def _target_points(self, target: Any, d: mujoco.MjData) -> tuple[np.ndarray, set[int]]:
+        """Sample points (n x 3, map) of `target` and the geoms that belong to it."""
+        if isinstance(target, str):
+            geoms = self._target_geoms.get(target)
+            if geoms is None:
+                geoms = self._target_geoms[target] = self._geoms_of(target)
+            pts = [self._local_points(g) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g] for g in geoms]
+            return np.vstack(pts), set(geoms)
+        try:
+            p = np.asarray([float(v) for v in target], float)
+        except (TypeError, ValueError):
+            p = np.zeros(0)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise ValueError(f"a visibility target is an object name or a point (x, y, z) [m]; got {target!r}")
+        return p[None, :], set()
+
+    def _geoms_of(self, name: str) -> list[int]:
+        """The visible geoms of the object (body) `name`; ValueError listing the objects if none."""
+        m = self.model
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        geoms = [g for g in range(m.ngeom) if bid >= 0 and int(m.geom_bodyid[g]) == bid
+                 and VISIBLE_GROUPS[min(int(m.geom_group[g]), 5)]]
+        if not geoms:
+            known = sorted({m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)
+                            if m.geom_bodyid[g] > 0 and m.body(int(m.geom_bodyid[g])).name == m.geom(g).name
+                            and not self._is_robot[g]})
+            raise ValueError(f"unknown object {name!r}; known objects: {known}")
+        return geoms
+
+    def _local_points(self, g: int) -> np.ndarray:
+        pts = self._points.get(g)
+        if pts is None:
+            m = self.model
+            rng = np.random.default_rng(g)
+            size, n = m.geom_size[g], POINTS_PER_GEOM
+            t = m.geom_type[g]
+            if t == mujoco.mjtGeom.mjGEOM_BOX:
+                pts = rng.uniform(-0.9, 0.9, (n, 3)) * size
+            elif t in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE):
+                r, a = size[0] * 0.9 * np.sqrt(rng.uniform(0, 1, n)), rng.uniform(0, 2 * np.pi, n)
+                pts = np.column_stack([r * np.cos(a), r * np.sin(a), rng.uniform(-0.9, 0.9, n) * size[1]])
+            elif t == mujoco.mjtGeom.mjGEOM_SPHERE:
+                v = rng.normal(size=(n, 3))
+                pts = v / np.linalg.norm(v, axis=1, keepdims=True) * size[0] * 0.9 * rng.uniform(0, 1, (n, 1)) ** (1 / 3)
+            elif t == mujoco.mjtGeom.mjGEOM_MESH and m.geom_dataid[g] >= 0:
+                mesh = int(m.geom_dataid[g])
+                adr, num = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+                verts = np.asarray(m.mesh_vert[adr:adr + num], float)
+                pick = verts[rng.choice(num, min(n, num), replace=False)]
+                centre = verts.mean(axis=0)
+                pts = centre + 0.8 * (pick - centre)
+            else:
+                c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
+                pts = c + rng.uniform(-0.5, 0.5, (n, 3)) * h
+            self._points[g] = pts
+        return pts
+
+    def _point_head(self, d: mujoco.MjData, point: np.ndarray) -> None:
+        """Turn pan/tilt (within limits) so that the camera looks at `point`; camera poses set."""
+        m = self.model
+        jacr = np.zeros((3, m.nv))
+        for _ in range(6):
+            mujoco.mj_camlight(m, d)
+            forward = -d.cam_xmat[self._camera].reshape(3, 3)[:, 2]
+            to = point - d.cam_xpos[self._camera]
+            to /= max(float(np.linalg.norm(to)), 1e-9)
+            axis = np.cross(forward, to)
+            s = float(np.linalg.norm(axis))
+            angle = math.atan2(s, float(forward @ to))
+            if angle < 0.005 or s < 1e-9:
+                return
+            mujoco.mj_comPos(m, d)
+            mujoco.mj_jacBody(m, d, None, jacr, self._camera_body)
+            dq = np.linalg.lstsq(jacr[:, self._head_dofs], axis / s * angle, rcond=1e-3)[0]
+            for adr, jid, step in zip(self._head_qpos, self._head_jids, dq):
+                lo, hi = m.jnt_range[jid]
+                d.qpos[adr] = float(np.clip(d.qpos[adr] + step, lo, hi)) if m.jnt_limited[jid] else d.qpos[adr] + step
+            mujoco.mj_kinematics(m, d)
+        mujoco.mj_camlight(m, d)
+
+    def _look_past_head(self, d: mujoco.MjData, cam: np.ndarray, vec: np.ndarray, geomid: np.ndarray,
+                        dist: np.ndarray) -> None:
+        """Re-cast the rays whose first hit is part of the head, from just beyond that hit."""
+        unit = np.zeros(1, np.int32)
+        for i in np.nonzero(self._is_head[np.maximum(geomid, 0)] & (geomid >= 0))[0]:
+            travelled = float(dist[i])
+            for _ in range(8):
+                g = int(geomid[i])
+                if g < 0 or not self._is_head[g]:
+                    break
+                start = cam + (travelled + 1e-4) * vec[i]
+                x = mujoco.mj_ray(self.model, d, start, vec[i], VISIBLE_GROUPS, 1,
+                                  int(self.model.geom_bodyid[g]), unit)
+                geomid[i] = unit[0] if x >= 0 else -1
+                travelled += 1e-4 + max(x, 0.0)
+            dist[i] = travelled
+
+    def visible(self, target: Any, base_pose: Any, threshold: float = 0.5,
+                joint_configuration: Optional[Mapping[str, float]] = None) -> Visibility:
+        m = self.model
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            points, own = self._target_points(target, d)
+            self._point_head(d, points.mean(axis=0))
+            rot = d.cam_xmat[self._camera].reshape(3, 3)
+            # rays start a little ahead of the lens, clear of the head the camera sits in
+            cam = d.cam_xpos[self._camera] - HEAD_CLEARANCE * rot[:, 2]
+            vec = points - cam
+            local = vec @ rot  # camera frame: looks along -z, up +y
+            depth = -local[:, 2]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                in_view = (depth > 1e-6) & (np.abs(local[:, 0]) <= self._tan_x * depth) & (
+                    np.abs(local[:, 1]) <= self._tan_y * depth)
+            n = len(points)
+            geomid = np.full(n, -1, np.int32)
+            dist = np.zeros(n)
+            mujoco.mj_multiRay(m, d, cam, vec.ravel().copy(), VISIBLE_GROUPS, 1, self._camera_body,
+                               geomid, dist, None, n, np.inf)
+            self._look_past_head(d, cam, vec, geomid, dist)
+            if own:
+                seen = np.isin(geomid, list(own))
+            else:  # a point: seen when nothing is hit before it (1 cm tolerance)
+                length = np.linalg.norm(vec, axis=1)
+                seen = (geomid < 0) | (dist * length >= length - 0.01)
+            seen &= in_view
+            blockers: dict[str, int] = {}
+            for g, s, v in zip(geomid, seen, in_view):
+                if v and not s and g >= 0:
+                    name = self._geom_name(int(g))
+                    blockers[name] = blockers.get(name, 0) + 1
+            fraction = float(seen.sum()) / n
+            return Visibility(fraction, fraction >= threshold, float(in_view.sum()) / n,
+                              tuple(sorted(blockers, key=lambda k: -blockers[k])))

@@ -1,0 +1,527 @@
+"""Base navigation on an occupancy grid: footprints, inflation, A* and path shortening.
+
+Backend-neutral (numpy only). A backend rasterizes its environment into an
+:class:`OccupancyGrid` and describes the robot's :class:`Footprint`; :class:`PathPlanner` then
+plans collision-free base paths between poses.
+
+How a path is planned
+---------------------
+1. The straight line from start to goal is taken when the footprint, turning uniformly from the
+   start yaw to the goal yaw along it, touches nothing (today's short, straight drives stay
+   exactly what they were).
+2. Otherwise A* (8-connected, octile heuristic, so optimal on the grid) searches the cells where
+   at least the footprint's inscribed circle (plus ``clearance``) fits; cells where only some
+   headings fit cost more, so paths keep their distance from furniture where they can.
+3. The A* cell path gets headings (a uniform turn by path length, or turning at the start, or
+   at the end, whichever is free; where the footprint does not fit at the profile's heading,
+   the nearest heading that fits) and is shortened greedily: from each waypoint a far later
+   waypoint reachable on a straight, footprint-checked segment is taken (found by bisection).
+   Every segment of the result is footprint-checked at ``resolution``/2 spacing. Cells where
+   the footprint fits at no heading are blocked and A* searches again.
+
+Obstacles may come in layers, each kept off by its own outline of the robot (the sim backend
+uses height bands: the base alone keeps off a counter the arms reach over, the robot with its
+arms keeps off walls and tall boxes). A backend may add an exact check of poses
+(``exact_check``): where only the convex outline of an arm is in the way it decides, and it
+validates the final path every `EXACT_STEP`.
+
+A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
+room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
+question gives the same path, which tests and traces rely on), and "no path exists" is a
+definite answer rather than a time-out.
+
+Failures: :class:`NoPathError` (a :class:`NavigationFailure`) with ``reason`` ``'no_path'``,
+``'goal_in_collision'`` or ``'outside_map'``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from .prospection import BasePose, as_base_pose
+
+__all__ = [
+    "Footprint",
+    "NavigationFailure",
+    "NoPathError",
+    "OccupancyGrid",
+    "PathPlanner",
+    "dilate",
+]
+
+SQRT2 = math.sqrt(2.0)
+#: A robot that already touches something may move this far [m] from its start unchecked, to
+#: get clear (e.g. after a drive stopped on contact).
+ESCAPE_RADIUS = 0.15
+#: A* searches per plan: after each, cells where the footprint fits at no heading are blocked.
+MAX_SEARCHES = 8
+#: Spacing [m] of the backend's exact checks along a path, and the half width [cells] of the
+#: square blocked around a spot where one failed.
+EXACT_STEP = 0.1
+EXACT_BLOCK_CELLS = 3
+
+PoseCheck = Callable[[float, float, float], bool]
+
+
+class NavigationFailure(Exception):
+    """The base cannot get where it was asked to go. ``reason`` names why (see subclasses)."""
+
+    reason = "navigation_failed"
+
+
+class NoPathError(NavigationFailure):
+    """No collision-free path exists. ``reason``: ``'no_path'`` (start and goal are not connected
+    on the free floor), ``'goal_in_collision'`` (the robot does not fit at the goal pose) or
+    ``'outside_map'`` (start or goal is off the map). ``start``/``goal`` are the poses asked."""
+
+    def __init__(self, reason: str, message: str, start: Optional[BasePose] = None,
+                 goal: Optional[BasePose] = None) -> None:
+        super().__init__(f"{reason}: {message}")
+        self.reason = reason
+        self.start, self.goal = start, goal
+
+
+@dataclass(frozen=True)
+class OccupancyGrid:
+    """Occupied floor cells: ``occupied[row, col]`` covers the square of side ``resolution`` [m]
+    whose centre is ``(origin[0] + (col + 0.5) * resolution, origin[1] + (row + 0.5) *
+    resolution)`` in the map frame. A cell is occupied when its centre lies under an obstacle
+    that the base could touch."""
+
+    origin: tuple[float, float]
+    resolution: float
+    occupied: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.occupied.shape  # type: ignore[return-value]
+
+    def cell(self, x: float, y: float) -> tuple[int, int]:
+        """(row, col) of the cell containing map point (x, y) [m] (may be outside the grid)."""
+        return (int(math.floor((y - self.origin[1]) / self.resolution)),
+                int(math.floor((x - self.origin[0]) / self.resolution)))
+
+    def center(self, row: int, col: int) -> tuple[float, float]:
+        """Map point [m] at the centre of cell (row, col)."""
+        r = self.resolution
+        return (self.origin[0] + (col + 0.5) * r, self.origin[1] + (row + 0.5) * r)
+
+    def inside(self, row: int, col: int) -> bool:
+        return 0 <= row < self.occupied.shape[0] and 0 <= col < self.occupied.shape[1]
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """The base's outline on the floor: a convex polygon in the base frame (x ahead, y left) [m],
+    counter-clockwise."""
+
+    vertices: tuple[tuple[float, float], ...]
+
+    @classmethod
+    def circle(cls, radius: float, sides: int = 16) -> "Footprint":
+        """A regular polygon circumscribing a circle of ``radius`` [m]."""
+        r = radius / math.cos(math.pi / sides)
+        return cls(tuple((r * math.cos(2 * math.pi * (i + 0.5) / sides),
+                          r * math.sin(2 * math.pi * (i + 0.5) / sides)) for i in range(sides)))
+
+    @classmethod
+    def rectangle(cls, x_min: float, y_min: float, x_max: float, y_max: float) -> "Footprint":
+        return cls(((x_min, y_min), (x_max, y_min), (x_max, y_max), (x_min, y_max)))
+
+    @property
+    def circumscribed_radius(self) -> float:
+        """Largest distance [m] of the outline from the base origin."""
+        return max(math.hypot(x, y) for x, y in self.vertices)
+
+    @property
+    def inscribed_radius(self) -> float:
+        """Radius [m] of the largest circle about the base origin inside the outline."""
+        return min(-d for d in self._edge_offsets())
+
+    def _edges(self) -> tuple[np.ndarray, np.ndarray]:
+        """Outward unit normals (n x 2) and offsets (n): a point p is inside iff n.p <= c for all."""
+        v = np.asarray(self.vertices, float)
+        e = np.roll(v, -1, axis=0) - v
+        normals = np.column_stack([e[:, 1], -e[:, 0]])
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        return normals, np.einsum("ij,ij->i", normals, v)
+
+    def _edge_offsets(self) -> np.ndarray:
+        normals, c = self._edges()
+        return -c
+
+
+def dilate(mask: np.ndarray, radius_cells: float) -> np.ndarray:
+    """``mask`` grown by a disk of ``radius_cells`` (cells within that distance of a set cell)."""
+    out = mask.copy()
+    r = int(math.floor(radius_cells))
+    if r <= 0 or not mask.any():
+        return out
+    rows, cols = mask.shape
+    for dr in range(-r, r + 1):
+        w = int(math.floor(math.sqrt(radius_cells * radius_cells - dr * dr)))
+        # rows shifted by dr, then a horizontal run of half-width w (a 1D dilation by doubling)
+        src = mask[max(0, -dr):rows - max(0, dr)]
+        run = src.copy()
+        span = 1
+        while span <= w:
+            step = min(span, w - span + 1)
+            shifted = np.zeros_like(run)
+            shifted[:, step:] |= run[:, :-step]
+            shifted[:, :-step] |= run[:, step:]
+            run |= shifted
+            span += step
+        out[max(0, dr):rows - max(0, -dr)] |= run
+    return out
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class _Layer:
+    """Occupied cells that one outline must keep off (e.g. counters: the base; walls and boxes:
+    the whole robot as it stands). The outline is one convex footprint or several (their
+    union, e.g. the base and each arm); the first contains the base origin."""
+
+    def __init__(self, mask: np.ndarray, outline: "Footprint | Sequence[Footprint]", grid: OccupancyGrid,
+                 margin: float) -> None:
+        parts = [outline] if isinstance(outline, Footprint) else list(outline)
+        self.mask = mask
+        self.edges = [part._edges() for part in parts]
+        self.inscribed = parts[0].inscribed_radius
+        self.circumscribed = max(part.circumscribed_radius for part in parts)
+        rows, cols = np.nonzero(mask)
+        res = grid.resolution
+        self.occ_xy = np.column_stack([grid.origin[0] + (cols + 0.5) * res, grid.origin[1] + (rows + 0.5) * res])
+        self.reach = self.circumscribed + margin
+
+    def hits(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+        """Per pose: does the outline's first part (around the base), grown by `margin`, cover
+        an occupied cell; does another part?"""
+        base, other = np.zeros(len(xs), bool), np.zeros(len(xs), bool)
+        reach, occ = self.reach, self.occ_xy
+        near = ((occ[:, 0] >= xs.min() - reach) & (occ[:, 0] <= xs.max() + reach)
+                & (occ[:, 1] >= ys.min() - reach) & (occ[:, 1] <= ys.max() + reach))
+        occ = occ[near]
+        if occ.size == 0:
+            return base, other
+        dx = occ[None, :, 0] - xs[:, None]  # poses x occupied cells
+        dy = occ[None, :, 1] - ys[:, None]
+        pose, cell = np.nonzero(dx * dx + dy * dy <= reach * reach)
+        if pose.size == 0:
+            return base, other
+        c, s = np.cos(yaws[pose]), np.sin(yaws[pose])
+        px, py = dx[pose, cell], dy[pose, cell]
+        bx, by = c * px + s * py, -s * px + c * py  # into the base frame
+        for k, (normals, offsets) in enumerate(self.edges):
+            d = np.outer(bx, normals[:, 0]) + np.outer(by, normals[:, 1]) - offsets
+            (base if k == 0 else other)[pose[np.all(d <= margin, axis=1)]] = True
+        return base, other
+
+
+@dataclass(frozen=True)
+class _Query:
+    """What one `PathPlanner.plan` call checks with: the start to move off unchecked (or None)
+    and the backend's exact check (or None)."""
+
+    escape: Optional[BasePose]
+    exact: Optional["PoseCheck"]
+
+
+class PathPlanner:
+    """Plans base paths on ``grid`` for a robot with ``footprint``, keeping ``clearance`` [m].
+
+    ``layers``: more occupied masks (same shape as the grid), each with the outline that must
+    keep off it (a footprint, or several whose union it is, the first around the base origin)
+    -- e.g. walls that the whole robot, arms included, must pass, while the base alone must
+    keep off the counters the arms reach over. ``grid`` (attribute) is the
+    union of all. Construction inflates the grid (a few ms); :meth:`plan` is then a pure function of its
+    arguments (thread-safe, deterministic). ``cost_weight`` is the extra cost per cell [m/m]
+    of passing where the footprint fits only at some headings.
+    """
+
+    def __init__(self, grid: OccupancyGrid, footprint: Footprint, clearance: float = 0.03,
+                 cost_weight: float = 2.0,
+                 layers: Sequence[tuple[np.ndarray, "Footprint | Sequence[Footprint]"]] = ()) -> None:
+        res = grid.resolution
+        # a cell is marked when its centre is under an obstacle: the obstacle may reach half a
+        # cell diagonal further, so checks add that to the clearance
+        self._margin = clearance + res * SQRT2 / 2.0
+        self._layers = [_Layer(grid.occupied, footprint, grid, self._margin)]
+        self._layers += [_Layer(mask, fp, grid, self._margin) for mask, fp in layers if mask.any()]
+        occupied = grid.occupied.copy()
+        for mask, _ in layers:
+            occupied |= mask
+        self.grid = OccupancyGrid(grid.origin, res, occupied)
+        self.footprint, self.clearance, self.cost_weight = footprint, clearance, cost_weight
+        half = res * SQRT2 / 2.0
+        self.lethal = np.zeros_like(occupied)
+        self.caution = np.zeros_like(occupied)
+        self._sure_hit = np.zeros_like(occupied)
+        sure_not_free = np.zeros_like(occupied)
+        for layer in self._layers:
+            m = layer.mask
+            self.lethal |= dilate(m, (layer.inscribed + self._margin) / res)
+            self.caution |= dilate(m, (layer.circumscribed + self._margin) / res)
+            # for single poses anywhere in a cell (up to half a diagonal from its centre)
+            self._sure_hit |= dilate(m, (layer.inscribed + self._margin - half) / res)
+            sure_not_free |= dilate(m, (layer.circumscribed + self._margin + half) / res)
+        self._sure_free = ~sure_not_free
+        self._turn_radius = max(layer.circumscribed for layer in self._layers)
+
+    # ------------------------------------------------------------------ checks
+    def pose_free(self, x: float, y: float, yaw: float, exact_check: Optional["PoseCheck"] = None) -> bool:
+        """Does the footprint at (x, y, yaw), grown by the clearance, stay off occupied cells?
+        Off-map poses count as free (nothing is known there)."""
+        return self._free(np.array([x], float), np.array([y], float), np.array([yaw], float), exact_check)
+
+    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray,
+              exact_check: Optional["PoseCheck"] = None) -> bool:
+        """Whether every pose (xs[i], ys[i], yaws[i]) is free (see `pose_free`)."""
+        g = self.grid
+        rows = np.floor((ys - g.origin[1]) / g.resolution).astype(int)
+        cols = np.floor((xs - g.origin[0]) / g.resolution).astype(int)
+        inside = (rows >= 0) & (rows < g.shape[0]) & (cols >= 0) & (cols < g.shape[1])
+        r, c = rows[inside], cols[inside]
+        if self._sure_hit[r, c].any():
+            return False
+        unsure = np.nonzero(inside)[0][~self._sure_free[r, c]]
+        if unsure.size == 0:
+            return True
+        xs, ys, yaws = xs[unsure], ys[unsure], yaws[unsure]
+        hit = np.zeros(len(xs), bool)
+        for layer in self._layers:
+            base, other = layer.hits(xs, ys, yaws, self._margin)
+            if base.any():
+                return False
+            hit |= other
+        if exact_check is None:
+            return not hit.any()
+        # the outlines of the other parts (arms) are convex hulls, larger than the arms: where
+        # only they are in the way, the backend's exact check decides
+        return all(exact_check(float(xs[i]), float(ys[i]), float(yaws[i])) for i in np.nonzero(hit)[0])
+
+    def segment_free(self, a: BasePose, b: BasePose, escape: Optional[BasePose] = None,
+                     exact_check: Optional["PoseCheck"] = None) -> bool:
+        """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?
+        Poses within `ESCAPE_RADIUS` of ``escape`` are not checked."""
+        dist = math.hypot(b.x - a.x, b.y - a.y)
+        dyaw = _wrap(b.yaw - a.yaw)
+        # sample so that neither the centre nor a corner moves more than half a cell per step
+        n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius)
+                                 / (0.5 * self.grid.resolution))))
+        s = np.linspace(0.0, 1.0, n + 1)
+        xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
+        if escape is not None:
+            keep = np.hypot(xs - escape.x, ys - escape.y) >= ESCAPE_RADIUS
+            xs, ys, yaws = xs[keep], ys[keep], yaws[keep]
+        return self._free(xs, ys, yaws, exact_check)
+
+    # ------------------------------------------------------------------ planning
+    def plan(self, start: object, goal: object, exact_check: Optional[PoseCheck] = None) -> list[BasePose]:
+        """Waypoints from ``start`` to ``goal`` (start excluded, goal last), each reached by a
+        straight, footprint-checked drive from the one before. Raises :class:`NoPathError`.
+
+        ``exact_check(x, y, yaw) -> bool`` (optional, from the backend: e.g. the whole robot in
+        its current configuration against the 3D environment) must also hold at the goal and
+        every `EXACT_STEP` along the path; where it fails, A* searches again around that spot.
+        """
+        a, b = as_base_pose(start), as_base_pose(goal)
+        g = self.grid
+        if not self.pose_free(b.x, b.y, b.yaw, exact_check):
+            raise NoPathError("goal_in_collision", f"the robot does not fit at the goal "
+                              f"(x={b.x:.2f}, y={b.y:.2f}, yaw={b.yaw:.2f})", a, b)
+        escape = None if self.pose_free(a.x, a.y, a.yaw, exact_check) else a
+        ctx = _Query(escape, exact_check)
+        if self.path_free(a, [b], exact_check):
+            return [b]
+        sc, gc = g.cell(a.x, a.y), g.cell(b.x, b.y)
+        for name, cell, pose in (("start", sc, a), ("goal", gc, b)):
+            if not g.inside(*cell):
+                raise NoPathError("outside_map", f"the {name} (x={pose.x:.2f}, y={pose.y:.2f}) is off "
+                                  f"the map of the floor", a, b)
+        bad: set[tuple[int, int]] = set()
+        for _attempt in range(MAX_SEARCHES):
+            cells = self._astar(sc, gc, bad, escape is None)
+            if cells is None:
+                raise NoPathError("no_path", f"no collision-free path from (x={a.x:.2f}, y={a.y:.2f}) to "
+                                  f"(x={b.x:.2f}, y={b.y:.2f})", a, b)
+            path, misfits = self._shorten(a, b, cells, ctx)
+            if not misfits:
+                hit = self._exact_hit(a, path, escape, exact_check)
+                if hit is None:
+                    return path
+                r, c = g.cell(*hit)  # the robot touches something there: keep its centre away
+                k = EXACT_BLOCK_CELLS
+                misfits = {(rr, cc) for rr in range(r - k, r + k + 1) for cc in range(c - k, c + k + 1)
+                           if g.inside(rr, cc) and (rr, cc) not in (sc, gc)}
+            bad |= misfits  # the footprint fits there at no heading (or cannot turn there)
+        raise NoPathError("no_path", "no path where the robot fits at the headings it needs", a, b)
+
+    def path_free(self, start: BasePose, waypoints: list[BasePose],
+                  exact_check: Optional[PoseCheck] = None) -> bool:
+        """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?"""
+        escape = None if self.pose_free(start.x, start.y, start.yaw, exact_check) else start
+        prev = start
+        for w in waypoints:
+            if not self.segment_free(prev, w, escape, exact_check):
+                return False
+            prev = w
+        return self._exact_hit(start, waypoints, escape, exact_check) is None
+
+    def _exact_hit(self, start: BasePose, waypoints: list[BasePose], escape: Optional[BasePose],
+                   exact_check: Optional[PoseCheck]) -> Optional[tuple[float, float]]:
+        """The first (x, y) along the path where ``exact_check`` fails, or None."""
+        if exact_check is None:
+            return None
+        prev = start
+        for w in waypoints:
+            dist = math.hypot(w.x - prev.x, w.y - prev.y)
+            dyaw = _wrap(w.yaw - prev.yaw)
+            n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius) / EXACT_STEP)))
+            for i in range(1, n + 1):
+                s = i / n
+                x, y = prev.x + s * (w.x - prev.x), prev.y + s * (w.y - prev.y)
+                if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+                    continue
+                if not exact_check(x, y, prev.yaw + s * dyaw):
+                    return (x, y)
+            prev = w
+        return None
+
+    def _astar(self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]],
+               start_free: bool) -> Optional[list[tuple[int, int]]]:
+        rows, cols = self.lethal.shape
+        passable = ~self.lethal
+        if not start_free:
+            # the robot already touches something: let it move off through the cells nearby
+            k = int(math.ceil(ESCAPE_RADIUS / self.grid.resolution))
+            r, c = sc
+            passable[max(0, r - k):r + k + 1, max(0, c - k):c + k + 1] = True
+        for cell in bad:
+            passable[cell] = False
+        passable[sc] = passable[gc] = True
+        free = passable.ravel().tolist()
+        penalty = (self.caution & passable).ravel().tolist()
+        w = self.cost_weight
+        start, goal = sc[0] * cols + sc[1], gc[0] * cols + gc[1]
+        gr, gcl = gc
+        neighbours = ((1, 0, 1.0), (-1, 0, 1.0), (0, 1, 1.0), (0, -1, 1.0),
+                      (1, 1, SQRT2), (1, -1, SQRT2), (-1, 1, SQRT2), (-1, -1, SQRT2))
+        best = [math.inf] * (rows * cols)
+        parent = [-1] * (rows * cols)
+        best[start] = 0.0
+        heap = [(0.0, 0.0, start)]
+        push, pop = heapq.heappush, heapq.heappop
+        while heap:
+            _f, cost, node = pop(heap)
+            if node == goal:
+                out = []
+                while node != start:
+                    out.append(divmod(node, cols))
+                    node = parent[node]
+                out.append(sc)
+                return out[::-1]
+            if cost > best[node]:
+                continue  # a stale entry: the node was reached more cheaply since
+            r, c = divmod(node, cols)
+            for dr, dc, step in neighbours:
+                nr, nc = r + dr, c + dc
+                if nr < 0 or nr >= rows or nc < 0 or nc >= cols:
+                    continue
+                n = nr * cols + nc
+                if not free[n]:
+                    continue
+                if dr and dc and not (free[r * cols + nc] and free[nr * cols + c]):
+                    continue  # no corner cutting
+                ncost = cost + step * (1.0 + w * penalty[n])
+                if ncost < best[n]:
+                    best[n] = ncost
+                    parent[n] = node
+                    ddr, ddc = abs(nr - gr), abs(nc - gcl)
+                    h = (ddr + ddc) + (SQRT2 - 2.0) * min(ddr, ddc)
+                    push(heap, (ncost + h, ncost, n))
+        return None
+
+    def _shorten(self, a: BasePose, b: BasePose, cells: list[tuple[int, int]],
+                 ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
+        """Poses along the cell path, shortened greedily, or the cells to block and search again.
+
+        Headings: the first of these profiles in which every step of the cell path is free --
+        turning uniformly along the path, turning at the start, turning at the end -- where at
+        each cell the nearest heading (steps of pi/16) that fits replaces the profile's when that
+        one does not fit. When none is free, the cells where the best profile failed are returned.
+        """
+        pts = [(a.x, a.y)] + [self.grid.center(r, c) for r, c in cells[1:-1]] + [(b.x, b.y)]
+        lengths = [0.0]
+        for (x0, y0), (x1, y1) in zip(pts, pts[1:]):
+            lengths.append(lengths[-1] + math.hypot(x1 - x0, y1 - y0))
+        total = lengths[-1] or 1.0
+        dyaw = _wrap(b.yaw - a.yaw)
+        profiles = (lambda s: a.yaw + dyaw * s, lambda s: a.yaw + dyaw, lambda s: a.yaw)
+        fewest: Optional[set[tuple[int, int]]] = None
+        for profile in profiles:
+            poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, ctx)
+            if not bad:
+                return self._greedy(poses, ctx), bad
+            if fewest is None or len(bad) < len(fewest):
+                fewest = bad
+        return [], fewest or set()
+
+    def _headed(self, a: BasePose, b: BasePose, pts: list[tuple[float, float]], lengths: list[float],
+                total: float, cells: list[tuple[int, int]], profile: Callable[[float], float],
+                ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
+        poses = [a]
+        bad: set[tuple[int, int]] = set()
+        for i in range(1, len(pts) - 1):
+            (x, y), yaw = pts[i], profile(lengths[i] / total)
+            fitting = self._fitting_yaw(x, y, yaw, ctx)
+            if fitting is None:
+                bad.add(cells[i])
+            poses.append(BasePose(x, y, yaw if fitting is None else fitting))
+        poses.append(b)
+        if not bad:
+            for i in range(len(poses) - 1):  # every raw step must be free (turns included)
+                if not self.segment_free(poses[i], poses[i + 1], ctx.escape, ctx.exact):
+                    bad.update(cells[j] for j in (i, i + 1) if 0 < j < len(cells) - 1)
+        return poses, bad
+
+    def _greedy(self, poses: list[BasePose], ctx: "_Query") -> list[BasePose]:
+        """From each pose on, a far later pose reachable on a free straight segment: the last
+        pose if it is, else one found by bisection (free, with the next one not free from
+        there). Consecutive poses are known to be connected by free segments."""
+        out: list[BasePose] = []
+        i, n = 0, len(poses)
+        while i < n - 1:
+            lo, hi = i + 1, n - 1
+            if self.segment_free(poses[i], poses[hi], ctx.escape, ctx.exact):
+                lo = hi
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if self.segment_free(poses[i], poses[mid], ctx.escape, ctx.exact):
+                    lo = mid
+                else:
+                    hi = mid
+            out.append(poses[lo])
+            i = lo
+        return out
+
+    def _fitting_yaw(self, x: float, y: float, yaw: float, ctx: "_Query") -> Optional[float]:
+        """`yaw` if the footprint fits there at it, else the nearest heading (in steps of
+        pi/16) that fits, else None."""
+        escape = ctx.escape
+        if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+            return yaw
+        for k in range(17):
+            for sign in ((1,) if k == 0 else (1, -1)):
+                candidate = yaw + sign * k * math.pi / 16
+                if self.pose_free(x, y, candidate, ctx.exact):
+                    return candidate
+        return None

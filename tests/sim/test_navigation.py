@@ -1,0 +1,67 @@
+"""Driving around things: planned base paths in the simulator, re-planning when an obstacle
+appears during a drive, and a named failure when there is no way."""
+
+from __future__ import annotations
+
+import math
+
+from sim_helpers import T, Recorder, ok, wait_wall
+
+OBSTACLE_HALF = 0.15  # [m] half width of `place_obstacle`'s box
+
+
+def _footprint_radius(world) -> float:
+    from pycram.sim.path_drive import navigation_of
+
+    nav = ok(world._call("navigation", navigation_of))
+    return nav.footprint.inscribed_radius
+
+
+def test_a_free_straight_drive_stays_straight(world):
+    start = world.base_pose.get_value()
+    poses = Recorder(world.base_pose)
+    ok(world.drive_to(start.x + 1.5, start.y + 0.5, start.yaw))
+    line = (1.5, 0.5)
+    n = math.hypot(*line)
+    off = [abs((p.x - start.x) * line[1] - (p.y - start.y) * line[0]) / n for p in poses.samples]
+    assert max(off) < 0.01
+    ok(world.drive_to(start.x, start.y, start.yaw))
+
+
+def test_an_obstacle_appearing_mid_drive_is_driven_around(world):
+    start = world.base_pose.get_value()
+    goal = (start.x + 2.2, start.y, start.yaw)
+    poses = Recorder(world.base_pose)
+    handle = world.drive_to(*goal)
+    # when the base crosses 0.4 m from its start, a box appears 1.0 m ahead on its way
+    assert wait_wall(lambda: world.base_pose.get_value().x > start.x + 0.4, [world.base_pose], timeout=T)
+    obstacle_x = start.x + 1.4
+    obstacle = ok(world.place_obstacle(obstacle_x, start.y))
+    try:
+        out = handle.wait(T)
+        assert out is not None and out.succeeded, out
+        final = world.base_pose.get_value()
+        assert math.hypot(final.x - goal[0], final.y - goal[1]) < 0.02
+        # it went around: off the straight line, and never closer to the box than fits
+        assert max(abs(p.y - start.y) for p in poses.samples) > OBSTACLE_HALF + 0.2
+        # (a drive that touches anything ends with "collision"); the base's centre kept at least
+        # its inscribed radius from the box
+        closest = min(math.hypot(max(abs(p.x - obstacle_x) - OBSTACLE_HALF, 0.0),
+                                 max(abs(p.y - start.y) - OBSTACLE_HALF, 0.0)) for p in poses.samples)
+        assert closest > _footprint_radius(world)
+    finally:
+        ok(world.remove_obstacle(obstacle))
+    ok(world.drive_to(start.x, start.y, start.yaw))
+
+
+def test_an_obstacle_on_the_goal_fails_with_no_path_and_the_base_stays(world):
+    start = world.base_pose.get_value()
+    obstacle = ok(world.place_obstacle(start.x + 1.5, start.y))
+    try:
+        out = world.drive_to(start.x + 1.5, start.y, start.yaw).wait(T)
+        assert out is not None and not out.succeeded
+        assert out.reason == "no_path" and "goal_in_collision" in out.message
+        assert world.base_pose.get_value().distance_to(start) < 0.01
+    finally:
+        ok(world.remove_obstacle(obstacle))
+
