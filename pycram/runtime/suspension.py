@@ -18,7 +18,9 @@ Semantics:
   fluent (set by its own thread, so never after it ended) and `RUNNING` again once woken.
   Tasks started later in the subtree are suspended as well (suspension is inherited).
 * Suspensions count: a task suspended twice runs again after two `wake_up`s. A task runs only
-  while neither it nor an ancestor is suspended.
+  while neither it nor an ancestor is suspended. Pair every `suspend` with a `wake_up` (or use
+  `with_task_suspended`): while any suspension is in force, every PyCRAM wait also walks its
+  task's ancestors.
 * Evaporation wins: an evaporating task is never suspended, and evaporating a suspended task
   wakes it with `Evaporated` (its clean-up runs).
 * `on_suspension(hook, on_wake)`: while the block runs, `hook()` is called in the task's own
