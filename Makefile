@@ -1,29 +1,38 @@
 # Two commands do all the set-up on a fresh machine:
 #   make demo  - create the virtual environment, install everything, run the thesis demo headless
-#   make test  - create the virtual environment if needed and run the whole test suite
+#   make test  - create the virtual environment if needed, install ROS 1 (scripts/install_ros.sh)
+#                and run the whole test suite
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+ROS    := $(VENV)/.ros-installed
 
-.PHONY: demo test bench docs check wheel clean
+.PHONY: demo test bench docs check wheel ros clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -e '.[all,dev]'
 	touch $(STAMP)
 
+# ROS 1 from Debian's packages (apt-get only when something is missing) + generated messages.
+$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/ros/interfaces/*/*.msg pycram/ros/interfaces/*/*.action pycram/ros/interfaces/*/*.srv) pycram/ros/interfaces/generate.py
+	scripts/install_ros.sh $(VENV)
+	touch $(ROS)
+
+ros: $(ROS)
+
 demo: $(STAMP)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(VENV)/bin/pycram demo
 
-test: $(STAMP)
+test: $(STAMP) $(ROS)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(PY) -m pytest
 
 bench: $(STAMP)
 	$(PY) benchmarks/language.py
 
 # The documentation site, built into site/ with warnings as errors (offline: no fonts or CDN).
-docs: $(STAMP)
+docs: $(STAMP) $(ROS)
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 # Lint, format, types and docs (not yet part of .ci/run: the tree-wide clean-up is pending).

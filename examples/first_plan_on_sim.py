@@ -58,8 +58,8 @@ def fetch_the_mug():
     seen = motion(type="detecting", object="mug")
     if not seen:
         raise MugNotFound("no mug on the back counter")
-    mug = seen[0].pose.position
-    log.info("saw the %s at (%.2f, %.2f, %.2f)", seen[0].name, *mug)
+    mug = seen[0].pose  # its centre (x, y, z) [m] as measured by the camera
+    log.info("saw the %s (%s) at (%.2f, %.2f, %.2f)", seen[0].type, seen[0].name, *mug)
 
     # grasp it: a base pose to reach it from (a location designator), then the arm
     motion(type="moving", pose=LocationDesignator([("to_reach", mug)]).reference())

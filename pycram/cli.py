@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
+import os
+import signal
 import sys
 from pathlib import Path
 from typing import Any, Optional
@@ -266,9 +268,14 @@ def run_command(
 
     The script owns logging (`logging.basicConfig` in it works as under `python FILE.py`);
     an exception it raises is reported with a traceback that starts at the script's code, and
-    the exit code is 1.
+    the exit code is 1. SIGINT (Ctrl-C) and SIGTERM stop the script so that its clean-up runs
+    (in plain Python code as a KeyboardInterrupt, inside PyCRAM by evaporating the script's
+    tasks): the run is recorded as "interrupted" with the reason, the exit code is 130 / 143; a
+    second signal while stopping exits at once.
     """
+    from pycram.interrupts import StopSignals
     from pycram.macros import format_script_error, run_script
+    from pycram.runtime import end_thread_root
 
     recorder = None
     if _record_flag(record):
@@ -277,29 +284,36 @@ def run_command(
         recorder = _trace_errors(lambda: Recorder(db, plan=plan or file.name, robot=robot,
                                                   command=" ".join(["pycram run", str(file), *ctx.args])).start())
     outcome, error, code = "succeeded", None, 0
-    try:
-        run_script(file, list(ctx.args))
-    except SystemExit as e:
-        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
-        outcome = "succeeded" if code == 0 else "failed"
-        error = None if code == 0 else f"SystemExit: {e.code}"
-    except KeyboardInterrupt as e:
-        outcome, error, code = "interrupted", e, 130
-        raise
-    except Exception as e:
-        outcome, error, code = "failed", e, 1
-        sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
-    except BaseException as e:
-        outcome, error, code = "failed", e, 1
-        raise
-    finally:
-        if recorder is not None:
-            _robot_from_active(recorder)
-            run_id = recorder.finish(outcome, error)
-            err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
-            if recorder.lost_records:
-                err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
-                          soft_wrap=True)
+    ended: BaseException | None = None  # what ended the main thread's root task
+    with StopSignals(stop_main=True) as stop:
+        try:
+            run_script(file, list(ctx.args))
+        except SystemExit as e:
+            code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+            outcome = "succeeded" if code == 0 else "failed"
+            error = None if code == 0 else f"SystemExit: {e.code}"
+            ended = None if code == 0 else e
+        except BaseException as e:
+            if not (stop.requested or isinstance(e, KeyboardInterrupt)):
+                outcome, error, code, ended = "failed", e, 1, e
+                if not isinstance(e, Exception):
+                    raise
+                sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
+            else:
+                # SIGINT / SIGTERM (as `Interrupted`, or as `Evaporated` of the script's tasks), or a
+                # KeyboardInterrupt raised by the script itself
+                stop.request(getattr(e, "signum", signal.SIGINT))
+                outcome, error, code, ended = "interrupted", stop.reason, stop.exit_code, e
+                err.print(f"[bold yellow]pycram run:[/bold yellow] {stop.reason}; the script was stopped")
+        finally:
+            end_thread_root(ended)
+            if recorder is not None:
+                _robot_from_active(recorder)
+                run_id = recorder.finish(outcome, error)
+                err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
+                if recorder.lost_records:
+                    err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
+                              soft_wrap=True)
     raise typer.Exit(code)
 
 
@@ -343,7 +357,8 @@ def _check_output_folder(output: str) -> None:
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
-    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: output/demo-ROBOT)."),
+    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: the run's "
+                                         "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded)."),
     item_at: int = typer.Option(1, "--item-at", min=0, max=3,
                                 help="Where the item starts: position 1, 2 or 3 (0: no item)."),
     steal: int = typer.Option(0, "--steal", min=0, max=_MAX_STEALS,
@@ -355,6 +370,11 @@ def demo_command(
                                           help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
     db: Optional[str] = DbOption,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
+    animation: bool = typer.Option(True, "--animation/--no-animation",
+                                   help="Record the animation run.gif (--no-animation: a faster run)."),
+    backend: str = typer.Option("sim", "--backend",
+                                help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
+                                     "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set)."),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     if output is not None:
@@ -367,7 +387,7 @@ def demo_command(
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
                          realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet)
+                         quiet=quiet, animation=animation, backend=backend)
     raise typer.Exit(int(code or 0))
 
 
@@ -383,8 +403,11 @@ def scene_command(
                                 help="Comma-separated object types to place at random ('' for none)."),
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
+    belief: bool = typer.Option(False, "--belief",
+                                help="Let the robot look around and draw its belief beside the ground truth."),
 ) -> None:
-    """A labelled picture of a scene: plan and overview with surfaces, containers and objects."""
+    """A labelled picture of a scene: plan and overview with surfaces, containers and objects
+    (with --belief: what the robot perceived from where it stands beside what is)."""
     try:
         from pycram.demos.scene_picture import VIEW_SIZE, write_scene_picture
         from pycram.sim import World
@@ -398,13 +421,66 @@ def scene_command(
     except (KeyError, PlacementError) as e:
         _fail(str(e).strip("'\""))
     try:
-        path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
+        if belief:
+            path = _belief_picture(world, robot, output, title=f"{env} · seed {seed} · {robot}: belief")
+        else:
+            path = write_scene_picture(world, output, title=f"{env} · seed {seed} · {robot}")
         for p in world.placements:
             where = p.support + (f" (in {p.container})" if p.container else "")
             console.print(f"  {escape(p.name):<10} {escape(where)}")
     finally:
         world.close()
     console.print(f"wrote {escape(str(path))}")
+
+
+@app.command("sim-ros-bridge")
+def sim_ros_bridge_command(
+    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
+                                help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."),
+    realtime: bool = typer.Option(False, "--realtime", help="Simulate at real-time speed (default: as fast as "
+                                  "possible; /clock carries the simulation time)."),
+    publish_rate: float = typer.Option(50.0, "--publish-rate", min=1.0, help="Sensor topics per second [Hz, wall]."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address the node binds to and advertises (ROS_IP). "
+                             "Loopback by default: nothing outside this machine can command the robot."),
+    allow_remote_master: bool = typer.Option(False, "--allow-remote-master",
+                                             help="Accept a ROS_MASTER_URI that is not on loopback."),
+) -> None:
+    """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
+    /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
+    if robot not in ("pr2", "tiago"):
+        _fail(f"--robot must be 'pr2' or 'tiago', not {robot!r}", code=2)
+    try:
+        from pycram.ros.launch import check_master_uri
+    except ImportError as e:
+        _fail(f"sim-ros-bridge needs ROS 1 (run scripts/install_ros.sh): {e}")
+    try:
+        check_master_uri(os.environ.get("ROS_MASTER_URI"), allow_remote=allow_remote_master)
+    except ValueError as e:
+        _fail(str(e), code=2)
+    os.environ["ROS_IP"] = os.environ["ROS_HOSTNAME"] = host
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from pycram.ros.bridge import run_bridge
+
+    run_bridge(robot, item_at=item_at, realtime=realtime, publish_rate=publish_rate,
+               ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True))
+
+
+def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Path:
+    """The robot looks around from where it stands; its belief is drawn beside the truth."""
+    from pycram import robots
+    from pycram.actions import look_around
+    from pycram.demos.belief_picture import write_belief_picture
+
+    robot = robots.load(robot_name, world)
+    try:
+        with robot:
+            look_around()
+    finally:
+        robot.shutdown()
+    for obj in robot.belief.objects():
+        console.print(f"  believed: {escape(repr(obj))}")
+    return write_belief_picture(world, robot.belief, output, title=title)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -41,7 +41,7 @@ from typing import Any, Callable, Sequence
 
 from pycram.block_forms import BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
-from pycram.runtime.evaporation import Evaporated, check_evaporation, shielded, wait_until
+from pycram.runtime.evaporation import check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
 from pycram.runtime.detached import detached_children
 from pycram.runtime.suspension import (is_suspended, on_suspension, retry_after_suspension, suspend,
@@ -292,13 +292,13 @@ class _Concurrent:
         """Run the branches; returns False if `deadline` [s] passed before an outcome."""
         self.count = len(fns)
         group = self.group = TaskGroup(self.on_end)
-        with shielded():  # never leave a started thread behind half-registered
-            for index, fn in enumerate(fns):
-                group.spawn(_label(fn, index), fn)
         try:
+            with shielded():  # never leave a started thread behind half-registered
+                for index, fn in enumerate(fns):
+                    group.spawn(_label(fn, index), fn)
             in_time = wait_until(group._cv, lambda: self.outcome is not None or group._running == 0, deadline)
-        except Evaporated:
-            group.wait_all()  # evaporates the branches, waits for them, re-raises
+        except BaseException:  # evaporated, or interrupted (KeyboardInterrupt): no branch outlives us
+            group.stop_all()
             raise
         try:
             group.evaporate()  # may raise a re-delivered Evaporated: the wait below still runs

@@ -160,16 +160,18 @@ def test_demo_passes_options_through(monkeypatch, db):
     fake.main = fake_main
     monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
     result = _invoke("demo", "--robot", "tiago", "--output", "out", "--item-at", "2", "--steal", "1",
-                     "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet")
+                     "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet",
+                     "--no-animation", "--backend", "ros")
     assert result.exit_code == 0, result.output
     assert calls == dict(robot="tiago", output="out", item_at=2, steal=1, seed=7, realtime=True,
-                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True)
+                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True, animation=False,
+                         backend="ros")
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")
     assert calls["record"] is False and calls["robot"] == "pr2"
     monkeypatch.delenv("PYCRAM_RECORD")
     _invoke("demo")
-    assert calls["record"] is True
+    assert calls["record"] is True and calls["animation"] is True
 
 
 @pytest.fixture
@@ -283,3 +285,44 @@ def test_db_option_names_the_database(tmp_path, plan_file, monkeypatch):
     assert fields[0] == "1" and fields[2:5] == ["by option", "pr2", "succeeded"]
     assert "no runs recorded" in _invoke("runs").output  # $PYCRAM_DB_URL: nothing there
     assert not (tmp_path / "env.sqlite3").exists()  # reading created nothing
+
+
+# -- SIGINT / SIGTERM end `pycram run` as "interrupted" (issue 12, point 6) -------------------------
+
+WAITING_PLAN = """
+from pycram.language import par
+from pycram.runtime import sleep
+
+def wait_long():
+    print("branch waiting", flush=True)
+    sleep(600)
+
+par(wait_long, wait_long)
+"""
+
+
+@pytest.mark.parametrize("signame, code, reason", [("SIGINT", 130, "interrupted by Ctrl-C (SIGINT)"),
+                                                   ("SIGTERM", 143, "terminated by SIGTERM")])
+def test_run_ends_as_interrupted_on_a_signal(tmp_path, signame, code, reason):
+    """The script waits in two `par` branches; the signal stops it (its branches end too), the
+    run is recorded as interrupted with the reason, the exit code is 128 + signal, one line says
+    why, no traceback; no task of the run is left "running" (the main thread's root included)."""
+    import signal
+
+    from signal_helpers import Command
+
+    from pycram.trace import query
+
+    script = tmp_path / "waiting.py"
+    script.write_text(WAITING_PLAN)
+    db = f"sqlite:///{tmp_path / 'runs.sqlite3'}"
+    run = Command(["run", str(script)], db, tmp_path)
+    run.wait_for_line("branch waiting")
+    run.send(getattr(signal, signame))
+    assert run.wait(60) == code, run.output
+    assert f"pycram run: {reason}; the script was stopped" in run.stderr and "Traceback" not in run.output
+    (info,) = query.runs(db)
+    assert info.outcome == "interrupted" and info.error == reason
+    tasks = query.tasks(info.id, db)
+    assert [t.status for t in tasks if t.kind == "branch"] == ["evaporated", "evaporated"]
+    assert not [t.name for t in tasks if t.status == "running"]

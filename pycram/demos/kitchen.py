@@ -2,8 +2,13 @@
 
 Builds the kitchen with the chosen robot and the item at the chosen position, activates the
 robot and the kitchen's location resolvers, runs `kitchen_plan.fetch_and_place` while showing
-live progress, then prints the task tree, writes snapshots, an animation, the task-tree SVG and
-the timeline PNG to the output folder, and returns 0 only when the item rests on cooker #1.
+live progress, then prints the task tree, writes snapshots, an animation (each frame captioned
+with the plan's phase and the simulated time), the task-tree SVG and the timeline PNG to the
+run's own output folder, and returns 0 only when the item rests on cooker #1.
+
+SIGINT (Ctrl-C) and SIGTERM stop the plan (the robot stops), the pictures of what happened are
+still written, the run is recorded as "interrupted" with the reason, and the exit code is 130 /
+143; a second signal while stopping exits at once (`pycram.interrupts.StopSignals`).
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ import logging
 import math
 import os
 import random
+import signal
 import threading
 import time
 from dataclasses import dataclass, field
@@ -31,6 +37,17 @@ WALL_TIME_LIMIT = 600.0
 #: The animation: frames per second of simulated time, and how much faster it plays.
 ANIMATION_FPS = 8.0
 ANIMATION_SPEED_UP = 2.0
+#: How long [s of wall time] the animation's recorder may take to render the frames still
+#: pending when the plan ended (a few seconds normally; much more on a heavily loaded machine).
+RENDER_CATCH_UP = 300.0
+#: Size of the animation's frames [px]; snapshots are 640 x 480.
+ANIMATION_SIZE = (480, 360)
+#: Where the pictures' camera frames bodies [m]: the kitchen (x_min, y_min, x_max, y_max); an
+#: item put aside out of the kitchen is not followed.
+KITCHEN_REGION = (-1.3, -1.8, 3.2, 3.6)
+#: The camera looks at the robot and the item from the side facing this point [m] (the open
+#: corner of the room, away from the walls).
+ROOM_MIDDLE = (2.0, 2.0)
 
 
 @dataclass
@@ -45,7 +62,8 @@ class DemoOptions:
     db: str | None = None
     record: bool = True
     quiet: bool = False
-    animation: bool = True  # record run.gif from the overview camera
+    animation: bool = True  # record run.gif (False: no animation, a faster run)
+    backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
 
 
 @dataclass
@@ -62,7 +80,9 @@ class DemoResult:
     failed_grasps: int = 0
     recoveries: int = 0
     item_on_cooker_1: bool = False
+    interrupted: bool = False  # stopped by SIGINT/SIGTERM (exit code 130/143)
     files: list[Path] = field(default_factory=list)
+    captions: list[tuple[float, str]] = field(default_factory=list)  # the animation's (sim time [s], caption)
     tree_text: str = ""  # the plan's task tree as plain text, one line per task
     plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
     trace_loss: str | None = None  # "N trace records could not be written: why", if any were lost
@@ -73,8 +93,17 @@ class DemoResult:
         return self.sim_time / self.plan_wall_time if self.plan_wall_time > 0 else 0.0
 
 
-def default_output(robot: str) -> Path:
-    return Path("output") / f"demo-{robot}"
+def default_output(robot: str, run_id: Any = None) -> Path:
+    """The run's own folder: `output/demo-ROBOT-RUNID` for a recorded run, else
+    `output/demo-ROBOT-YYYYmmdd-HHMMSS` (with a suffix if that folder exists already)."""
+    if run_id is not None:
+        return Path("output") / f"demo-{robot}-{run_id}"
+    stem = Path("output") / f"demo-{robot}-{time.strftime('%Y%m%d-%H%M%S')}"
+    folder, n = stem, 1
+    while folder.exists():
+        n += 1
+        folder = stem.with_name(f"{stem.name}-{n}")
+    return folder
 
 
 class PlanRun:
@@ -98,7 +127,7 @@ class PlanRun:
         self._thread.start()
 
     def _run(self) -> None:
-        from pycram.runtime import current_task, run_subtask
+        from pycram.runtime import current_task, end_thread_root, run_subtask
 
         def whole_plan() -> Any:
             self.task = current_task()
@@ -110,6 +139,7 @@ class PlanRun:
         except BaseException as error:  # the plan failed, or was evaporated
             self.error = error
         finally:
+            end_thread_root(self.error)  # the thread's root task ends with the thread, as the plan did
             self._ended_wall = time.monotonic()
 
     def join(self, timeout: float) -> bool:
@@ -136,60 +166,106 @@ class PlanRun:
         return sim_now - self._started_sim
 
 
-def run_demo(options: DemoOptions) -> DemoResult:
-    """Run the demo once; never raises for plan failures (they are in the result)."""
+def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
+    """Run the demo once; never raises for plan failures (they are in the result).
+
+    `stop` (a `pycram.interrupts.StopSignals`, e.g. the one `main` installs): once it is
+    requested, the plan is stopped, the pictures are written, and the run ends "interrupted"
+    with the signal's exit code (130 / 143). A `KeyboardInterrupt` while the plan runs counts as
+    SIGINT. The output folder is `options.output`, else the run's own (`default_output`).
+    """
+    from pycram.interrupts import StopSignals
+
     if options.item_at not in (0, 1, 2, 3):
         raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {options.item_at}")
+    if options.backend not in ("sim", "ros"):
+        raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in ("pr2", "tiago"):
         raise ValueError(f"--robot must be 'pr2' or 'tiago', not {options.robot!r}")
-    output = Path(options.output) if options.output else default_output(options.robot)
-    output.mkdir(parents=True, exist_ok=True)
-
-    result = DemoResult(exit_code=1, message="", output=output)
+    stop = stop if stop is not None else StopSignals()  # never signalled unless entered
     started_wall = time.monotonic()
     recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
+    run_id = recorder.run_id if recorder is not None else None
+    output = Path(options.output) if options.output else default_output(options.robot, run_id)
+    result = DemoResult(exit_code=1, message="", output=output, run_id=run_id)
+    error: BaseException | None = None
     try:
-        _run_in_world(options, result, recorder)
+        output.mkdir(parents=True, exist_ok=True)
+        _run_in_world(options, result, recorder, stop)
+    except BaseException as exc:
+        error = exc
+        raise
     finally:
         result.wall_time = time.monotonic() - started_wall
+        if isinstance(error, KeyboardInterrupt):
+            stop.request(signal.SIGINT)
+        if stop.requested:
+            _mark_interrupted(result, stop)
         if recorder is not None:
-            ok = result.exit_code == 0
-            result.run_id = recorder.finish("succeeded" if ok else "failed", None if ok else result.message)
+            outcome = "succeeded" if result.exit_code == 0 else "interrupted" if result.interrupted else "failed"
+            reason = result.message if result.exit_code != 0 else None
+            if error is not None and not isinstance(error, KeyboardInterrupt):
+                reason = f"{type(error).__name__}: {error}"
+            result.run_id = recorder.finish(outcome, reason)
             result.trace_loss = recorder.loss_report()
     if recorder is not None:
         result.files.extend(_write_run_pictures(result, recorder))
     return result
 
 
-def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> None:
+def _mark_interrupted(result: DemoResult, stop: Any) -> None:
+    """Make `result` say that a signal ended the run (exit code 130/143), and what had happened."""
+    result.interrupted = True
+    result.exit_code = stop.exit_code
+    if result.item_on_cooker_1:
+        result.message = f"{stop.reason} after the plan had placed the item on cooker #1"
+    elif result.plan_task is None:
+        result.message = f"{stop.reason} before the plan started"
+    else:
+        result.message = (f"{stop.reason} after {result.sim_time:.1f} s of simulated time; "
+                          f"the plan and the robot were stopped")
+
+
+def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop: Any) -> None:
     """Build the kitchen, run the plan in it, fill in `result`, write the pictures."""
     from pycram import robots as robot_packages
     from pycram.demos import kitchen_plan as plan
     from pycram.demos.kitchen_world import (
         ITEM_NAME,
-        SLOTS,
         START_POSE,
         Helper,
         KitchenFacts,
         Operator,
         Thief,
+        demo_items,
         operator_resolver,
     )
-    from pycram.runtime import format_task_tree
-    from pycram.sim import ItemSpec, Pose2D, World
+    from pycram.environments import load as load_environment
+    from pycram.runtime import add_task_listener, format_task_tree, remove_task_listener
+    from pycram.sim import FollowView, Pose2D, World
     from pycram.sim.render import write_animation
 
     output = result.output
     rng = random.Random(options.seed)
-    mug = ItemSpec(ITEM_NAME, "mug", "cylinder", (0.03, 0.05), 0.25,
-                   (*SLOTS[options.item_at], None) if options.item_at else (5.0, 5.0, None), (0.85, 0.2, 0.15, 1))
-    items = [mug] if options.item_at else []
-    world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
-    counter_height = world.environment.surface("cooker #1").height
+    items = demo_items(options.item_at)
+    mug = demo_items(1)[0]  # the mug's size, also when it is not in the kitchen
+    camera: Any = "overview"
+    if options.backend == "ros":  # plan -> ROS process modules -> roscore -> sim-ros-bridge -> MuJoCo
+        from pycram.ros.sim_environment import open_ros_world
+
+        world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
+        counter_height = load_environment("thesis-kitchen").surface("cooker #1").height
+    else:
+        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+        robot = None
+        counter_height = world.environment.surface("cooker #1").height
+        camera = FollowView((world.description.ROOT_LINK, *(item.name for item in items)), region=KITCHEN_REGION,
+                            side_of=ROOM_MIDDLE, elevation=-50.0, min_distance=2.8, margin=2.2)
     thief = None
+    story = None
     frames: list = []
     try:
-        robot = robot_packages.load(options.robot, world)
+        robot = robot or robot_packages.load(options.robot, world)
         helper = Helper(world, interactive=options.interactive)
         gripper_of = _gripper_mapper(world)
         operator = Operator(helper, gripper_of)
@@ -201,15 +277,18 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
             recorder.set_run_info(robot=options.robot)
             for fluent in (plan.phase, world.base_pose):
                 recorder.watch(fluent, fluent.name, max_rate_hz=5.0)
-        world.snapshot(output / "start.png")
+        world.snapshot(output / "start.png", camera=camera)
         result.files.append(output / "start.png")
         plan.forget_state()
+        story = _Story(plan, thief, stop)
+        add_task_listener(story)
         if options.animation:
-            world.start_recording("overview", fps=ANIMATION_FPS, width=480, height=360)
+            world.start_recording(camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1],
+                                  caption=story.caption)
         run = PlanRun(plan, robot, facts)
         thief.start()
         run.start(world.sim_time.get_value())
-        result.message = _watch(run, world, plan, helper, thief, options)
+        result.message = _watch(run, world, plan, helper, thief, options, stop)
         thief.stop()
         result.plan_wall_time = run.wall_time
         result.sim_time = run.sim_time(world.sim_time.get_value())
@@ -218,17 +297,21 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any) -> No
         result.failed_grasps = failed_grasps(run.task)
         result.recoveries = recoveries(run.task)
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
-        world.snapshot(output / "end.png")
+        world.snapshot(output / "end.png", camera=camera)
         result.files.append(output / "end.png")
-        frames = world.stop_recording() if options.animation else []
+        # the recorder may lag behind on a busy machine: let it finish rather than lose the end
+        frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation else []
         if result.item_on_cooker_1:
             result.exit_code, result.message = 0, "the item rests on cooker #1"
         elif not result.message:
             result.message = _failure_message(run)
     finally:
+        if story is not None:
+            remove_task_listener(story)
         if thief is not None:
             thief.stop()
         world.close()
+    result.captions = list(getattr(frames, "captions", []))
     if frames:  # encoded after the simulation stopped, so the two do not compete for the CPU
         result.files.append(write_animation(output / "run.gif", frames, ANIMATION_SPEED_UP * ANIMATION_FPS))
 
@@ -329,8 +412,8 @@ def _write_run_pictures(result: DemoResult, recorder: Any) -> list[Path]:
     return list(write_task_pictures(result.plan_task, result.output))
 
 
-def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions) -> str:
-    """Show live progress until the plan ends; stop it on a time limit or Ctrl-C.
+def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions, stop: Any) -> str:
+    """Show live progress until the plan ends; stop it on a time limit, a stop signal or Ctrl-C.
 
     Returns "" when the plan ended by itself, otherwise why it was stopped. Without
     `--interactive` the plan is stopped after `SIM_TIME_LIMIT` of simulated time or
@@ -350,18 +433,60 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
             while not run.join(0.25):
                 if progress is not None:
                     progress.refresh()
-                if limited and world.sim_time.get_value() > sim_deadline:
+                if stop.requested:
+                    reason = stop.reason
+                elif limited and world.sim_time.get_value() > sim_deadline:
                     reason = f"the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
                 elif limited and time.monotonic() > wall_deadline:
                     reason = f"the plan did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
                 if reason:
                     break
-        except KeyboardInterrupt:
-            reason = "interrupted by the user (Ctrl-C)"
+        except KeyboardInterrupt:  # no StopSignals installed (library use): Ctrl-C raised here
+            stop.request(signal.SIGINT)
+            reason = stop.reason
+        if not reason and stop.requested:  # the signal came as the plan ended
+            reason = stop.reason
         if reason:
             log.warning("stopping the plan: %s", reason)
             run.stop()
     return reason
+
+
+class _Story:
+    """What the animation's captions say: the plan's phase in words, with the failed grasps
+    (counted as `grab_item` tasks fail: a task listener, O(1) per task end), the thefts and the
+    recovery (read from the simulated gripper: this is for people watching, not for the plan).
+    `caption` is called by the simulation thread at each frame time: it only reads."""
+
+    GRASP_POSITIONS = 3
+
+    def __init__(self, plan: Any, thief: Any, stop: Any) -> None:
+        self.plan, self.thief, self.stop = plan, thief, stop
+        self.failed_grasps = 0
+
+    def task_started(self, task: Any) -> None:
+        pass
+
+    def task_ended(self, task: Any) -> None:
+        if task.name == "grab_item" and _failed(task):
+            self.failed_grasps += 1
+
+    def caption(self) -> str:
+        if self.stop.requested:
+            return f"{self.stop.reason}: stopping"
+        phase = self.plan.phase.get_value()
+        failed, stolen = self.failed_grasps, self.thief.stolen
+        if phase == "fetching":
+            if failed:
+                return f"fetching: grasp {failed} of {self.GRASP_POSITIONS} failed, trying position {failed + 1}"
+            return f"fetching: grasp 1 of {self.GRASP_POSITIONS}"
+        if phase == "transporting":
+            if stolen and self.thief.world.gripper_states[self.thief.gripper].get_value().holding is None:
+                return f"item taken ({stolen}x): recovering"  # until the gripper holds it again
+            return f"transporting (recovered {stolen}x)" if stolen else "transporting"
+        if phase == "failed" and failed >= self.GRASP_POSITIONS:
+            return f"failed: all {self.GRASP_POSITIONS} grasps failed"
+        return {"initialising": "getting ready", "resetting": "resetting the robot"}.get(phase, phase)
 
 
 class _ProgressLine:
@@ -453,9 +578,12 @@ def _log_to_terminal() -> None:
 
 def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal: int = 0, seed: int = 0,
          realtime: bool = False, interactive: bool = False, db: str | None = None, record: bool = True,
-         quiet: bool = False) -> int:
-    """Run the demo, print the task tree and a summary; return the process exit code."""
+         quiet: bool = False, animation: bool = True, backend: str = "sim") -> int:
+    """Run the demo, print the task tree and a summary; return the process exit code (0: the item
+    rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
     from rich.console import Console
+
+    from pycram.interrupts import StopSignals
 
     if not quiet:
         _log_to_terminal()
@@ -463,9 +591,10 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     console = Console()
     options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
                           seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
-                          quiet=quiet)
+                          quiet=quiet, animation=animation, backend=backend)
     try:
-        result = run_demo(options)
+        with StopSignals(on_second=lambda: _stderr_console().show_cursor(True)) as stop:
+            result = run_demo(options, stop)
     except ValueError as error:  # an option out of range: say which, no traceback
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
         return 2
@@ -480,7 +609,7 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
     if result.trace_loss:
         console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]",
                       highlight=False)
-    colour = "green" if result.exit_code == 0 else "red"
-    verdict = "SUCCESS" if result.exit_code == 0 else "FAILURE"
+    colour = "green" if result.exit_code == 0 else "yellow" if result.interrupted else "red"
+    verdict = "SUCCESS" if result.exit_code == 0 else "INTERRUPTED" if result.interrupted else "FAILURE"
     console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")
     return result.exit_code

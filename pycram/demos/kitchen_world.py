@@ -36,6 +36,21 @@ START_POSE = (0.8, 0.6, 0.0)
 ITEM_NAME = "mug"
 
 
+#: The mug's colour: a yellow that stands out against counters, floor and robot in the pictures.
+ITEM_COLOUR = (1.0, 0.82, 0.05, 1.0)
+
+
+def demo_items(item_at: int) -> list:
+    """The demo's items: the mug on slot `item_at` (1, 2 or 3) of cooker #2, none for 0."""
+    from pycram.sim import ItemSpec
+
+    if item_at not in (0, *SLOTS):
+        raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {item_at}")
+    if not item_at:
+        return []
+    return [ItemSpec(ITEM_NAME, "mug", "cylinder", (0.03, 0.05), 0.25, (*SLOTS[item_at], None), ITEM_COLOUR)]
+
+
 def item_centre(xy: tuple[float, float], half_height: float, counter_height: float) -> tuple[float, float, float]:
     """The centre [m] of an item of `half_height` [m] standing on the counter at `xy`."""
     return (xy[0], xy[1], counter_height + half_height)

@@ -185,7 +185,14 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
     ax.text(lx, ly, "solid circle: object in view   dashed: inside a closed container\n"
             "brown arrow: how a container opens   grey arrow: a named place (base pose)",
             ha=ha, va=va, fontsize=8, color="#263238", bbox={**_BOX, "facecolor": "white"})
-    fig.suptitle(title or f"{env.name}: {env.title}", fontsize=14, y=0.95)
+    return _save(fig, path, title or f"{env.name}: {env.title}")
+
+
+def _save(fig: Any, path: str | Path, title: str) -> Path:
+    """Give `fig` its title, write it to `path` (PNG) and close it; returns the path."""
+    import matplotlib.pyplot as plt
+
+    fig.suptitle(title, fontsize=14, y=0.95)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100, bbox_inches="tight")
@@ -206,8 +213,8 @@ def _door_swing(ax: Any, arc_type: Any, door: Any) -> None:
     ax.plot([hx], [hy], "s", ms=5, color="#5d4037")
 
 
-def _render(world: Any, camera: str, width: int, height: int) -> np.ndarray:
-    outcome = world.request_image(camera, width, height).wait(60.0)
+def _render(world: Any, camera: str, width: int, height: int, hide_objects: bool = False) -> np.ndarray:
+    outcome = world.request_image(camera, width, height, hide_objects).wait(60.0)
     if outcome is None or not outcome.succeeded:
         raise RuntimeError(f"rendering camera {camera!r} failed: {outcome}")
     return outcome.value

@@ -88,6 +88,12 @@ def _object_value(obj: Any, key: Any) -> Any:
     return getattr(obj, key, _MISSING)
 
 
+def _name_of(value: Any) -> Any:
+    """The ``name`` of a described thing (a surface, a container...), or ``_MISSING``."""
+    name = getattr(value, "name", _MISSING)
+    return name if isinstance(name, str) else _MISSING
+
+
 class ObjectDesignator(LazyDesignator):
     """An object described by properties (``type``, ``color``, ``name``, ``at`` a location...).
 
@@ -100,7 +106,14 @@ class ObjectDesignator(LazyDesignator):
     - ``value`` is another designator: the object's property ``key`` is that designator's
       resolved solution (or the designator itself);
     - ``value`` is callable: ``value(object_value)`` is true (predicates, e.g. on size);
-    - otherwise the object's property ``key`` equals ``value``.
+    - otherwise the object's property ``key`` equals ``value``, or names it: ``('on', surface)``
+      matches an object whose ``'on'`` is ``surface.name`` (a surface or container of an
+      environment description given instead of its name).
+
+    The simulated robots resolve object designators against their belief
+    (:class:`pycram.world.belief.BeliefState`): ``type``, ``name`` (the belief's name),
+    ``color``, ``on`` (a surface), ``in`` (a container), ``size`` and ``pose`` of what they
+    perceived, best match first.
     """
 
     resolvers: ClassVar[list[Callable[["ObjectDesignator"], Any]]] = []
@@ -133,7 +146,7 @@ class ObjectDesignator(LazyDesignator):
             elif callable(value) and not callable(actual):
                 if not value(actual):
                     return False
-            elif actual != value:
+            elif actual != value and not (isinstance(actual, str) and _name_of(value) == actual):
                 return False
         return True
 

@@ -47,6 +47,8 @@ __all__ = [
     "SensorModule",
     "PerceptionModule",
     "SimRobot",
+    "cancel_running_handle",
+    "shutdown_modules",
 ]
 
 logger = logging.getLogger(__name__)
@@ -135,13 +137,21 @@ class SimProcessModule(ProcessModule):
         return outcome.value
 
     def _cancel(self, designator: Any) -> None:
-        current = self.current
-        if current is None or current.designator is not designator:
-            return  # evaporated while queued: the running command belongs to another caller
-        handle, self._handle = self._handle, None
-        if handle is not None and not handle.done:
-            logger.info("%s: cancelling %s", self.name, handle.name)
-            handle.cancel()
+        cancel_running_handle(self, designator)
+
+
+def cancel_running_handle(module: Any, designator: Any) -> None:
+    """The cancel hook of a module that keeps its running command's handle in ``module._handle``
+    (a simulator command, a ROS goal: anything with ``name``, ``done`` and ``cancel()``): cancel
+    it -- unless ``designator`` was evaporated while still queued, when the running command
+    belongs to another caller."""
+    current = module.current
+    if current is None or current.designator is not designator:
+        return
+    handle, module._handle = module._handle, None
+    if handle is not None and not handle.done:
+        logger.info("%s: cancelling %s", module.name, handle.name)
+        handle.cancel()
 
 
 class NavigationModule(SimProcessModule):
@@ -352,23 +362,38 @@ class SensorModule(SimProcessModule):
 
 
 class PerceptionModule(SimProcessModule):
-    """Perceives the items visible to the head camera (``'cmd': 'perceive'``).
+    """Object perception with the head camera (``'cmd': 'perceive'``), filling the robot's belief.
 
-    Returns a list of :class:`pycram.sim.VisibleItem` (most visible first), restricted to
-    items whose name or type equals ``'object'`` when given (possibly empty).
+    Each execution takes one look (:meth:`pycram.sim.World.detect`: segmentation, depth and
+    colour images measured into detections) and folds it into ``belief`` (a
+    :class:`pycram.world.belief.BeliefState`). Returns the believed objects seen in this look
+    (:class:`pycram.world.belief.PerceivedObject`, most visible first), restricted by
+    ``'object'`` when given: a type or belief name, or an object designator; for a designator
+    the best match is recorded with ``designator.perceived(obj)`` (equated to it, thesis 3.3).
+    The look's :class:`pycram.world.belief.BeliefUpdate` is kept in ``last_update``.
     """
 
-    def __init__(self, world: Any, name: str = "perception") -> None:
+    def __init__(self, world: Any, belief: Any, name: str = "perception") -> None:
         super().__init__(name, world)
+        self.belief = belief
+        self.last_update: Any = None
 
     def _execute(self, designator: Any) -> Any:
+        from pycram.designators.object import ObjectDesignator
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
-        seen = self._run_command(self.world.perceive, "perceive", timeout=10.0)
+        report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
+        update = self.last_update = self.belief.update(report)
+        seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
         wanted = solution.get("object")
         if wanted is None:
-            return list(seen)
-        return [item for item in seen if wanted in (item.name, item.type)]
+            return seen
+        if isinstance(wanted, ObjectDesignator):
+            matching = [obj for obj in seen if wanted.matches(obj)]
+            if matching:
+                wanted.perceived(matching[0], timestamp=report.stamp)
+            return matching
+        return [obj for obj in seen if wanted in (obj.name, obj.type)]
 
 
 def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
@@ -377,27 +402,40 @@ def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
                          f"{solution!r}")
 
 
+def shutdown_modules(robot: Robot) -> None:
+    """End every subscription of ``robot``'s sensor modules and take all its process modules
+    offline (running motions finish); idempotent."""
+    for module in robot.process_modules.values():
+        if isinstance(module, SensorModule):
+            module.unsubscribe_all()
+        if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
+            module.shutdown()
+
+
 class SimRobot(Robot):
     """A :class:`pycram.robot.Robot` bound to a simulated :class:`pycram.sim.World`.
 
-    ``world`` is the world, ``description`` the robot's description module. :meth:`shutdown`
+    ``world`` is the world, ``description`` the robot's description module, ``belief`` the
+    robot's :class:`pycram.world.belief.BeliefState` (its resolver is the robot's object
+    resolver, so object designators resolve against what it perceived). :meth:`shutdown`
     ends every subscription and takes every process module offline (idempotent).
     """
 
     def __init__(self, name: str, world: Any, description: Any) -> None:
+        from pycram.world.belief import BeliefState
         super().__init__(name)
         self.world = world
         self.description = description
+        #: What this robot believes is in the world: filled by its perception module, read by
+        #: its object resolver.
+        self.belief = BeliefState(getattr(world, "environment", None))
+        self.object_resolvers.append(self.belief.resolver)
         make_prospection = getattr(world, "prospection", None)
         self.prospection = make_prospection() if callable(make_prospection) else None
 
     def shutdown(self) -> None:
         """Stop subscriptions and take all process modules offline (running motions finish)."""
-        for module in self.process_modules.values():
-            if isinstance(module, SensorModule):
-                module.unsubscribe_all()
-            if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
-                module.shutdown()
+        shutdown_modules(self)
 
     def __repr__(self) -> str:
         return f"SimRobot({self.name!r}, {self.world!r})"

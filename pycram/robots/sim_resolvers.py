@@ -23,7 +23,7 @@ designator type                solution
                                'phase', 'target'}``
 ``subscribing_pose``           ``{'cmd': 'subscribe', 'source': 'base_pose', 'fl'}``
 ``subscribing_gripper``        ``{'cmd': 'subscribe', 'source': 'gripper_opening', 'gripper', 'fl'}``
-``detecting``                  ``{'cmd': 'perceive', 'object': name/type or None}``
+``detecting``                  ``{'cmd': 'perceive', 'object': type, belief name, designator or None}``
 =============================  ==================================================================
 
 ``arm`` / ``gripper`` in a solution is always the *physical* name (``description.ARMS``); a

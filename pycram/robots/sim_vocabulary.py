@@ -90,10 +90,10 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                    (fluent,)),
         MotionType("subscribing_gripper", "make a fluent follow a gripper's opening [m]",
                    (gripper, fluent)),
-        MotionType("detecting", "perceive the items the head camera sees; returns a list of "
-                   "VisibleItem", (
-                       MotionKey("object", "item name or type to look for (default: every "
-                                 "visible item)", form="text", required=False),
+        MotionType("detecting", "perceive the objects the head camera sees and update the robot's "
+                   "belief; returns the believed objects seen (PerceivedObject)", (
+                       MotionKey("object", "object type, belief name or object designator to look "
+                                 "for (default: every object seen)", form="any", required=False),
                    )),
     )
     return {t.name: t for t in types}

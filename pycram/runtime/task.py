@@ -44,6 +44,7 @@ __all__ = [
     "run_subtask",
     "task_scope",
     "as_task",
+    "end_thread_root",
     "format_task_tree",
 ]
 
@@ -233,7 +234,55 @@ def _root_task_for_this_thread(runner: Runner) -> Task:
     task.start_time = current_clock().now()
     task.status.set_value(TaskStatus.RUNNING)
     runner.task = task
+    if thread is not threading.main_thread():  # the main thread's root ends with end_thread_root()
+        _thread_roots.guard = _RootGuard(task)
     return task
+
+
+class _RootGuard:
+    """Held in thread-local storage: when the thread ends, CPython drops it (before `join()`
+    returns), and a root task still running ends SUCCEEDED."""
+
+    __slots__ = ("task",)
+
+    def __init__(self, task: Task) -> None:
+        self.task = task
+
+    def __del__(self) -> None:
+        _end_root(self.task, None)
+
+
+_thread_roots = threading.local()
+
+
+def _end_root(task: Task, exception: BaseException | None) -> None:
+    if task.done:
+        return
+    if exception is None:
+        task._end(TaskStatus.SUCCEEDED)
+    elif isinstance(exception, Evaporated) and task._evaporating:
+        task._end(TaskStatus.EVAPORATED, exception)
+    else:
+        task._end(TaskStatus.FAILED, exception)
+
+
+def end_thread_root(exception: BaseException | None = None) -> None:
+    """End the calling thread's root task: SUCCEEDED, or FAILED (EVAPORATED for an evaporation)
+    with `exception`, e.g. what ended the thread's work. No-op when the thread has no root task
+    or is inside a task. A later PyCRAM call in this thread starts a new root task.
+
+    Threads that PyCRAM did not start get a root task on their first PyCRAM call; it ends with
+    the thread by itself (SUCCEEDED). Call this to end it earlier or with an outcome, e.g. in the
+    main thread when a script's plans are done.
+    """
+    runner = current_runner()
+    task = runner.task
+    if task is None or task.kind != "root" or task.parent is not None:
+        return
+    runner.task = None
+    _end_root(task, exception)  # before dropping the guard, whose finalizer would end it SUCCEEDED
+    if getattr(_thread_roots, "guard", None) is not None and _thread_roots.guard.task is task:
+        _thread_roots.guard = None
 
 
 def current_task() -> Task:
@@ -424,14 +473,20 @@ class TaskGroup:
                 task.evaporate()
 
     def wait_all(self) -> None:
-        """Block until every child has ended (see the class doc for evaporation)."""
+        """Block until every child has ended (see the class doc for evaporation). If the wait is
+        cut short — by evaporation, or by `KeyboardInterrupt` (Ctrl-C, or SIGTERM under `pycram
+        run`) — every child is evaporated and waited for before the exception propagates."""
         try:
             wait_until(self._cv, self._all_ended)
-        except Evaporated:
-            with shielded():  # evaporate() itself may re-deliver the evaporation: never skip the wait
-                self.evaporate()
-                wait_until(self._cv, self._all_ended)
+        except BaseException:
+            self.stop_all()
             raise
+
+    def stop_all(self) -> None:
+        """Evaporate every child and block until all have ended (not interruptible by evaporation)."""
+        with shielded():
+            self.evaporate()
+            wait_until(self._cv, self._all_ended)
 
     def _all_ended(self) -> bool:
         return self._running == 0

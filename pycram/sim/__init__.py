@@ -13,6 +13,7 @@ from ._gl import configure_gl
 
 configure_gl()
 
+from .camera import FollowView  # noqa: E402
 from .errors import CommandFailed, SimulationError, UnknownNameError, WorldClosedError  # noqa: E402
 from .handle import CommandHandle  # noqa: E402
 from .items import DEFAULT_ITEMS, ItemSpec  # noqa: E402
@@ -24,6 +25,6 @@ from .world import World  # noqa: E402
 __all__ = [
     "World", "CommandHandle", "Outcome", "Pose", "Pose2D", "VisibleItem", "GripperState", "JointStates",
     "ItemSpec", "DEFAULT_ITEMS", "HEAD_CAMERA", "ROBOTS",
-    "Scene", "build_scene", "yaw_to_quat",
+    "Scene", "build_scene", "yaw_to_quat", "FollowView",
     "SimulationError", "UnknownNameError", "WorldClosedError", "CommandFailed",
 ]

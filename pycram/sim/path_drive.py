@@ -21,7 +21,7 @@ import numpy as np
 from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
 from pycram.world.prospection import BasePose
 
-from .controllers import BaseDrive, Controller, fail
+from .controllers import BaseDrive, Controller, fail, invalid_input
 from .engine import Engine
 from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, robot_parts
 from .prospection import SimProspection
@@ -154,6 +154,9 @@ class PlannedDrive(Controller):
         return self.segment.start(eng)
 
     def start(self, eng: Engine) -> Optional[Outcome]:
+        refused = invalid_input(goal=(self.goal.x, self.goal.y, self.goal.yaw))
+        if refused is not None:  # "invalid" before anything is planned or moves, as BaseDrive
+            return refused
         return self._plan(eng)
 
     def _remaining_free(self, eng: Engine, planner: PathPlanner) -> bool:

@@ -18,18 +18,22 @@ recorder catches up afterwards (`finish` waits for it).
 
 from __future__ import annotations
 
+import atexit
 import collections
 import copy
+import functools
 import logging
 import os
 import threading
 import time
+import weakref
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Callable, Iterable
 
 import mujoco
 import numpy as np
 
+from .camera import FollowView
 from .errors import SimulationError
 from .gif import GifEncoder
 
@@ -39,6 +43,17 @@ _log = logging.getLogger(__name__)
 RECORDER_NICE = 5
 #: Default bound of snapshots waiting to be rendered; more are dropped (counted, logged).
 DEFAULT_MAX_PENDING = 512
+#: Recorders whose thread may still run: ended at interpreter exit, so that no recorder thread
+#: is inside MuJoCo or the GL driver while the interpreter and its libraries shut down.
+_LIVE_RECORDERS: "weakref.WeakSet[FrameRecorder]" = weakref.WeakSet()
+
+
+@atexit.register
+def _close_live_recorders() -> None:
+    for recorder in list(_LIVE_RECORDERS):
+        recorder.abort()
+    for recorder in list(_LIVE_RECORDERS):
+        recorder.close(timeout=5.0)
 
 
 @dataclass(frozen=True)
@@ -53,11 +68,12 @@ class StateSnapshot:
     qpos: np.ndarray
     mocap_pos: np.ndarray
     mocap_quat: np.ndarray
+    caption: str = ""  #: what the frame's caption says besides the time (e.g. the plan's phase)
 
     @classmethod
-    def of(cls, data: mujoco.MjData) -> "StateSnapshot":
+    def of(cls, data: mujoco.MjData, caption: str = "") -> "StateSnapshot":
         """Copy the state of `data` (call from the thread that owns `data`; a few microseconds)."""
-        return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+        return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy(), caption)
 
     def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """Set `data` to this state and compute what rendering reads (body, geom, camera and
@@ -74,16 +90,18 @@ class RecordedFrames(list):
     """RGB frames (height x width x 3, uint8), oldest first, as recorded by a `FrameRecorder`.
 
     A plain list of arrays to its users; it also carries the recording's `fps` [frames per s of
-    simulated time], how many frames were `dropped`, and their GIF encoding (`gif`), which
-    `pycram.sim.render.write_animation` uses to write a GIF at once.
+    simulated time], how many frames were `dropped`, their GIF encoding (`gif`), which
+    `pycram.sim.render.write_animation` uses to write a GIF at once, and each frame's simulated
+    time [s] and caption text (`captions`, "" without a caption function).
     """
 
     def __init__(self, frames: Iterable[np.ndarray] = (), fps: float = 1.0, dropped: int = 0,
-                 gif: GifEncoder | None = None) -> None:
+                 gif: GifEncoder | None = None, captions: Iterable[tuple[float, str]] = ()) -> None:
         super().__init__(frames)
         self.fps = fps
         self.dropped = dropped
         self.gif = gif
+        self.captions = list(captions)
 
     def encoded_gif(self) -> GifEncoder | None:
         """The GIF encoding of exactly these frames, or None (e.g. after the list was changed)."""
@@ -94,6 +112,11 @@ class RecordedFrames(list):
 class FrameRecorder:
     """Renders frames of `camera` at `fps` [frames per s of simulated time] in its own thread.
 
+    `camera` is a camera name of the model or a `FollowView` (a free camera that follows some
+    bodies, smoothed from frame to frame). With `caption`, a function called in the simulation
+    thread at each frame time (it must be quick and must not block: e.g. read a fluent), every
+    frame carries a caption line: its text and the simulated time.
+
     The owner of the simulation calls `due(t)` and `capture(data)` from its thread; neither ever
     blocks for rendering. At most `max_pending` snapshots wait for rendering: a snapshot offered
     while that many wait is dropped (counted in `dropped`). `finish` renders the rest and ends
@@ -102,8 +125,9 @@ class FrameRecorder:
     must not block (`abort` never blocks).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str, fps: float, width: int, height: int,
-                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder") -> None:
+    def __init__(self, model: mujoco.MjModel, camera: str | FollowView, fps: float, width: int, height: int,
+                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder",
+                 caption: Callable[[], str] | None = None) -> None:
         if fps <= 0:
             raise ValueError(f"fps must be positive, got {fps}")
         if width <= 0 or height <= 0:
@@ -112,20 +136,25 @@ class FrameRecorder:
             raise ValueError(f"max_pending must be at least 1, got {max_pending}")
         self.camera, self.fps, self.size = camera, float(fps), (int(width), int(height))
         self.max_pending = max_pending
+        self.caption = caption
+        self._caption_failed = False
         self._model = model
         self._period = 1.0 / self.fps
         self._next: float | None = None  # simulated time of the next frame [s]; None: not started
+        self._last: float | None = None  # simulated time of the last frame captured [s]
         self._pending: collections.deque[StateSnapshot] = collections.deque()
         self._cond = threading.Condition()
         self._finishing = False  # render what is pending, then end
         self._aborted = False  # end now
         self._frames: list[np.ndarray] = []
+        self._captions: list[tuple[float, str]] = []
         self._gif = GifEncoder()
         self.dropped = 0  #: snapshots dropped because `max_pending` were waiting, or not rendered
         self.error: BaseException | None = None  #: why the recorder thread failed, if it did
         self.render_time = 0.0  #: wall time the thread spent on rendering and encoding [s]
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
+        _LIVE_RECORDERS.add(self)
 
     # ------------------------------------------------------------------ simulation side
     def start_at(self, sim_time: float) -> None:
@@ -146,7 +175,8 @@ class FrameRecorder:
         self._next += self._period
         if self._next <= data.time:  # far behind (e.g. stepped in big chunks): no burst of frames
             self._next = float(data.time) + self._period
-        snapshot = StateSnapshot.of(data)
+        self._last = float(data.time)
+        snapshot = StateSnapshot.of(data, self._caption_text())
         with self._cond:
             if self._finishing or self._aborted:
                 return False
@@ -156,6 +186,23 @@ class FrameRecorder:
             self._pending.append(snapshot)
             self._cond.notify_all()
         return True
+
+    def capture_last(self, data: mujoco.MjData) -> bool:
+        """Capture the state of `data` as the recording's last frame, unless the last frame
+        captured already shows this simulated time (simulation thread; as `capture`)."""
+        if self._next is None or self._last == float(data.time):
+            return False
+        return self.capture(data)
+
+    def _caption_text(self) -> str:
+        if self.caption is None or self._caption_failed:
+            return ""
+        try:
+            return str(self.caption())
+        except Exception:  # noqa: BLE001 - a broken caption must not stop the simulation
+            self._caption_failed = True
+            _log.exception("recording: the caption function failed; frames get no caption text from now on")
+            return ""
 
     # ------------------------------------------------------------------ ending
     @property
@@ -188,9 +235,10 @@ class FrameRecorder:
         if self.error is not None:
             raise SimulationError(f"recording failed: {type(self.error).__name__}: {self.error}") from self.error
         level = logging.WARNING if self.dropped else logging.INFO
-        _log.log(level, "recorded %d frames of %r at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
-                 len(self._frames), self.camera, self.fps, *self.size, self.dropped, self.render_time)
-        return RecordedFrames(self._frames, self.fps, self.dropped, self._gif)
+        _log.log(level, "recorded %d frames of %s at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
+                 len(self._frames), self.camera if isinstance(self.camera, FollowView) else repr(self.camera),
+                 self.fps, *self.size, self.dropped, self.render_time)
+        return RecordedFrames(self._frames, self.fps, self.dropped, self._gif, self._captions)
 
     def close(self, timeout: float = 10.0) -> None:
         """`abort` and wait up to `timeout` [s of wall time] for the thread to end; idempotent."""
@@ -223,12 +271,20 @@ class FrameRecorder:
             model.vis.global_.offwidth, model.vis.global_.offheight = self.size
             data = mujoco.MjData(model)
             renderer = mujoco.Renderer(model, height=self.size[1], width=self.size[0])
+            view = None  # the free camera of the previous frame (FollowView)
             while (snapshot := self._take()) is not None:
                 t0 = time.perf_counter()
                 snapshot.apply(model, data)
-                renderer.update_scene(data, camera=self.camera)
+                if isinstance(self.camera, FollowView):
+                    view = self.camera.view(model, data, view)
+                    renderer.update_scene(data, camera=view)
+                else:
+                    renderer.update_scene(data, camera=self.camera)
                 rgb = renderer.render()
+                if self.caption is not None:
+                    rgb = draw_caption(rgb, snapshot.caption, snapshot.time)
                 self._frames.append(rgb)
+                self._captions.append((snapshot.time, snapshot.caption))
                 self._gif.add(rgb)
                 self.render_time += time.perf_counter() - t0
         except BaseException as exc:  # noqa: BLE001 - reported by finish()
@@ -243,6 +299,32 @@ class FrameRecorder:
                 renderer.close()
 
 
+def draw_caption(rgb: np.ndarray, text: str, sim_time: float) -> np.ndarray:
+    """`rgb` with a caption band along its bottom edge: `text` on the left, the simulated time
+    `sim_time` [s] on the right (white on a dark band; a new array, `rgb` is not changed)."""
+    from PIL import Image, ImageDraw
+
+    height, width = rgb.shape[:2]
+    font = _caption_font(max(10, height // 24))
+    band = min(height, max(14, height // 14))
+    strip = Image.new("RGB", (width, band), (20, 20, 24))  # only the band is drawn: ~4x cheaper
+    draw = ImageDraw.Draw(strip)
+    clock = f"t = {sim_time:5.1f} s"
+    draw.text((6, band / 2), text, fill=(255, 255, 255), font=font, anchor="lm")
+    draw.text((width - 6 - draw.textlength(clock, font=font), band / 2), clock, fill=(255, 255, 255), font=font,
+              anchor="lm")
+    captioned = rgb.copy()
+    captioned[height - band:] = np.asarray(strip)
+    return captioned
+
+
+@functools.cache
+def _caption_font(size: int):  # noqa: ANN202 - a PIL font
+    from PIL import ImageFont
+
+    return ImageFont.load_default(size=size)
+
+
 def _lower_priority() -> None:
     """Lower this thread's scheduling priority by `RECORDER_NICE` (Linux: nice is per thread)."""
     try:
@@ -252,4 +334,4 @@ def _lower_priority() -> None:
         _log.debug("could not lower the recorder's priority", exc_info=True)
 
 
-__all__ = ["FrameRecorder", "RecordedFrames", "StateSnapshot", "RECORDER_NICE", "DEFAULT_MAX_PENDING"]
+__all__ = ["FrameRecorder", "RecordedFrames", "StateSnapshot", "draw_caption", "RECORDER_NICE", "DEFAULT_MAX_PENDING"]

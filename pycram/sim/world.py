@@ -19,6 +19,8 @@ and never races afterwards to catch up.
 
 from __future__ import annotations
 
+import atexit
+import copy
 import logging
 import queue
 import threading
@@ -36,6 +38,7 @@ from pycram.world.objects import object_type
 from pycram.world.scenes import random_scene
 
 from ._runtime import Fluent, ManualClock, current_clock, set_clock
+from .camera import FollowView
 from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
                           JointTrajectory, Reach)
 from .engine import Engine
@@ -45,6 +48,7 @@ from .errors import UnknownNameError, WorldClosedError
 from .handle import CommandHandle
 from .items import ItemSpec
 from .path_drive import PlannedDrive
+from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
 from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames, StateSnapshot
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
@@ -64,6 +68,18 @@ _CLOCK_LOCK = threading.Lock()
 #: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
 #: trying to catch up (it then paces from where it is).
 REALTIME_SLACK = 0.05
+#: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
+#: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
+_LIVE_WORLDS: "weakref.WeakSet[World]" = weakref.WeakSet()
+
+
+@atexit.register
+def _close_live_worlds() -> None:
+    for world in list(_LIVE_WORLDS):
+        try:
+            world.close()
+        except BaseException:  # noqa: BLE001 - exiting anyway; never mask the exit
+            _log.debug("closing a world at exit failed", exc_info=True)
 
 
 class World:
@@ -88,8 +104,12 @@ class World:
                  objects: Sequence[str] | None = None, seed: int = 0,
                  base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
-                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True) -> None:
+                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True,
+                 perception_faults: PerceptionFaults | None = None) -> None:
         env = load_environment(environment)
+        #: Faults of `detect` (none by default); its random generator is seeded from them.
+        self.perception_faults = perception_faults or PerceptionFaults()
+        self._fault_rng = np.random.default_rng(self.perception_faults.seed)
         #: Where the `objects` started (a random scene from `seed`; empty without objects).
         self.placements = random_scene(env, objects, seed) if objects else []
         if self.placements:
@@ -133,11 +153,13 @@ class World:
         self._recorder: FrameRecorder | None = None  # the running recording (simulation thread's)
         self._recorders: list[FrameRecorder] = []  # every recorder started, for close() to end
         self._renderers: Renderers | None = None
+        self._perception_renderers: Renderers | None = None
         self.error: BaseException | None = None
         self._previous_clock = set_clock(self.clock) if activate_clock else None
         self._clock_active = activate_clock
         self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
         self._thread.start()
+        _LIVE_WORLDS.add(self)
 
     # ------------------------------------------------------------------ lifecycle
     def __enter__(self) -> "World":
@@ -157,19 +179,40 @@ class World:
         Commands still running end with reason "closed"; a recording still running is ended
         without writing anything (its recorder thread is joined too); the clock that was active
         before this world is re-activated if this world's clock is still the active one.
+
+        Guarantee: on return no thread of this world (simulation, recorders) runs any more
+        (unless one hangs in a driver for longer than `timeout`: logged). A `KeyboardInterrupt`
+        arriving while it closes does not cut the closing short: it is re-raised afterwards.
         """
+        interrupted: BaseException | None = None
+        for step in (self._stop_simulation, self._close_recorders, self._deactivate_clock):
+            while True:  # each step is idempotent: an interrupted one is simply run again
+                try:
+                    step(timeout)
+                    break
+                except KeyboardInterrupt as exc:
+                    interrupted = exc
+        _LIVE_WORLDS.discard(self)
+        if interrupted is not None:
+            raise interrupted
+
+    def _stop_simulation(self, timeout: float) -> None:
         self._stop.set()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
                 _log.error("simulation thread did not stop within %.1f s", timeout)
+
+    def _close_recorders(self, timeout: float) -> None:
+        """End every recorder thread this world started; a recorder is forgotten only once its
+        thread has ended (so an interrupted call leaves the rest for the next one)."""
         with self._lock:
-            recorders, self._recorders = self._recorders, []
+            recorders = list(self._recorders)
         for recorder in recorders:
             recorder.close(timeout)
-        self._deactivate_clock()
+            self._forget_recorder(recorder, abort=False)
 
-    def _deactivate_clock(self) -> None:
+    def _deactivate_clock(self, timeout: float = 0.0) -> None:
         """Hand the active clock back (once). Worlds may be closed in any order: the clock of a
         world closed earlier is never re-activated; a later world's active clock stays active."""
         with _CLOCK_LOCK:
@@ -240,8 +283,9 @@ class World:
                 break
             if kind == "start":
                 b._finish(Outcome(False, reason, "world closed"))
-        if self._renderers is not None:
-            self._renderers.close()
+        for renderers in (self._renderers, self._perception_renderers):
+            if renderers is not None:
+                renderers.close()
         if self._recorder is not None:
             self._recorder.abort()  # never blocks; close() joins the thread
         # wake anybody waiting on simulated time one last time
@@ -428,20 +472,48 @@ class World:
             self._renderers = Renderers(self.scene.model)
         return self._renderers
 
-    def request_image(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
-        """Render an RGB image (height x width x 3, uint8) from `camera`; also set `camera_image`."""
-        self.scene.camera(camera)
+    def _get_perception_renderers(self) -> Renderers:
+        """Renderers of object perception, on a copy of the model without multisampling (~2x
+        cheaper with a software renderer; the geometry is the model's, the state `eng.data`)."""
+        if self._perception_renderers is None:
+            model = copy.copy(self.scene.model)  # mj_copyModel: nothing shared afterwards
+            model.vis.quality.offsamples = 0
+            self._perception_renderers = Renderers(model)
+        return self._perception_renderers
+
+    def request_image(self, camera: str | FollowView = HEAD_CAMERA, width: int = 320, height: int = 240,
+                      hide_objects: bool = False) -> CommandHandle:
+        """Render an RGB image (height x width x 3, uint8) from `camera` (a camera name or a
+        `FollowView`); also set `camera_image`.
+
+        `hide_objects` leaves the items out of the picture (e.g. a plan to draw a belief on).
+        """
+        self._check_camera(camera)
 
         def fn(eng: Engine) -> np.ndarray:
-            img = self._get_renderers().rgb(eng.data, camera, width, height)
+            geoms = [g for gs in eng.item_part_geoms.values() for g in gs] if hide_objects else []
+            saved = eng.model.geom_rgba[geoms, 3].copy()
+            eng.model.geom_rgba[geoms, 3] = 0.0  # fully transparent geoms are not drawn
+            try:
+                img = self._get_renderers().rgb(eng.data, camera, width, height)
+            finally:
+                eng.model.geom_rgba[geoms, 3] = saved
             self.camera_image.set_value(img)
             return img
 
         return self._call(f"image:{camera}", fn)
 
-    def snapshot(self, path: str | Path, camera: str = "overview", width: int = 640, height: int = 480,
-                 timeout: float = 30.0) -> Path:
-        """Render `camera` and write a PNG to `path` (blocks up to `timeout` [s of wall time])."""
+    def _check_camera(self, camera: str | FollowView) -> None:
+        """Raise for a camera name the scene does not have, or a `FollowView` of unknown bodies."""
+        if isinstance(camera, FollowView):
+            camera.check(self.scene.model)
+        else:
+            self.scene.camera(camera)
+
+    def snapshot(self, path: str | Path, camera: str | FollowView = "overview", width: int = 640,
+                 height: int = 480, timeout: float = 30.0) -> Path:
+        """Render `camera` (a camera name or a `FollowView`) and write a PNG to `path` (blocks up
+        to `timeout` [s of wall time])."""
         handle = self.request_image(camera, width, height)
         _wait_wall(handle, timeout)
         out = handle.outcome
@@ -465,6 +537,38 @@ class World:
 
         return self._call("perceive", fn)
 
+    def detect(self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS,
+               max_range: float = MAX_RANGE) -> CommandHandle:
+        """One look of the head camera's object perception: value a
+        `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
+        colour images of `width` x `height` [px], most visible first; the camera view with its
+        depth image; the joint positions of the containers whose handle is in the image),
+        stamped with the simulated time.
+
+        Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
+        not reported; `perception_faults` apply. No simulator names or poses are reported.
+        """
+        return self._call("detect", lambda eng: self._detect(eng, width, height, min_pixels, max_range))
+
+    def _detect(self, eng: Engine, width: int, height: int, min_pixels: int, max_range: float) -> Any:
+        """`detect`'s work, in the simulation thread: render, measure, report."""
+        from pycram.world.belief import PerceptionReport
+
+        renderers = self._get_perception_renderers()
+        ids, depth = renderers.segmentation_and_depth(eng.data, HEAD_CAMERA, width, height)
+        rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
+        cam = eng.camera
+        view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]),
+                       depth, max_range)
+        objects = {it.name: (it.type, eng.item_part_geoms[it.name]) for it in self.scene.items}
+        states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
+        detections = measure_detections(ids, depth, rgb, view, objects, self.environment, states,
+                                        self.perception_faults, self._fault_rng, min_pixels)
+        # the joint positions of the containers whose handle is in the image
+        in_view = {name: q for name, q in states.items()
+                   if view.in_image(self.environment.container(name).handle_position(q))}
+        return PerceptionReport(eng.time, tuple(detections), view, in_view)
+
     def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
                              height: int = 240) -> CommandHandle:
         """Render geom ids per pixel (height x width, -1: background) from `camera`."""
@@ -472,8 +576,9 @@ class World:
         return self._call(f"segmentation:{camera}",
                           lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height))
 
-    def start_recording(self, camera: str = "overview", fps: float = 10.0, width: int = 320,
-                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING) -> CommandHandle:
+    def start_recording(self, camera: str | FollowView = "overview", fps: float = 10.0, width: int = 320,
+                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING,
+                        caption: Callable[[], str] | None = None) -> CommandHandle:
         """Start recording frames of `camera` (width x height [px]) every 1/`fps` s of simulated
         time, from the simulated time at which the command runs; a recording already running is
         discarded.
@@ -483,10 +588,15 @@ class World:
         simulation never waits for rendering. If `max_pending` frames wait to be rendered, a new
         one is dropped (counted and logged when the recording stops). Frames are not limited by
         the world's `offscreen_size`, and are rendered without multisampling.
+
+        `camera` is a camera name or a `FollowView` (a free camera that keeps bodies in view).
+        With `caption` (called in the simulation thread at each frame time; it must be quick and
+        never block, e.g. read a fluent), each frame carries a caption: its text and the
+        simulated time.
         """
-        self.scene.camera(camera)
+        self._check_camera(camera)
         recorder = FrameRecorder(self.scene.model, camera, fps, width, height, max_pending,
-                                 name=f"pycram-recorder-{self.robot}")
+                                 name=f"pycram-recorder-{self.robot}", caption=caption)
         with self._lock:
             self._recorders.append(recorder)
 
@@ -504,14 +614,19 @@ class World:
             raise
 
     def _forget_recorder(self, recorder: FrameRecorder, abort: bool) -> None:
+        """Stop tracking `recorder` for `close()`; with `abort`, end its thread first. A recorder
+        whose thread still runs is never forgotten (`close()` must end it)."""
+        if abort:
+            recorder.close()
+        if recorder.running:
+            return
         with self._lock:
             if recorder in self._recorders:
                 self._recorders.remove(recorder)
-        if abort:
-            recorder.close()
 
     def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
         """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
+        The last frame shows the state at the simulated time the recording stopped.
 
         Waits for the recorder thread to render the frames still pending and ends it. Blocks up
         to `timeout` [s of wall time]; frames not rendered by then are dropped (logged). Returns
@@ -524,6 +639,8 @@ class World:
 
         def fn(eng: Engine) -> FrameRecorder | None:
             recorder, self._recorder = self._recorder, None
+            if recorder is not None:
+                recorder.capture_last(eng.data)  # the animation ends with the state it stopped in
             return recorder
 
         handle = self._call("stop_recording", fn)
@@ -537,7 +654,7 @@ class World:
         else:
             try:
                 frames = recorder.finish(max(0.0, deadline - time.monotonic()))
-            finally:
+            finally:  # if `finish` was interrupted (Ctrl-C), its thread runs on until close()
                 self._forget_recorder(recorder, abort=False)
         if path is not None:
             write_animation(path, frames, frames.fps)

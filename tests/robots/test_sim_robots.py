@@ -181,7 +181,9 @@ def test_non_waited_head_pointing_tracks_while_driving_and_detecting_sees_the_mu
     x, y = START[0], START[1] - 0.4
     motion(type="moving", pose=(x, y, math.atan2(mug[1] - y, mug[0] - x)))
     seen = motion(type="detecting", object="mug")
-    assert [item.name for item in seen] == ["mug"]
+    assert [item.type for item in seen] == ["mug"]
+    assert seen[0].name.startswith("mug-")  # a belief's name, not the simulator's
+    assert math.dist(seen[0].pose[:2], mug[:2]) < 0.04
     assert [item.type for item in motion(type="detecting")].count("mug") == 1
     assert motion(type="detecting", object="teapot") == []
 

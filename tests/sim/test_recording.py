@@ -207,3 +207,112 @@ def test_write_animation_of_plain_and_recorded_frames(tmp_path):
     changed.pop()
     assert changed.encoded_gif() is None
     assert iio.imread(write_animation(tmp_path / "changed.gif", changed, 10), index=None).shape[0] == 5
+
+
+# -- interrupted recordings (issue 12: Ctrl-C shortly after the plan ended crashed with SIGSEGV) --
+
+_INTERRUPT_PROBE = r'''
+import sys, threading
+from pycram.sim import World
+
+class InterruptAt:
+    """A trace function raising KeyboardInterrupt at the k-th new line run in pycram/sim/ (this
+    thread). A line already run in the same frame is skipped: that is a loop, or the end of a
+    `with` block, where an exception from a trace function lands after the lock was taken and
+    before the block's exit runs (which Python's own `with lock:` cannot survive either)."""
+    def __init__(self, k):
+        self.k, self.lines, self.hit = k, 0, False
+    def __call__(self, frame, event, arg):
+        if "/pycram/sim/" not in frame.f_code.co_filename:
+            return None
+        seen = set()
+        def line(frame, event, arg):
+            if event == "line" and not self.hit and frame.f_lineno not in seen:
+                seen.add(frame.f_lineno)
+                self.lines += 1
+                if self.lines == self.k:
+                    self.hit = True
+                    raise KeyboardInterrupt(f"line {frame.f_lineno} of {frame.f_code.co_name}")
+            return line
+        return line
+
+first, stride = int(sys.argv[1]), int(sys.argv[2])
+k, points = first, 0
+while True:
+    world = World("pr2", [], offscreen_size=(64, 48))
+    world.start_recording(fps=50, width=64, height=48, caption=lambda: "probe").wait(5.0)
+    assert (world.sim_time > 0.4).wait_for(30.0), "the simulation does not advance"
+    probe = InterruptAt(k)
+    sys.settrace(probe)
+    try:
+        world.stop_recording()
+    except KeyboardInterrupt as e:
+        print("interrupted at", e)
+    finally:
+        sys.settrace(None)
+    world.close()
+    left = [t.name for t in threading.enumerate() if t.name.startswith("pycram-")]
+    assert not left, f"threads left after close() (interrupted at point {k}): {left}"
+    if not probe.hit:
+        break
+    points += 1
+    k += stride
+print(f"interrupted at {points} points of {probe.lines}")
+'''
+
+
+def test_an_interrupted_stop_recording_leaves_no_thread_after_close(tmp_path):
+    """`stop_recording` is interrupted (KeyboardInterrupt raised by a trace hook) at every third
+    line it runs in pycram/sim/ — in the world, the handle, the recorder's `finish` — each time in
+    a fresh world; `close()` must then leave no thread of ours, and the process must exit normally
+    (before the fix the recorder thread outlived `close()`, and a daemon thread still inside MuJoCo
+    at interpreter shutdown crashed the process with SIGSEGV)."""
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "probe.py"
+    script.write_text(_INTERRUPT_PROBE)
+    env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
+    done = subprocess.run([sys.executable, str(script), "1", "3"], capture_output=True, text=True, timeout=240,
+                          env=env)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-4000:]
+    points = done.stdout.count("interrupted at ")
+    assert points >= 10, done.stdout
+    assert "of finish" in done.stdout and "of stop_recording" in done.stdout
+
+
+def test_captions_are_taken_when_the_frame_is_due_and_drawn_on_it(world, tmp_path):
+    """The caption function runs in the simulation thread at each frame time; each frame keeps
+    its text and simulated time, and carries a dark caption band with light text."""
+    from pycram.sim import FollowView
+
+    callers: set[int] = set()
+    count = iter(range(10_000))
+
+    def caption() -> str:
+        callers.add(threading.get_ident())
+        return f"frame {next(count)}"
+
+    view = FollowView((world.description.ROOT_LINK,), min_distance=2.5)
+    ok(world.start_recording(view, fps=20, width=160, height=120, caption=caption))
+    base = world.base_pose.get_value()
+    ok(world.drive_to(base.x + 0.2, base.y, base.yaw))
+    frames = world.stop_recording()
+
+    assert callers == {world._thread.ident}
+    assert len(frames.captions) == len(frames) >= 5
+    assert [text for _, text in frames.captions] == [f"frame {i}" for i in range(len(frames))]
+    times = [t for t, _ in frames.captions]
+    assert all(0 < b - a < 0.1 for a, b in zip(times, times[1:]))
+    band = frames[0][-12:]
+    assert band.mean() < 80 and (band.min(axis=2) > 200).any()
+
+
+def test_a_follow_view_of_an_unknown_body_is_refused(world):
+    from pycram.sim import FollowView
+
+    with pytest.raises(ValueError, match="no body 'teapot'"):
+        world.start_recording(FollowView(("teapot",)))
+    with pytest.raises(ValueError, match="no body 'teapot'"):
+        world.request_image(FollowView(("teapot",)))

@@ -44,3 +44,16 @@ def test_scene_command_names_bad_input(tmp_path, args, message):
     assert result.exit_code == 1
     assert message in " ".join(result.output.split())
     assert not (tmp_path / "x.png").exists()
+
+
+def test_scene_command_draws_the_belief_beside_the_ground_truth(tmp_path):
+    import imageio.v3 as iio
+
+    out = tmp_path / "belief.png"
+    result = runner.invoke(app, ["scene", "--env", "apartment", "--seed", "3", "--belief", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    # seed 3: the plate and the milk stand on the table in front of the robot, in view
+    assert "believed: <plate-1: white plate" in result.output and "believed: <milk-1:" in result.output
+    assert "cereal-" not in result.output  # in the closed fridge: never perceived
+    image = iio.imread(out)
+    assert image.shape[1] > 1200 and np.asarray(image).std() > 20

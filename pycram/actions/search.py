@@ -1,0 +1,308 @@
+"""Searching for an object the belief does not hold: a robot-agnostic plan.
+
+`search_for(ObjectDesignator(type="cup"))` finds an object matching the description:
+
+1. if the robot's belief already holds one, that is the answer;
+2. it looks around from where it stands: at each likely place within `look_range` [m], nearest
+   first, it points the head there and detects;
+3. it visits the likely places it has not looked at closely, nearest first: it drives to a
+   standing pose in front of each, points the head at it and detects;
+4. it fails with `pycram.failures.ObjectNotFound`, which names every place it looked at and
+   the places it could not look into (closed containers, places it could not reach).
+
+Likely places come from the environment's description (`Lookout`s): the surfaces of the kinds
+objects of the type are found on (`ObjectType.found_on`; every surface for an unknown or
+unspecified type), open surfaces seen from their free edge nearest to the robot, surfaces inside
+containers seen from in front of the container. A container measured closed is opened with
+`open_container(name)` when given (a plan, e.g. an opening action); without one it is skipped
+and reported: this package has no opening action yet, so objects in closed containers are found
+only when the scene leaves them open.
+
+The plan uses motion designators only (`subscribing_pose`, `moving`, `pointing_head`,
+`detecting`) and the active robot's belief (`robot.belief`, a
+`pycram.world.belief.BeliefState`): it runs unchanged on every robot that offers them.
+A failed motion (a pose it cannot drive to, a point its head cannot turn to) skips that place;
+evaporation is never caught.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from pycram.designators.core import DesignatorError
+from pycram.designators.motion import MotionDesignator
+from pycram.designators.object import ObjectDesignator
+from pycram.designators.perform import perform
+from pycram.failures import ObjectNotFound, PlanFailure
+from pycram.fluent import Fluent
+from pycram.process_module import ProcessModuleError
+from pycram.runtime import as_task
+from pycram.world.belief import BeliefState, PerceivedObject
+from pycram.world.environment import Environment, Surface
+from pycram.world.objects import OBJECT_TYPES
+
+__all__ = ["Lookout", "lookouts", "look_around", "search_for", "LOOK_RANGE", "STANDOFF", "STAND_CLEARANCE"]
+
+logger = logging.getLogger(__name__)
+
+#: Places farther than this [m] are not looked at from where the robot stands.
+LOOK_RANGE = 3.0
+#: How far [m] in front of a surface's edge (or a container's opened front) the robot stands.
+STANDOFF = 0.9
+#: A place looked at from closer than this [m] is not visited again.
+CLOSE_LOOK = 1.6
+#: Longest stretch [m] of an edge one look covers; longer edges get several lookouts.
+LOOK_WIDTH = 1.3
+
+_FAILURES = (PlanFailure, ProcessModuleError, DesignatorError)
+
+
+@dataclass(frozen=True)
+class Lookout:
+    """A place to look at: `name` (the surface's, with a part number on long surfaces),
+    `surface`, the `target` [m, map] to point the head at, where to `stand` (x [m], y [m],
+    yaw [rad]) and the `container` the surface is inside (None for open surfaces)."""
+
+    name: str
+    surface: str
+    target: tuple[float, float, float]
+    stand: tuple[float, float, float]
+    container: str | None = None
+
+
+#: Clearance [m] of a standing pose from walls and furniture (a robot base's half diagonal).
+STAND_CLEARANCE = 0.5
+
+
+def _free(environment: Environment, x: float, y: float) -> bool:
+    return environment.is_free_floor(x, y, margin=STAND_CLEARANCE)
+
+
+def _stand_along(environment: Environment, point: tuple[float, float], towards: tuple[float, float],
+                 n: tuple[float, float], standoff: float) -> tuple[float, float] | None:
+    """A free standing spot `standoff` [m] out from `point` on an edge (outward normal `n`),
+    moved along the edge towards `towards` (in 0.1 m steps, at most to it) when `point` is not
+    free; None when there is none."""
+    span = math.dist(point, towards)
+    steps = int(span / 0.1) + 1
+    for k in range(steps + 1):
+        f = 0.0 if span == 0.0 else min(1.0, 0.1 * k / span)
+        x = point[0] + f * (towards[0] - point[0]) + standoff * n[0]
+        y = point[1] + f * (towards[1] - point[1]) + standoff * n[1]
+        if _free(environment, x, y):
+            return (x, y)
+    return None
+
+
+def _surface_lookouts(environment: Environment, surface: Surface, near: tuple[float, float],
+                      standoff: float) -> list[Lookout]:
+    """Lookouts along the free edge of an open surface nearest to `near`."""
+    options = []
+    for a, b, n in surface.edges():
+        mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+        if _stand_along(environment, mid, mid, n, standoff) is None:
+            continue
+        options.append((math.dist(near, mid), a, b, n))
+    if not options:
+        return []
+    _, a, b, n = min(options)
+    length = math.dist(a, b)
+    pieces = max(1, math.ceil(length / LOOK_WIDTH))
+    x0, y0, x1, y1 = surface.bounds
+    inward = min(0.25, (x1 - x0 + y1 - y0) / 8)
+    out = []
+    mid = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+    for k in range(pieces):
+        f = (k + 0.5) / pieces
+        px, py = a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])
+        stand = _stand_along(environment, (px, py), mid, n, standoff)
+        if stand is None:
+            continue
+        name = surface.name if pieces == 1 else f"{surface.name} ({k + 1}/{pieces})"
+        out.append(Lookout(name, surface.name, (px - inward * n[0], py - inward * n[1], surface.height + 0.05),
+                           (*stand, math.atan2(-n[1], -n[0]))))
+    return out
+
+
+def lookouts(environment: Environment, type_name: str | None = None, near: tuple[float, float] = (0.0, 0.0),
+             standoff: float = STANDOFF) -> list[Lookout]:
+    """The places of `environment` where an object of `type_name` is likely (all surfaces when
+    the type is None or unknown), with where to stand for each, nearest to `near` [m] first."""
+    kinds = OBJECT_TYPES[type_name].found_on if type_name in OBJECT_TYPES else None
+    out: list[Lookout] = []
+    for surface in environment.all_surfaces():
+        if kinds is not None and surface.kind not in kinds:
+            continue
+        container = environment.container_of(surface.name)
+        if container is None:
+            out += _surface_lookouts(environment, surface, near, standoff)
+            continue
+        dx, dy = container.opening_direction
+        reach = container.limits[1] if container.kind == "drawer" else 0.0
+        hx, hy, _ = container.handle
+        stand = (hx + dx * (reach + standoff), hy + dy * (reach + standoff), math.atan2(-dy, -dx))
+        if _free(environment, stand[0], stand[1]):
+            cx, cy, h = surface.centroid
+            out.append(Lookout(surface.name, surface.name, (cx, cy, h + 0.05), stand, container.name))
+    return sorted(out, key=lambda lk: math.dist(near, lk.stand[:2]))
+
+
+def _robot_belief() -> BeliefState:
+    from pycram.robot import current_robot
+    robot = current_robot()
+    belief = getattr(robot, "belief", None)
+    if not isinstance(belief, BeliefState):
+        raise ValueError(f"search_for needs a belief state: the active robot {robot!r} has none "
+                         f"(pass belief=...)")
+    return belief
+
+
+def _believed(description: ObjectDesignator, belief: BeliefState) -> PerceivedObject | None:
+    return next((o for o in belief.present() if description.matches(o)), None)
+
+
+def _base_pose() -> Any:
+    pose = Fluent(name="search: base pose")
+    perform(MotionDesignator(type="subscribing_pose", fl=pose))
+    return pose
+
+
+def _target(lookout: Lookout, environment: Environment, belief: BeliefState) -> tuple[float, float, float]:
+    """Where to look at: a drawer's inside moves out with the drawer (measured opening)."""
+    if lookout.container is None:
+        return lookout.target
+    container = environment.container(lookout.container)
+    q = belief.container_states.get(container.name, 0.0) if container.kind == "drawer" else 0.0
+    x, y, z = lookout.target
+    return (x + q * container.opening_direction[0], y + q * container.opening_direction[1], z)
+
+
+def _look(description: ObjectDesignator, target: tuple[float, float, float]) -> PerceivedObject | None:
+    """Point the head at `target` and detect; the best match seen, or None."""
+    perform(MotionDesignator(type="pointing_head", coordinates=target))
+    seen = perform(MotionDesignator(type="detecting", object=description))
+    return seen[0] if seen else None
+
+
+def _look_around(description: ObjectDesignator | None, places: list[Lookout], here: tuple[float, float],
+                 belief: BeliefState, look_range: float, looked: list[str], close: set[str]) -> list[PerceivedObject]:
+    """Look at each place within `look_range` of `here`; stop at the first match of a
+    `description` (None: look at every place and return everything seen)."""
+    environment = belief.environment
+    seen: list[PerceivedObject] = []
+    for lookout in places:
+        target = _target(lookout, environment, belief)
+        distance = math.dist(here, target[:2])
+        if distance > look_range or any(entry.startswith(lookout.name + " ") for entry in looked):
+            continue
+        if lookout.container is not None and belief.container_open(lookout.container) is False:
+            continue
+        try:
+            perform(MotionDesignator(type="pointing_head", coordinates=target))
+            result = perform(MotionDesignator(type="detecting", object=description))
+        except _FAILURES as failure:
+            logger.info("cannot look at %s from here: %s", lookout.name, failure)
+            continue
+        looked.append(f"{lookout.name} (from where it stood)")
+        if distance < CLOSE_LOOK:
+            close.add(lookout.name)
+        seen += [obj for obj in result if obj not in seen]
+        if description is not None and seen:
+            break
+    return seen
+
+
+@as_task(name="look_around")
+def look_around(description: ObjectDesignator | None = None, *, belief: BeliefState | None = None,
+                look_range: float = LOOK_RANGE) -> list[PerceivedObject]:
+    """Look at every likely place within `look_range` [m] from where the robot stands (for the
+    type of `description`, all places without one), detecting at each, without driving; stops
+    at the first object matching `description`. Returns the believed objects seen (matching
+    `description` when given). Runs as a task named "look_around"."""
+    belief = belief if belief is not None else _robot_belief()
+    if belief.environment is None:
+        raise ValueError("look_around needs a belief with an environment description")
+    here = _base_pose().get_value()
+    type_name = None if description is None else description.prop_value("type")
+    places = lookouts(belief.environment, type_name, (here.x, here.y))
+    return _look_around(description, places, (here.x, here.y), belief, look_range, [], set())
+
+
+@as_task(name="search_for")
+def search_for(description: ObjectDesignator, *, belief: BeliefState | None = None,
+               open_container: Callable[[str], Any] | None = None, look_range: float = LOOK_RANGE,
+               standoff: float = STANDOFF) -> PerceivedObject:
+    """Find an object matching `description` (see the module's description); returns the believed
+    object found, to which `description` is then equated (``description.current()``).
+
+    `belief` defaults to the active robot's; `open_container(name)` opens a container (a plan),
+    when available. Raises `ObjectNotFound` naming the places looked at and those skipped, and
+    `ValueError` when there is no belief to search with. Runs as a task named "search_for".
+    """
+    if not isinstance(description, ObjectDesignator):
+        raise TypeError(f"search_for needs an ObjectDesignator, got {description!r}")
+    belief = belief if belief is not None else _robot_belief()
+    environment = belief.environment
+    if environment is None:
+        raise ValueError("search_for needs a belief with an environment description")
+    known = _believed(description, belief)
+    if known is not None:
+        return known
+    here = _base_pose().get_value()
+    places = lookouts(environment, description.prop_value("type"), (here.x, here.y), standoff)
+    looked: list[str] = []
+    skipped: dict[str, str] = {}
+    close: set[str] = set()
+    # 1. look around from where it stands
+    found = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
+    if found:
+        return found[0]
+    # 2. visit the likely places, nearest first
+    for lookout in places:
+        if lookout.name in close:
+            continue
+        found = _visit(description, lookout, environment, belief, open_container, looked, skipped)
+        if found is not None:
+            return found
+    raise ObjectNotFound(description, looked, sorted(skipped.items()))
+
+
+def _visit(description: ObjectDesignator, lookout: Lookout, environment: Environment, belief: BeliefState,
+           open_container: Callable[[str], Any] | None, looked: list[str],
+           skipped: dict[str, str]) -> PerceivedObject | None:
+    container = lookout.container
+    if container is not None and belief.container_open(container) is False and open_container is None:
+        skipped[lookout.name] = f"{container} is closed"
+        return None
+    try:
+        perform(MotionDesignator(type="moving", pose=lookout.stand))
+    except _FAILURES as failure:
+        skipped[lookout.name] = f"could not get there: {failure}"
+        return None
+    for _ in range(2):  # a look that finds the container closed opens it and looks again
+        if container is not None and belief.container_open(container) is False:
+            if open_container is None:
+                skipped[lookout.name] = f"{container} is closed"
+                return None
+            try:
+                open_container(container)
+            except _FAILURES as failure:
+                skipped[lookout.name] = f"could not open {container}: {failure}"
+                return None
+        try:
+            found = _look(description, _target(lookout, environment, belief))
+        except _FAILURES as failure:
+            skipped[lookout.name] = f"could not look at it: {failure}"
+            return None
+        if found is not None:
+            looked.append(lookout.name)
+            return found
+        if container is None or belief.container_open(container) is not False:
+            looked.append(lookout.name)
+            return None
+    looked.append(lookout.name)
+    return None

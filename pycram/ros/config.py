@@ -1,0 +1,180 @@
+"""Per-robot ROS configuration, as data: action and topic names, joint names, frames.
+
+:data:`ROBOT_CONFIGS` holds the defaults: the PR2's real interface names (thesis ch. 4.1,
+``control.py``) and TIAGo's. Point PyCRAM at another robot, or at a PR2 whose controllers are
+named differently, with :meth:`RosRobotConfig.replace` or :func:`config_from_dict` (e.g. from a
+YAML/JSON file) -- nothing else changes. The simulator bridge serves exactly the names of the
+configuration it is started with.
+
+Interfaces (types)
+------------------
+===================  ==========================================  ===============================
+part                 default action / topic                      type
+===================  ==========================================  ===============================
+base                 ``move_base``                               move_base_msgs/MoveBase
+head                 ``head_action``                             control_msgs/PointHead
+torso                ``torso_action``                            control_msgs/SingleJointPosition
+                                                                 or .../FollowJointTrajectory
+arm (joints)         ``arms[a].trajectory_action``               control_msgs/FollowJointTrajectory
+arm (tool pose)      ``arms[a].reach_action``                    pycram_msgs/Reach (PyCRAM's own)
+gripper              ``grippers[g].action``                      control_msgs/GripperCommand
+base pose            ``pose_topic`` (``/amcl_pose``)             geometry_msgs/PoseWithCovarianceStamped
+joints, grippers     ``joint_states_topic``                      sensor_msgs/JointState
+detections           ``detections_topic``                        pycram_msgs/DetectedItems
+simulation time      ``/clock``                                  rosgraph_msgs/Clock
+===================  ==========================================  ===============================
+
+A gripper's opening [m] is the sum of the positions of its ``opening_joints`` in the joint
+states (the PR2 publishes its gap as ``r_gripper_joint``; TIAGo's two fingers each move half).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["ArmInterface", "GripperInterface", "RosRobotConfig", "ROBOT_CONFIGS", "robot_config",
+           "config_from_dict"]
+
+_PR2_ARM_JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "upper_arm_roll_joint",
+                   "elbow_flex_joint", "forearm_roll_joint", "wrist_flex_joint", "wrist_roll_joint")
+
+
+@dataclass(frozen=True)
+class ArmInterface:
+    """One arm: its joint-trajectory action, joint names (in the description's order) and the
+    action that moves its tool to a pose."""
+
+    trajectory_action: str
+    joint_names: tuple[str, ...]
+    reach_action: str
+
+
+@dataclass(frozen=True)
+class GripperInterface:
+    """One gripper: its GripperCommand action and the joints whose positions add up to its
+    opening [m] in the joint states."""
+
+    action: str
+    opening_joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class RosRobotConfig:
+    """How one robot's parts are reached over ROS (names only: no numbers a plan needs)."""
+
+    robot: str
+    arms: dict[str, ArmInterface]
+    grippers: dict[str, GripperInterface]
+    head_action: str
+    head_pointing_frame: str
+    head_pointing_axis: tuple[float, float, float]
+    torso_action: str
+    torso_joint: str
+    #: 'single_joint_position' (control_msgs/SingleJointPosition, the PR2) or 'joint_trajectory'
+    #: (control_msgs/FollowJointTrajectory on ``torso_joint``, TIAGo)
+    torso_interface: str = "single_joint_position"
+    move_base_action: str = "move_base"
+    pose_topic: str = "/amcl_pose"
+    joint_states_topic: str = "/joint_states"
+    detections_topic: str = "/pycram/detections"
+    clock_topic: str = "/clock"
+    map_frame: str = "map"
+    base_frame: str = "base_footprint"
+    #: the environment description (``pycram.environments``) of the robot's map: where the base
+    #: may stand (goals off its free floor are refused before anything moves) and its surfaces
+    environment: str = "thesis-kitchen"
+    #: simulator-only services and topics of the bridge (item states, the environment's hands)
+    sim_namespace: str = "/pycram_sim"
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.torso_interface not in ("single_joint_position", "joint_trajectory"):
+            raise ValueError(f"ROS config of {self.robot!r}: torso_interface must be "
+                             f"'single_joint_position' or 'joint_trajectory', not {self.torso_interface!r}")
+
+    def replace(self, **changes: Any) -> "RosRobotConfig":
+        """A copy with ``changes`` (field names; ``TypeError`` names an unknown one)."""
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    def actions(self) -> dict[str, str]:
+        """``{action name: action type}`` of every action this robot offers."""
+        torso_type = ("control_msgs/SingleJointPosition" if self.torso_interface == "single_joint_position"
+                      else "control_msgs/FollowJointTrajectory")
+        result = {self.move_base_action: "move_base_msgs/MoveBase",
+                  self.head_action: "control_msgs/PointHead",
+                  self.torso_action: torso_type}
+        for arm in self.arms.values():
+            result[arm.trajectory_action] = "control_msgs/FollowJointTrajectory"
+            result[arm.reach_action] = "pycram_msgs/Reach"
+        for gripper in self.grippers.values():
+            result[gripper.action] = "control_msgs/GripperCommand"
+        return result
+
+
+def _pr2() -> RosRobotConfig:
+    def arm(side: str) -> ArmInterface:
+        return ArmInterface(f"/{side}_arm_controller/follow_joint_trajectory",
+                            tuple(f"{side}_{j}" for j in _PR2_ARM_JOINTS), f"/{side}_arm_reach")
+
+    return RosRobotConfig(
+        robot="pr2",
+        arms={"right": arm("r"), "left": arm("l")},
+        grippers={"right": GripperInterface("/r_gripper_controller/gripper_action", ("r_gripper_joint",)),
+                  "left": GripperInterface("/l_gripper_controller/gripper_action", ("l_gripper_joint",))},
+        head_action="/head_traj_controller/point_head_action",
+        head_pointing_frame="high_def_frame",
+        head_pointing_axis=(1.0, 0.0, 0.0),
+        torso_action="/torso_controller/position_joint_action",
+        torso_joint="torso_lift_joint",
+        torso_interface="single_joint_position",
+    )
+
+
+def _tiago() -> RosRobotConfig:
+    return RosRobotConfig(
+        robot="tiago",
+        arms={"right": ArmInterface("/arm_controller/follow_joint_trajectory",
+                                    tuple(f"arm_{i}_joint" for i in range(1, 8)), "/arm_reach")},
+        grippers={"right": GripperInterface("/gripper_controller/gripper_action",
+                                            ("gripper_left_finger_joint", "gripper_right_finger_joint"))},
+        head_action="/head_controller/point_head_action",
+        head_pointing_frame="xtion_rgb_optical_frame",
+        head_pointing_axis=(0.0, 0.0, 1.0),
+        torso_action="/torso_controller/follow_joint_trajectory",
+        torso_joint="torso_lift_joint",
+        torso_interface="joint_trajectory",
+    )
+
+
+#: Default configurations by robot name.
+ROBOT_CONFIGS: dict[str, RosRobotConfig] = {"pr2": _pr2(), "tiago": _tiago()}
+
+
+def robot_config(robot: str) -> RosRobotConfig:
+    """The default configuration of ``robot``; ``ValueError`` lists the known robots."""
+    try:
+        return ROBOT_CONFIGS[robot]
+    except KeyError:
+        raise ValueError(f"no ROS configuration for robot {robot!r}; available: "
+                         f"{', '.join(sorted(ROBOT_CONFIGS))}") from None
+
+
+def config_from_dict(data: dict[str, Any]) -> RosRobotConfig:
+    """A configuration from plain data (as :meth:`RosRobotConfig.to_dict` writes it); keys not
+    given keep the default of ``data['robot']``. ``ValueError`` names an unknown key."""
+    base = robot_config(data["robot"]).to_dict()
+    unknown = sorted(set(data) - set(base))
+    if unknown:
+        raise ValueError(f"unknown ROS configuration keys {unknown}; valid: {sorted(base)}")
+    merged = {**base, **data}
+    merged["arms"] = {k: ArmInterface(v["trajectory_action"], tuple(v["joint_names"]), v["reach_action"])
+                      for k, v in merged["arms"].items()}
+    merged["grippers"] = {k: GripperInterface(v["action"], tuple(v["opening_joints"]))
+                          for k, v in merged["grippers"].items()}
+    merged["head_pointing_axis"] = tuple(merged["head_pointing_axis"])
+    return RosRobotConfig(**merged)

@@ -1,0 +1,147 @@
+"""The simulated head camera's object perception: segmentation, depth and colour images in,
+`pycram.world.belief.Detection`s out, with configurable faults.
+
+The recogniser names an object's type from the object its segmented pixels belong to (as a
+trained detector would); everything else is measured: the pixels are back-projected with the
+depth image into map points, whose extent gives the size and centre, whose mean colour gives the
+colour name, and whose lowest point, with the environment's description, gives the supporting
+surface. Objects inside a closed drawer or behind the fridge door are hidden by the furniture's
+geometry in the rendering; objects hidden behind others likewise.
+
+`PerceptionFaults` (per world, all off by default) add Gaussian noise to the measured centre,
+drop detections with a probability, and name a wrong colour with a probability, drawn from a
+random generator seeded per world so that runs repeat.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from pycram.world.belief import (
+    COLOR_NAMES,
+    CameraView,
+    Detection,
+    color_name,
+    support_of,
+)
+from pycram.world.environment import Environment
+
+__all__ = ["MAX_RANGE", "MIN_PIXELS", "PerceptionFaults", "measure_detections", "view_of"]
+
+#: Objects farther from the camera than this [m] are not detected.
+MAX_RANGE = 3.5
+#: Fewest visible pixels for a detection.
+MIN_PIXELS = 20
+
+
+@dataclass(frozen=True)
+class PerceptionFaults:
+    """Faults of the simulated object perception (all off by default).
+
+    `pose_noise`: standard deviation [m] of Gaussian noise on each coordinate of a measured
+    centre; `miss_probability`: probability that a visible object is not reported;
+    `wrong_color_probability`: probability that another colour name is reported; `seed` seeds
+    the world's fault generator.
+    """
+
+    pose_noise: float = 0.0
+    miss_probability: float = 0.0
+    wrong_color_probability: float = 0.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.pose_noise < 0.0:
+            raise ValueError(f"pose_noise must be >= 0 [m], got {self.pose_noise}")
+        for name in ("miss_probability", "wrong_color_probability"):
+            p = getattr(self, name)
+            if not 0.0 <= p <= 1.0:
+                raise ValueError(f"{name} is a probability in [0, 1], got {p}")
+
+    @property
+    def any(self) -> bool:
+        return bool(self.pose_noise or self.miss_probability or self.wrong_color_probability)
+
+
+def _back_project(view: CameraView, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Map points [m] (n x 3) of the pixels (rows, cols) with the view's depth."""
+    width, height = view.size
+    focal = 0.5 * height / math.tan(math.radians(view.fovy) / 2.0)
+    depth = view.depth[rows, cols]
+    local = np.stack([(cols + 0.5 - width / 2.0) / focal * depth,
+                      -(rows + 0.5 - height / 2.0) / focal * depth, -depth], axis=1)
+    return local @ np.asarray(view.rotation, float).reshape(3, 3).T + np.asarray(view.position, float)
+
+
+def _measure(view: CameraView, type_name: str, points: np.ndarray, colours: np.ndarray,
+             environment: Environment, container_states: dict[str, float]) -> Detection:
+    """A detection from an object's visible pixels: their map `points` [m] and `colours`."""
+    # horizontal axes of the view: across it and along it (away from the camera)
+    rotation = np.asarray(view.rotation, float).reshape(3, 3)
+    across = rotation[:2, 0] / max(np.linalg.norm(rotation[:2, 0]), 1e-9)
+    along = -rotation[:2, 2] / max(np.linalg.norm(rotation[:2, 2]), 1e-9)  # the view's heading
+    a, b = points[:, :2] @ across, points[:, :2] @ along
+    width = float(a.max() - a.min())
+    centre_a = float(a.max() + a.min()) / 2.0
+    top, lowest = float(points[:, 2].max()), float(points[:, 2].min())
+    if view.position[2] > top + 0.05:  # seen from above: the top shows the object's full depth
+        centre_b = float(b.max() + b.min()) / 2.0
+        depth = float(b.max() - b.min())
+    else:  # only the near side is seen: assume the object is as deep as it is wide
+        centre_b = float(b.min()) + width / 2.0
+        depth = width
+    x, y = (centre_a * across + centre_b * along).tolist()
+    surface = support_of(environment, x, y, lowest, container_states)
+    bottom = surface.height if surface is not None else max(0.0, lowest)
+    container = None if surface is None else environment.container_of(surface.name)
+    mean = colours.mean(axis=0) / 255.0
+    return Detection(type_name, (x, y, (top + bottom) / 2.0), (width, depth, top - bottom),
+                     color_name(mean), tuple(float(c) for c in mean),
+                     None if surface is None else surface.name, None if container is None else container.name,
+                     int(len(points)))
+
+
+def measure_detections(ids: np.ndarray, depth: np.ndarray, rgb: np.ndarray, view: CameraView,
+                       objects: dict[str, tuple[str, list[int]]], environment: Environment,
+                       container_states: dict[str, float], faults: PerceptionFaults,
+                       rng: np.random.Generator, min_pixels: int = MIN_PIXELS) -> list[Detection]:
+    """The detections in one look: `ids` geom ids per pixel (-1: none), `depth` [m] and `rgb`
+    images of the same camera; `objects` maps each object to (type, its geoms). Most visible
+    first."""
+    types = [type_name for type_name, _ in objects.values()]
+    last = int(max((max(g) for _, g in objects.values() if g), default=0))
+    lookup = np.full(last + 2, -1, np.int64)  # geom id -> object index; the extra last entry: none
+    for index, (_, geoms) in enumerate(objects.values()):
+        lookup[geoms] = index
+    labels = lookup[np.where((ids >= 0) & (ids <= last), ids, last + 1)]
+    counts = np.bincount(labels[labels >= 0], minlength=len(types))
+    detections = []
+    for index in np.nonzero(counts >= min_pixels)[0]:
+        rows, cols = np.nonzero(labels == index)
+        points = _back_project(view, rows, cols)
+        if float(np.median(np.linalg.norm(points - np.asarray(view.position), axis=1))) > view.max_range:
+            continue
+        if faults.miss_probability and rng.random() < faults.miss_probability:
+            continue
+        detection = _measure(view, types[index], points, rgb[rows, cols], environment, container_states)
+        if faults.pose_noise:
+            noisy = tuple(float(v) for v in np.asarray(detection.position) + rng.normal(0.0, faults.pose_noise, 3))
+            detection = _replace(detection, position=noisy)
+        if faults.wrong_color_probability and rng.random() < faults.wrong_color_probability:
+            others = [c for c in COLOR_NAMES if c != detection.color]
+            detection = _replace(detection, color=others[int(rng.integers(len(others)))])
+        detections.append(detection)
+    return sorted(detections, key=lambda d: -d.pixels)
+
+
+def _replace(detection: Detection, **changes: object) -> Detection:
+    return replace(detection, **changes)
+
+
+def view_of(position: np.ndarray, rotation: np.ndarray, fovy: float, depth: np.ndarray,
+            max_range: float = MAX_RANGE) -> CameraView:
+    """A `CameraView` from a camera's map position, rotation matrix and depth image."""
+    return CameraView(tuple(float(v) for v in position), np.asarray(rotation, float).reshape(3, 3).copy(),
+                      float(fovy), depth, max_range)

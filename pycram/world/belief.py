@@ -1,0 +1,358 @@
+"""The robot's belief state: the objects it has perceived, where it last saw them, and when.
+
+Backend-neutral: a perception backend (the simulator's head camera today, a ROS perception
+pipeline tomorrow) fills it with `PerceptionReport`s; object designators resolve against it
+(`BeliefState.resolver`); plans read it, never the simulator.
+
+A `PerceptionReport` holds what one look of the camera measured: a `Detection` per object seen
+(type from the recogniser; centre, size and colour measured from segmentation, depth and colour
+images; the surface and container it rests on/in from the environment's description), the
+`CameraView` it was taken with (pose, field of view and depth image, to decide which believed
+objects *should* have been seen) and the measured joint positions of the containers.
+
+`BeliefState.update(report)`:
+
+- associates each detection with the nearest believed object of the same type within `gate`
+  [m] (objects marked gone included, so an object that comes back is the same object again);
+  the object's pose, size, colour, support and container are refreshed in place, its
+  `last_seen` set to the report's time stamp [s of the active clock, simulated time in a
+  simulation], and its `pose_fluent` set (so it pulses);
+- adds a new `PerceivedObject` for each detection left over, named "<type>-<n>" in order of
+  first sight (belief names: nothing is taken from the simulator);
+- marks *gone* each believed object that was not seen although the view says it should have
+  been (in the image, within range, nothing measured in front of it); gone objects are not
+  resolved by designators until seen again.
+
+Thread-safe: updates and reads may come from any thread.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pycram.designators.object import Belief, BelievedObject
+from pycram.fluent import Fluent
+
+from .environment import Environment, Surface
+
+__all__ = [
+    "COLOR_NAMES",
+    "BeliefState",
+    "BeliefUpdate",
+    "CameraView",
+    "Detection",
+    "PerceivedObject",
+    "PerceptionReport",
+    "color_name",
+    "support_of",
+]
+
+Vec3 = tuple[float, float, float]
+#: How many looks a `BeliefState` remembers.
+MAX_LOOKS = 100
+
+#: Colour names a recogniser reports (see `color_name`).
+COLOR_NAMES = ("red", "orange", "yellow", "green", "blue", "purple", "white", "grey", "black")
+
+
+def color_name(rgb: Iterable[float]) -> str:
+    """The name (one of `COLOR_NAMES`) of an RGB(A) colour with channels in [0, 1].
+
+    Unsaturated colours are white, grey or black by brightness; the others are named by hue.
+    """
+    r, g, b = (float(c) for c in tuple(rgb)[:3])
+    high, low = max(r, g, b), min(r, g, b)
+    saturation = 0.0 if high <= 0.0 else (high - low) / high
+    if saturation < 0.25:
+        return "white" if high > 0.7 else "grey" if high > 0.25 else "black"
+    if high == r:
+        hue = (60.0 * (g - b) / (high - low)) % 360.0
+    elif high == g:
+        hue = 60.0 * (b - r) / (high - low) + 120.0
+    else:
+        hue = 60.0 * (r - g) / (high - low) + 240.0
+    for limit, name in ((18, "red"), (40, "orange"), (70, "yellow"), (165, "green"), (260, "blue"),
+                        (330, "purple"), (360, "red")):
+        if hue < limit:
+            return name
+    return "red"
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One object seen in one look of the camera.
+
+    `type` comes from the recogniser; `position` is the measured centre [m, map frame] and
+    `size` the measured (width across the view, depth along it, height) [m] — when the camera
+    does not see the object's top, its depth is assumed equal to its width; `color` is the name of the measured
+    mean colour (`rgb`, channels in [0, 1]); `support` the surface it rests on and `container`
+    the container that surface is in (None when it rests on none known / an open surface);
+    `pixels` how many pixels of it were visible.
+    """
+
+    type: str
+    position: Vec3
+    size: Vec3
+    color: str
+    rgb: Vec3 = (0.0, 0.0, 0.0)
+    support: str | None = None
+    container: str | None = None
+    pixels: int = 0
+
+
+@dataclass(frozen=True, eq=False)
+class CameraView:
+    """The pinhole camera a look was taken with, and its measured depth image.
+
+    `position` [m, map]; `rotation` the camera's axes in the map frame as the columns of a 3x3
+    matrix (OpenGL convention: x right, y up, the camera looks along -z); `fovy` the vertical
+    field of view [deg]; `depth` the distance along the optical axis per pixel [m] (height x
+    width); objects farther than `max_range` [m] from the camera are not detected.
+    """
+
+    position: Vec3
+    rotation: Any
+    fovy: float
+    depth: Any
+    max_range: float = 4.0
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) [px]."""
+        return int(self.depth.shape[1]), int(self.depth.shape[0])
+
+    def project(self, point: Iterable[float]) -> tuple[float, float, float] | None:
+        """(u, v) pixel coordinates and depth [m] of a map point; None behind the camera."""
+        rotation = np.asarray(self.rotation, float).reshape(3, 3)
+        local = rotation.T @ (np.asarray(tuple(point), float) - np.asarray(self.position, float))
+        depth = -local[2]
+        if depth <= 1e-6:
+            return None
+        width, height = self.size
+        focal = 0.5 * height / math.tan(math.radians(self.fovy) / 2.0)
+        return (width / 2.0 + focal * local[0] / depth, height / 2.0 - focal * local[1] / depth, float(depth))
+
+    def in_image(self, point: Iterable[float], border: float = 0.0) -> bool:
+        """True when the map point [m] projects into the image (`border` [px] inside its edges)
+        and lies within `max_range` of the camera, whatever stands in front of it."""
+        projected = self.project(point)
+        if projected is None:
+            return False
+        u, v, _ = projected
+        width, height = self.size
+        return (border <= u < width - border and border <= v < height - border
+                and math.dist(tuple(point), self.position) <= self.max_range)
+
+    def expects_visible(self, point: Iterable[float], border: float = 4.0, tolerance: float = 0.06) -> bool:
+        """True when an object at `point` [m, map] should be seen: it projects into the image
+        (`border` [px] inside its edges), lies within `max_range`, and the measured depth there
+        is not nearer than the point by more than `tolerance` [m] (nothing stands in front)."""
+        if not self.in_image(point, border):
+            return False
+        u, v, depth = self.project(point)  # type: ignore[misc]
+        measured = float(self.depth[int(v), int(u)])
+        return measured >= depth - tolerance
+
+
+@dataclass(frozen=True)
+class Look:
+    """Where the camera looked from, for a record of the looks: time stamp [s], camera position
+    [m, map], unit viewing direction, vertical field of view [deg] and range [m]."""
+
+    stamp: float
+    position: Vec3
+    direction: Vec3
+    fovy: float
+    max_range: float
+
+
+@dataclass(frozen=True)
+class PerceptionReport:
+    """What one look of the camera measured, at time `stamp` [s of the active clock]."""
+
+    stamp: float
+    detections: tuple[Detection, ...]
+    view: CameraView | None = None
+    #: Measured joint position of each container in view [m or rad], 0 when closed.
+    container_states: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(eq=False)
+class PerceivedObject(BelievedObject):
+    """An object the robot believes in because it perceived it.
+
+    `pose` is its centre (x, y, z) [m, map frame] as last measured; `properties` hold "color",
+    "size", "on" (the surface's name), "in" (the container's name or None), "first_seen",
+    "last_seen" [s] and "pixels". `pose_fluent` holds the pose and pulses on every refresh;
+    `gone` is True while it should have been seen but was not.
+    """
+
+    pose_fluent: Fluent = field(default_factory=lambda: Fluent(None))
+    gone: bool = False
+    times_seen: int = 0
+
+    @property
+    def last_seen(self) -> float:
+        """When it was last seen [s of the active clock]."""
+        return float(self.properties.get("last_seen", -math.inf))
+
+    def moved(self, threshold: float = 0.02) -> Fluent:
+        """A fluent network that becomes True once the believed pose is more than `threshold` [m]
+        away from where it is believed now (None until then): ``cup.moved().wait_for(10)``.
+
+        The caller must hold the returned fluent while waiting (networks are held weakly).
+        """
+        start = self.pose
+
+        def value() -> bool | None:
+            pose = self.pose_fluent.get_value()
+            if pose is None or start is None:
+                return None
+            return True if math.dist(pose, start) > threshold else None
+
+        network = Fluent(value, name=f"{self.name} moved > {threshold} m")
+        self.pose_fluent.add_child(network)
+        return network
+
+    def __repr__(self) -> str:
+        pose = "?" if self.pose is None else "(" + ", ".join(f"{v:.2f}" for v in self.pose) + ")"
+        where = self.properties.get("on")
+        return (f"<{self.name}: {self.properties.get('color')} {self.type} at {pose}"
+                f"{' on ' + where if where else ''}{' (gone)' if self.gone else ''}>")
+
+
+@dataclass(frozen=True)
+class BeliefUpdate:
+    """What one report changed: objects `added`, `refreshed` (seen again) and newly `gone`."""
+
+    added: tuple[PerceivedObject, ...] = ()
+    refreshed: tuple[PerceivedObject, ...] = ()
+    gone: tuple[PerceivedObject, ...] = ()
+
+    @property
+    def seen(self) -> tuple[PerceivedObject, ...]:
+        """Every object seen in the report (refreshed first, then added)."""
+        return self.refreshed + self.added
+
+
+class BeliefState(Belief):
+    """A robot's belief: the `PerceivedObject`s it saw, filled by `update`.
+
+    `environment` (a description) gives perception its surfaces and containers; `gate` [m] is
+    how far an object may have moved between two looks and still be taken for the same one.
+    `container_states` holds the containers' joint positions last measured.
+    """
+
+    def __init__(self, environment: Environment | None = None, gate: float = 0.3) -> None:
+        super().__init__()
+        self.environment = environment
+        self.gate = gate
+        self.container_states: dict[str, float] = {}
+        self._counts: dict[str, int] = {}
+        self._update_lock = threading.Lock()
+        #: The most recent looks (at most `MAX_LOOKS`), oldest first.
+        self.looks: list[Look] = []
+        #: Pulses after every update (a plan may wait for the next look).
+        self.updated = Fluent(None, name="belief updated")
+
+    # --- reading ----------------------------------------------------------------------------
+    def present(self) -> list[PerceivedObject]:
+        """The objects believed present (not gone), best first: most recently seen, then the most
+        visible."""
+        objects = [o for o in self.objects() if isinstance(o, PerceivedObject) and not o.gone]
+        return sorted(objects, key=lambda o: (-o.last_seen, -int(o.properties.get("pixels", 0))))
+
+    def resolver(self, designator: Any) -> list[BelievedObject]:
+        """Object resolver: the objects believed present, best first (the designator filters
+        them). Objects added by hand (plain `BelievedObject`s) follow."""
+        plain = [o for o in self.objects() if not isinstance(o, PerceivedObject)]
+        return [*self.present(), *plain]
+
+    def container_open(self, container: str, threshold: float = 0.05) -> bool | None:
+        """Whether `container` was measured open (joint beyond `threshold` [m or rad]); None
+        when it was never measured."""
+        q = self.container_states.get(container)
+        return None if q is None else abs(q) > threshold
+
+    # --- writing ----------------------------------------------------------------------------
+    def update(self, report: PerceptionReport) -> BeliefUpdate:
+        """Fold `report` into the belief (see the module's description); returns what changed."""
+        with self._update_lock:
+            self.container_states.update(report.container_states)
+            known = [o for o in self.objects() if isinstance(o, PerceivedObject)]
+            pairs = sorted(((math.dist(d.position[:2], o.pose[:2]), i, j)
+                            for i, d in enumerate(report.detections)
+                            for j, o in enumerate(known) if o.type == d.type and o.pose is not None),
+                           key=lambda p: (p[0], known[p[2]].gone))
+            detection_of: dict[int, int] = {}
+            used: set[int] = set()
+            for distance, i, j in pairs:
+                if distance > self.gate or i in detection_of or j in used:
+                    continue
+                detection_of[i] = j
+                used.add(j)
+            refreshed, added = [], []
+            for i, detection in enumerate(report.detections):
+                if i in detection_of:
+                    obj = known[detection_of[i]]
+                    refreshed.append(obj)
+                else:
+                    obj = self._new_object(detection.type, report.stamp)
+                    added.append(obj)
+                self._refresh(obj, detection, report.stamp)
+            gone = []
+            if report.view is not None:
+                view = report.view
+                forward = -np.asarray(view.rotation, float).reshape(3, 3)[:, 2]
+                self.looks = [*self.looks[-(MAX_LOOKS - 1):],
+                              Look(report.stamp, tuple(view.position), tuple(float(v) for v in forward),
+                                   view.fovy, view.max_range)]
+                for j, obj in enumerate(known):
+                    if j not in used and not obj.gone and obj.pose is not None \
+                            and report.view.expects_visible(obj.pose):
+                        obj.gone = True
+                        gone.append(obj)
+        self.updated.set_value(report.stamp)
+        return BeliefUpdate(tuple(added), tuple(refreshed), tuple(gone))
+
+    def _new_object(self, type_name: str, stamp: float) -> PerceivedObject:
+        n = self._counts[type_name] = self._counts.get(type_name, 0) + 1
+        obj = PerceivedObject(f"{type_name}-{n}", type_name, None, {"first_seen": stamp})
+        obj.pose_fluent.name = f"{obj.name} pose"
+        self.add(obj)
+        return obj
+
+    @staticmethod
+    def _refresh(obj: PerceivedObject, detection: Detection, stamp: float) -> None:
+        obj.properties.update(color=detection.color, size=detection.size, on=detection.support,
+                              **{"in": detection.container}, last_seen=stamp, pixels=detection.pixels)
+        obj.gone = False
+        obj.times_seen += 1
+        obj.pose = detection.position
+        obj.pose_fluent.set_value(detection.position)
+
+
+def support_of(environment: Environment, x: float, y: float, bottom: float,
+               container_states: dict[str, float] | None = None,
+               tolerance: float = 0.04) -> Surface | None:
+    """The surface an object whose lowest seen point is at height `bottom` [m] rests on at
+    (x, y) [m]: the highest surface under (x, y) not above `bottom` + `tolerance`, drawers'
+    insides moved out by their measured opening (`container_states`). None on the floor."""
+    states = container_states or {}
+    candidates: list[Surface] = [s for s in environment.surfaces
+                                 if s.height <= bottom + tolerance and s.contains(x, y)]
+    for container in environment.containers:
+        dx = dy = 0.0
+        if container.kind == "drawer":
+            q = states.get(container.name, 0.0)
+            dx, dy = q * container.opening_direction[0], q * container.opening_direction[1]
+        candidates += [s for s in container.interior
+                       if s.height <= bottom + tolerance and s.contains(x - dx, y - dy)]
+    # the highest; of equally high ones the smallest (a cooker on its counter)
+    return min(candidates, key=lambda s: (-round(s.height, 3), s.area), default=None)

@@ -1,0 +1,127 @@
+"""Search (issue 15): the robot-agnostic `search_for` plan looks around, visits the likely places
+from the environment's description and fails with an `ObjectNotFound` naming where it looked.
+
+The plan under test performs motion designators only; the tests set the world up directly and
+judge the result with the simulator's truth.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from belief_helpers import apartment, open_container, put
+
+from pycram import robots
+from pycram.actions import ObjectNotFound, lookouts, search_for
+from pycram.designator import ObjectDesignator
+from pycram.world.belief import PerceivedObject
+
+START = (2.0, 1.5, math.pi / 2)
+
+
+def robot_in(world, name="pr2"):
+    return robots.load(name, world)
+
+
+def within(obj: PerceivedObject, world, item: str, tolerance: float = 0.05) -> bool:
+    return math.dist(obj.pose[:2], world.item_poses.get_value()[item].position[:2]) < tolerance
+
+
+def test_search_finds_an_object_on_a_surface_out_of_view():
+    world = apartment(START)
+    put(world, "cup", "counter", (0.15, 4.85))  # 3.8 m from the camera: beyond its range
+    robot = robot_in(world)
+    try:
+        with robot:
+            cup = ObjectDesignator(type="cup")
+            found = search_for(cup)
+            assert found.type == "cup" and found.properties["on"] == "counter" and within(found, world, "cup")
+            assert cup.current().reference() is found
+            base = world.base_pose.get_value()
+            assert math.dist((base.x, base.y), START[:2]) > 1.5  # it had to go and look
+            assert search_for(ObjectDesignator(type="cup")) is found  # believed now: no search
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_search_drives_around_the_table_to_an_object_beyond_the_cameras_range():
+    world = apartment((4.3, 0.9, math.pi / 2))  # south of the table, the cabinet 4.5 m away
+    put(world, "cup", "cabinet top", (0.2, 2.6))
+    robot = robot_in(world)
+    try:
+        with robot:
+            found = search_for(ObjectDesignator(type="cup"))
+            assert found.properties["on"] == "cabinet top" and within(found, world, "cup")
+            base = world.base_pose.get_value()
+            assert base.x < 2.5  # it went over to the cabinet's side of the room
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+@pytest.mark.parametrize("robot_name", ["pr2", "tiago"])
+def test_search_finds_an_object_in_an_open_drawer(robot_name):
+    world = apartment(START) if robot_name == "pr2" else _tiago_apartment()
+    q = open_container(world, "drawer 2")
+    put(world, "cup", "drawer 2 inside", (0.3, 2.9), q)
+    robot = robot_in(world, robot_name)
+    try:
+        with robot:
+            found = search_for(ObjectDesignator([("type", "cup"), ("color", "red")]))
+            assert found.properties["in"] == "drawer 2" and within(found, world, "cup")
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def _tiago_apartment():
+    from belief_helpers import TYPES
+    from sim_helpers import ok
+
+    from pycram.sim import World
+    world = World("tiago", environment="apartment", objects=list(TYPES), seed=1, base_pose=START)
+    for name in TYPES:
+        ok(world.take_item(item=name))
+    return world
+
+
+def test_object_not_found_names_the_places_looked_at_and_the_closed_ones():
+    world = apartment(START)
+    put(world, "cereal", "fridge middle shelf", (3.05, 4.62))  # in the closed fridge
+    robot = robot_in(world)
+    try:
+        with robot, pytest.raises(ObjectNotFound) as caught:
+            search_for(ObjectDesignator(type="cereal"))
+        error = caught.value
+        looked = " ".join(error.looked)
+        for place in ("table", "cabinet top", "counter (1/2)", "counter (2/2)"):
+            assert place in looked, (place, error.looked)
+        assert ("fridge middle shelf", "fridge is closed") in error.skipped, error.skipped
+        assert "fridge middle shelf (fridge is closed)" in str(error) and "table" in str(error)
+        assert error.designator.prop_value("type") == "cereal"
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_lookouts_come_from_the_environment_and_the_type():
+    from pycram.environments import load
+    apartment_env = load("apartment")
+    cup_places = {lk.surface for lk in lookouts(apartment_env, "cup")}
+    assert {"table", "counter", "cabinet top", "drawer 1 inside", "fridge middle shelf"} <= cup_places
+    assert not any(s.startswith("cooker") for s in cup_places)  # cups are not found on cookers
+    cereal_places = {lk.surface for lk in lookouts(apartment_env, "cereal")}
+    assert not any(s.startswith("drawer") for s in cereal_places)  # cereal is never in a drawer
+    assert all(apartment_env.is_free_floor(*lk.stand[:2], margin=0.5) for lk in lookouts(apartment_env))
+    near_table = lookouts(apartment_env, "cup", (4.3, 0.5))[0]
+    assert near_table.surface == "table" and near_table.stand[1] < 1.55  # from its south edge
+
+
+def test_search_needs_a_belief():
+    from pycram.robot import ResolverSet
+    with ResolverSet("no robot"), pytest.raises(ValueError, match="belief"):
+        search_for(ObjectDesignator(type="cup"))
+    with pytest.raises(TypeError, match="ObjectDesignator"):
+        search_for("cup")

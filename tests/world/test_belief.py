@@ -1,0 +1,100 @@
+"""The belief state without a simulator: association, ranking, gone objects, container states
+and the support look-up, from hand-made perception reports and camera views."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pycram.designator import NoSolutionError, ObjectDesignator
+from pycram.environments import load
+from pycram.robot import ResolverSet
+from pycram.world.belief import BeliefState, CameraView, Detection, PerceptionReport, color_name, support_of
+
+APARTMENT = load("apartment")
+
+
+def cup(x, y, pixels=100, color="red"):
+    return Detection("cup", (x, y, 0.795), (0.07, 0.07, 0.09), color, support="table", pixels=pixels)
+
+
+def view_from_south(depth_m=10.0):
+    """A camera at (4.3, 0.5, 1.3) looking north (along +y), a flat depth image `depth_m` away."""
+    # camera axes in the map: x right = +x, y up = +z, looking along -z = +y  ->  z = -y
+    rotation = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    return CameraView((4.3, 0.5, 1.3), rotation, 60.0, np.full((240, 320), depth_m, np.float32))
+
+
+def test_new_objects_get_belief_names_and_seen_objects_are_refreshed():
+    belief = BeliefState(APARTMENT)
+    first = belief.update(PerceptionReport(1.0, (cup(4.0, 2.0), cup(4.6, 2.0))))
+    assert [o.name for o in first.added] == ["cup-1", "cup-2"]
+    second = belief.update(PerceptionReport(2.0, (cup(4.62, 2.05), cup(4.05, 1.98))))
+    assert not second.added and {o.name for o in second.refreshed} == {"cup-1", "cup-2"}
+    one = next(o for o in belief.present() if o.name == "cup-1")
+    assert one.pose[:2] == (4.05, 1.98) and one.last_seen == 2.0 and one.times_seen == 2
+    far = belief.update(PerceptionReport(3.0, (cup(1.0, 4.6),)))  # beyond the gate: another cup
+    assert [o.name for o in far.added] == ["cup-3"]
+
+
+def test_the_best_match_is_the_most_recently_seen_then_the_most_visible():
+    belief = BeliefState(APARTMENT)
+    resolvers = ResolverSet("belief")
+    resolvers.object_resolvers.append(belief.resolver)
+    belief.update(PerceptionReport(1.0, (cup(4.0, 2.0, 50), cup(4.6, 2.0, 300))))
+    with resolvers:
+        assert ObjectDesignator(type="cup").reference().name == "cup-2"
+        assert ObjectDesignator(type="cup").next_solution().reference().name == "cup-1"
+        belief.update(PerceptionReport(2.0, (cup(4.0, 2.0, 20),)))
+        assert [o.name for o in ObjectDesignator(type="cup").solutions()] == ["cup-1", "cup-2"]
+
+
+def test_an_object_expected_in_view_but_not_seen_is_gone_one_hidden_behind_something_is_not():
+    belief = BeliefState(APARTMENT)
+    resolvers = ResolverSet("belief")
+    resolvers.object_resolvers.append(belief.resolver)
+    belief.update(PerceptionReport(1.0, (cup(4.3, 2.0),)))
+    view = view_from_south(depth_m=0.8)  # something 0.8 m in front of the camera hides the cup
+    assert view.expects_visible((4.3, 2.0, 0.8)) is False
+    assert not belief.update(PerceptionReport(2.0, (), view)).gone
+    view = view_from_south()
+    assert view.expects_visible((4.3, 2.0, 0.8)) and not view.expects_visible((4.3, 0.2, 0.8))  # behind
+    assert not view.expects_visible((8.3, 2.0, 0.8))  # outside the image
+    (gone,) = belief.update(PerceptionReport(3.0, (), view)).gone
+    with resolvers, pytest.raises(NoSolutionError):
+        ObjectDesignator(type="cup").reference()
+    back = belief.update(PerceptionReport(4.0, (cup(4.35, 2.1),)))
+    assert back.refreshed == (gone,) and not gone.gone
+
+
+def test_container_states_and_supports():
+    belief = BeliefState(APARTMENT)
+    assert belief.container_open("drawer 1") is None
+    belief.update(PerceptionReport(1.0, (), None, {"drawer 1": 0.3, "fridge": 0.0}))
+    assert belief.container_open("drawer 1") and belief.container_open("fridge") is False
+    assert support_of(APARTMENT, 1.78, 4.7, 0.9).name == "cooker #1"  # the cooker, not the counter
+    assert support_of(APARTMENT, 1.0, 4.7, 0.9).name == "counter"
+    assert support_of(APARTMENT, 0.3, 2.9, 0.4).name == "drawer 2 inside"
+    assert support_of(APARTMENT, 0.7, 2.9, 0.4, {"drawer 2": 0.4}).name == "drawer 2 inside"
+    assert support_of(APARTMENT, 0.7, 2.9, 0.4) is None
+    assert support_of(APARTMENT, 4.3, 2.0, 0.75).name == "table"
+
+
+@pytest.mark.parametrize("rgb, name", [((0.8, 0.18, 0.15), "red"), ((0.95, 0.82, 0.25), "yellow"),
+                                       ((0.92, 0.55, 0.12), "orange"), ((0.96, 0.96, 0.93), "white"),
+                                       ((0.5, 0.5, 0.52), "grey"), ((0.1, 0.1, 0.1), "black"),
+                                       ((0.1, 0.3, 0.9), "blue"), ((0.2, 0.7, 0.2), "green")])
+def test_colour_names(rgb, name):
+    assert color_name(rgb) == name
+
+
+def test_moved_is_a_fluent_on_the_believed_pose():
+    belief = BeliefState(APARTMENT)
+    (obj,) = belief.update(PerceptionReport(1.0, (cup(4.0, 2.0),))).added
+    moved = obj.moved(0.05)
+    belief.update(PerceptionReport(2.0, (cup(4.02, 2.0),)))
+    assert moved.get_value() is None
+    belief.update(PerceptionReport(3.0, (cup(4.1, 2.0),)))
+    assert moved.get_value() is True and math.isclose(obj.pose[0], 4.1)
