@@ -14,6 +14,11 @@ Figures (each is the median over several repetitions, after a warm-up):
   synchronously inside `Task._end`, in the loser's thread).
 * CPU of 1,000 idle `whenever` monitors: `time.process_time()` of the whole process over a 2 s
   window while nobody pulses their fluents, in % of one core.
+* suspend → wake latency p50/p99 (issue 18): a task blocked in `wait_for` is suspended (until
+  its status shows SUSPENDED); time from just before `wake_up(task)` to its `on_suspension`
+  wake hook running in the task's own thread.
+* policy overhead (issue 18): `with_policy(timeout_policy, seq of 1,000 no-op steps, 3600 s)`
+  against the bare `seq`, in % of the bare `seq` (medians).
 * `python -c "import pycram.language"`: wall time of the whole command (interpreter start-up
   included; the floor column is `python -c pass`), and the import alone (`-X importtime`).
 
@@ -70,6 +75,8 @@ TARGETS = {
     "evap_busy": 20e-3,
     "idle_cpu": 1.0,  # % of one core
     "import": 0.3,  # python -c "import pycram.language" [s]
+    "suspend_wake": 100e-6,
+    "policy_overhead": 10.0,  # % of a 1,000-step seq
 }
 
 
@@ -209,6 +216,51 @@ def pycram_seq() -> float:
     steps = [_noop] * 1000
     t0 = perf()
     seq(*steps)
+    return perf() - t0
+
+
+def pycram_suspend_wake(samples: int) -> list[float]:
+    """Latencies [s] of `wake_up(task)` → the suspended task going on (its wake hook)."""
+    from pycram.language import on_suspension, par, suspend, wake_up
+
+    never = Fluent()
+    woke = threading.Semaphore(0)
+    t_woke = [0.0]
+    box: dict[str, Any] = {}
+    ready = threading.Event()
+
+    def on_wake() -> None:
+        t_woke[0] = perf()
+        woke.release()
+
+    def sleeper() -> None:
+        box["task"] = current_task()
+        with on_suspension(None, on_wake):
+            ready.set()
+            never.wait_for()
+
+    thread = threading.Thread(target=lambda: par(sleeper), daemon=True)
+    thread.start()
+    ready.wait(10)
+    task = box["task"]
+    out = []
+    for _ in range(samples):
+        suspend(task)  # returns once the task shows SUSPENDED
+        t0 = perf()
+        wake_up(task)
+        woke.acquire()
+        out.append(t_woke[0] - t0)
+    task.evaporate()
+    thread.join(10)
+    return out
+
+
+def pycram_policy_seq() -> float:
+    from pycram.language import timeout_policy, with_policy
+
+    steps = [_noop] * 1000
+    t0 = perf()
+    with_policy(timeout_policy, lambda: seq(*steps), 3600.0)
     return perf() - t0
 
 
@@ -884,6 +936,21 @@ def main(argv: list[str] | None = None) -> int:
         "Evaporated at the back-jump of a `while True:` that is the first statement of a `try:` "
         "skips that try's handlers — the busy loser's loop lives in a helper function."
     )
+    gc.collect()
+    suspend_wake = pycram_suspend_wake(300 if cfg.quick else 2000)
+    plain, _ = median_of(pycram_seq, cfg.repeat)
+    policed, _ = median_of(pycram_policy_seq, cfg.repeat)
+    overhead = 100 * (policed - plain) / plain
+    extra = Table(title="Issue 18 additions (recording off)")
+    for column in ("figure", "PyCRAM", "target", "verdict"):
+        extra.add_column(column)
+    extra.add_row("suspend → wake latency p50", fmt_time(pct(suspend_wake, 50)), fmt_time(TARGETS["suspend_wake"]),
+                  verdict(pct(suspend_wake, 50), TARGETS["suspend_wake"]))
+    extra.add_row("suspend → wake latency p99", fmt_time(pct(suspend_wake, 99)), "", "")
+    extra.add_row("policy around seq(1,000): overhead", f"{overhead:.1f} % ({fmt_time(policed)} vs {fmt_time(plain)})",
+                  f"{TARGETS['policy_overhead']:g} %", verdict(overhead, TARGETS["policy_overhead"]))
+    console.print(extra)
+    misses += (pct(suspend_wake, 50) > TARGETS["suspend_wake"]) + (overhead > TARGETS["policy_overhead"])
     console.print(f"targets missed (recording off): {misses}")
     return 0
 

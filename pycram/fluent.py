@@ -18,10 +18,17 @@ Guarantees (unlike the thesis implementation):
 * a `Fluent` is hashable by identity (usable in sets and as dict keys) although `==` builds a
   network; `bool(fluent)` is an error, because `if f > 3:` would otherwise always be true;
 * waits follow the active clock and are evaporable (see `pycram.runtime`).
+
+Bridging to other systems: `f.on_change(callback)` calls `callback(value)` after every pulse
+of `f` (networks: after every pulse of an input), in the pulsing thread, outside every lock;
+an exception of a callback is logged, never propagated. `Fluent(v, changes_only=True)` is
+CRAM's value fluent that pulses only when `set_value` changes the value (`!=`). `peek()` reads
+a value without consuming anything (a pulse fluent's pulses stay for `whenever`).
 """
 
 from __future__ import annotations
 
+import logging
 import operator
 import threading
 import weakref
@@ -29,9 +36,11 @@ from enum import Enum
 from typing import Any, Callable, Iterator
 
 from pycram.block_forms import BlockForm
-from pycram.runtime.evaporation import notify_waiters, wait_until
+from pycram.runtime.evaporation import Evaporated, current_runner, notify_waiters, wait_until
 
-__all__ = ["Fluent", "Behavior", "whenever", "Whenever", "STOP"]
+__all__ = ["Fluent", "Behavior", "whenever", "Whenever", "STOP", "ChangeCallback"]
+
+log = logging.getLogger(__name__)
 
 _pulse_lock = threading.Lock()
 _create_lock = threading.Lock()
@@ -57,10 +66,13 @@ class Fluent:
     changes). `name` defaults to a random string.
     """
 
-    __slots__ = ("_value", "_name", "_cv", "_children", "_live", "_pulses", "_handle_missed", "__weakref__")
+    __slots__ = ("_value", "_name", "_cv", "_children", "_live", "_pulses", "_handle_missed", "_callbacks",
+                 "_changes_only", "__weakref__")
 
-    def __init__(self, value: Any = None, name: str | None = None) -> None:
+    def __init__(self, value: Any = None, name: str | None = None, changes_only: bool = False) -> None:
         self._value = value
+        self._callbacks: tuple[Callable[[Any], Any], ...] = ()
+        self._changes_only = changes_only
         self._name = name
         self._cv: threading.Condition | None = None
         self._children: list[weakref.ref] = []  # replaced, never shrunk in place (see add_child)
@@ -104,21 +116,66 @@ class Fluent:
         return value
 
     def set_value(self, value: Any) -> None:
-        """Store `value` and pulse — always, even when the value did not change."""
-        self._value = value
+        """Store `value` and pulse — always, even when the value did not change, unless the
+        fluent was made with `changes_only=True` (then only when `value != old value`)."""
+        if self._changes_only:
+            old, self._value = self._value, value
+            if old is value or _equal(old, value):
+                return
+        else:
+            self._value = value
         self.pulse()
 
+    def peek(self) -> Any:
+        """The current value, without consuming a pulse or blocking (same as `get_value`, which
+        never consumes either: only a `whenever` pass does)."""
+        return self.get_value()
+
+    def on_change(self, callback: Callable[[Any], Any]) -> ChangeCallback:
+        """Call `callback(value)` after every pulse of this fluent; returns a handle whose
+        `remove()` stops it (idempotent).
+
+        The callback runs in the thread that set or pulsed the fluent, after the waiters were
+        woken, outside every lock; keep it short. An exception it raises is logged (logger
+        `pycram.fluent`) and otherwise ignored. The fluent holds the callback strongly.
+        """
+        if not callable(callback):
+            raise TypeError(f"on_change() needs a callable, got {type(callback).__name__}: {callback!r}")
+        with _create_lock:
+            self._callbacks = self._callbacks + (callback,)
+        return ChangeCallback(self, callback)
+
     def pulse(self) -> None:
-        """Wake every waiter on this fluent and on the networks and pulse fluents built from it."""
-        for ref in self._children:
-            child = ref()
-            if child is not None:
-                with _pulse_lock:
-                    child._pulses += 1
-                child.pulse()
-        cv = self._cv
-        if cv is not None:
-            notify_waiters(cv)
+        """Wake every waiter on this fluent and on the networks and pulse fluents built from it,
+        then call the `on_change` callbacks (also if waking raised `Evaporated`)."""
+        try:
+            for ref in self._children:
+                child = ref()
+                if child is not None:
+                    with _pulse_lock:
+                        child._pulses += 1
+                    child.pulse()
+            cv = self._cv
+            if cv is not None:
+                notify_waiters(cv)  # may raise Evaporated (where an asynchronous one was due)
+        finally:
+            if self._callbacks:
+                self._run_callbacks()
+
+    def _run_callbacks(self) -> None:
+        runner = current_runner()
+        token = runner.enter_runtime()  # an asynchronous Evaporated waits until the callbacks ran
+        try:
+            value = self.get_value()
+            for callback in self._callbacks:
+                try:
+                    callback(value)
+                except Exception:
+                    log.exception("on_change callback %r of fluent %s failed", callback, self.name)
+        finally:
+            due = runner.leave_runtime(token)
+        if due:
+            raise Evaporated()
 
     def add_child(self, fluent: Fluent) -> None:
         """Make `fluent` be pulsed whenever this fluent is. Held weakly: it dies with its users.
@@ -269,6 +326,32 @@ class Fluent:
 
     def __rtruediv__(self, other: Any) -> Fluent:
         return self._math(operator.truediv, other, self)
+
+
+def _equal(a: Any, b: Any) -> bool:
+    try:
+        return bool(a == b)
+    except Exception:  # noqa: BLE001 - values that cannot be compared count as changed
+        return False
+
+
+class ChangeCallback:
+    """Handle of an `on_change` registration."""
+
+    __slots__ = ("fluent", "callback")
+
+    def __init__(self, fluent: Fluent, callback: Callable[[Any], Any]) -> None:
+        self.fluent = fluent
+        self.callback = callback
+
+    def remove(self) -> None:
+        """Stop calling the callback (no error if it was removed already)."""
+        fluent = self.fluent
+        with _create_lock:
+            callbacks = list(fluent._callbacks)
+            if self.callback in callbacks:
+                callbacks.remove(self.callback)
+            fluent._callbacks = tuple(callbacks)
 
 
 class _PulseFluent(Fluent):

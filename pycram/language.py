@@ -20,6 +20,9 @@ Guarantees:
 * An expression never raises its branches' exceptions to the caller: they are appended to
   `errors` (when given) in the order the branches failed. Exactly the branches whose task ended
   FAILED contribute; evaporated branches contribute nothing.
+* The state fluent (a `StateFluent`) holds the winning branch's return value in `result` —
+  `seq`: the last step's, `par`: every branch's in order, the others: the winner's — set before
+  the value becomes SUCCEEDED; None on failure.
 * The state fluent is set as soon as the outcome is decided (branches may watch it) and never
   changes afterwards. Pass `state=` a fresh `Fluent` to get it before the branches start.
 * An expression returns only after every task it started — and all of theirs — has ended, on
@@ -41,9 +44,15 @@ from pycram.block_forms import BRANCHES, BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
 from pycram.runtime.evaporation import check_evaporation, shielded, wait_until
 from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
+from pycram.runtime.detached import detached_children
+from pycram.runtime.suspension import (is_suspended, on_suspension, retry_after_suspension, suspend,
+                                       wake_up, with_task_suspended)
+from pycram.runtime.tags import Tags, find_task, find_tasks, tag, with_tags
+from pycram.runtime.task_variables import TaskVariable
 
 __all__ = [
     "State",
+    "StateFluent",
     "seq",
     "par",
     "pursue",
@@ -54,7 +63,30 @@ __all__ = [
     "RetriesExhausted",
     "current_attempt",
     "with_timeout",
+    "try_each_in_order",
+    "par_loop",
+    "partial_order",
+    "Policy",
+    "PolicyRun",
+    "PolicyConditionMet",
+    "PolicyInitFailed",
+    "define_policy",
+    "with_policy",
+    "timeout_policy",
     "whenever",
+    "TaskVariable",
+    "suspend",
+    "wake_up",
+    "with_task_suspended",
+    "on_suspension",
+    "retry_after_suspension",
+    "is_suspended",
+    "detached_children",
+    "Tags",
+    "with_tags",
+    "tag",
+    "find_task",
+    "find_tasks",
     "Fluent",
     "Behavior",
 ]
@@ -89,6 +121,27 @@ def _label(fn: Branch, index: int) -> tuple[str, str | None]:
     if not name or name == "<lambda>":
         return str(index + 1), None
     return f"{index + 1}:{name}", None
+
+
+class StateFluent(Fluent):
+    """The state fluent an expression returns: its value is a `State` once decided, and
+    `result` holds the return value of the winning branch (see `_set_result`).
+
+    `result` is set *before* the value becomes `State.SUCCEEDED`, so a branch or caller that
+    waited for the state reads the final result. It stays None on failure.
+    """
+
+    __slots__ = ("result",)
+
+    def __init__(self, value: Any = None, name: str | None = None) -> None:
+        super().__init__(value, name)
+        self.result: Any = None
+
+
+def _set_result(state: Fluent, result: Any) -> None:
+    """Record the winning branch's return value on `state` (if undecided and it can hold one)."""
+    if state.get_value() is None and isinstance(state, StateFluent):
+        state.result = result
 
 
 def _decide(state: Fluent, outcome: State) -> None:
@@ -127,7 +180,7 @@ class _Expression(BlockForm):
             raise TypeError(f"{self.kind}(): errors must be a list, got {type(errors).__name__}")
         if state is not None and not isinstance(state, Fluent):
             raise TypeError(f"{self.kind}(): state must be a Fluent, got {type(state).__name__}")
-        state = state if state is not None else Fluent(name=name or self.kind)
+        state = state if state is not None else StateFluent(name=name or self.kind)
         self._run(fns, errors if errors is not None else [], state, name or self.kind)
         return state
 
@@ -145,15 +198,18 @@ class _BlockUse(BlockForm):
 
 def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
     with task_scope(name, "seq", plan_code=False) as scope:
+        result = None
         for index, fn in enumerate(fns):
             try:
-                name, location = _label(fn, index)
-                run_subtask(name, fn, kind="step", location=location)
+                label, location = _label(fn, index)
+                result = run_subtask(label, fn, kind="step", location=location)
             except Exception as exc:
                 errors.append(exc)
                 scope.fail(exc)
                 _decide(state, State.FAILED)
                 return
+        scope.task.result = result
+        _set_result(state, result)
         _decide(state, State.SUCCEEDED)
 
 
@@ -161,11 +217,13 @@ def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: 
     with task_scope(name, "try_in_order", plan_code=False) as scope:
         for index, fn in enumerate(fns):
             try:
-                name, location = _label(fn, index)
-                run_subtask(name, fn, kind="step", location=location)
+                label, location = _label(fn, index)
+                result = run_subtask(label, fn, kind="step", location=location)
             except Exception as exc:
                 errors.append(exc)
                 continue
+            scope.task.result = result
+            _set_result(state, result)
             _decide(state, State.SUCCEEDED)
             return
         scope.fail(errors[-1] if errors else RuntimeError(f"{name}: no alternatives"))
@@ -196,6 +254,8 @@ class _Concurrent:
         self.succeeded = 0
         self.failed = 0
         self.count = 0
+        self.group: TaskGroup | None = None
+        self.result: Any = None  #: the winning branch's return value (par: all branches' in order)
 
     def on_end(self, task: Task) -> None:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
@@ -218,14 +278,17 @@ class _Concurrent:
             if status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
             elif self.succeeded == self.count:
+                self.result = [t.result for t in self.group.tasks]  # every branch's, in branch order
                 self._decide(State.SUCCEEDED)
         elif kind == "try_all":
             if status is TaskStatus.SUCCEEDED:
+                self.result = task.result
                 self._decide(State.SUCCEEDED)
             elif ended == self.count:
                 self._decide(State.FAILED)
         elif kind == "pursue":
             if status is TaskStatus.SUCCEEDED:
+                self.result = task.result
                 self._decide(State.SUCCEEDED)
             elif status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
@@ -233,12 +296,14 @@ class _Concurrent:
     def _decide(self, outcome: State) -> None:
         if self.outcome is None:
             self.outcome = outcome
+            if outcome is State.SUCCEEDED:
+                _set_result(self.state, self.result)
             _decide(self.state, outcome)
 
     def run(self, fns: Sequence[Branch], name: str, deadline: float | None = None) -> bool:
         """Run the branches; returns False if `deadline` [s] passed before an outcome."""
         self.count = len(fns)
-        group = TaskGroup(self.on_end)
+        group = self.group = TaskGroup(self.on_end)
         try:
             with shielded():  # never leave a started thread behind half-registered
                 for index, fn in enumerate(fns):
@@ -270,6 +335,8 @@ def _concurrent_runner(kind: str) -> Callable[[Sequence[Branch], list, Fluent, s
                 engine.run(fns, name)
             if engine.outcome is State.FAILED:
                 scope.fail(engine.first_error or engine.retry or RuntimeError(f"{name} failed"))
+            else:
+                scope.task.result = engine.result
         if engine.retry is not None:
             raise engine.retry  # a branch called retry(): restart the enclosing failure_handling
 
@@ -295,6 +362,46 @@ pursue = _Expression(
 )
 
 
+def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Branch]:
+    if not callable(body):
+        raise TypeError(f"{form}(): body must be a callable taking one item, got {type(body).__name__}: {body!r}")
+    try:
+        items = list(items)
+    except TypeError:
+        raise TypeError(f"{form}(): items must be iterable, got {type(items).__name__}: {items!r}") from None
+    branches = []
+    for index, item in enumerate(items):
+        def branch(item: Any = item) -> Any:
+            return body(item)
+
+        branch.__pycram_name__ = f"{index + 1}:{item!r}"[:60]  # type: ignore[attr-defined]
+        branches.append(branch)
+    return branches
+
+
+def try_each_in_order(items: Any, body: Callable[[Any], Any], errors: list | None = None,
+                      name: str | None = None, state: Fluent | None = None) -> Fluent:
+    """`try_in_order` over `body(item)` for each item (CRAM's `try-each-in-order`).
+
+    Calls `body(item)` for the items in order until one returns without raising; returns the
+    state fluent, whose `result` is that call's return value. FAILED (with every failure in
+    `errors`, in order) when all calls fail or `items` is empty.
+    """
+    branches = _item_branches(items, body, "try_each_in_order")
+    return try_in_order(*branches, errors=errors, state=state, name=name or "try_each_in_order")
+
+
+def par_loop(items: Any, body: Callable[[Any], Any], errors: list | None = None,
+             name: str | None = None, state: Fluent | None = None) -> Fluent:
+    """`par` over `body(item)` for each item (CRAM's `par-loop`): one branch per item.
+
+    SUCCEEDED when every call returned — `result` is then the list of return values in item
+    order; the first failure evaporates the other branches (as `par`).
+    """
+    branches = _item_branches(items, body, "par_loop")
+    return par(*branches, errors=errors, state=state, name=name or "par_loop")
+
+
 def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: str | None = None) -> Fluent:
     """Run `fn` as a task; evaporate it if it has not ended after `seconds` [s] of the active clock.
 
@@ -315,7 +422,7 @@ def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: s
         raise TypeError(f"with_timeout(): fn must be callable, got {type(fn).__name__}")
     errors = errors if errors is not None else []
     label = name or f"with_timeout({seconds:g} s)"
-    state = Fluent(name=label)
+    state = StateFluent(name=label)
     engine = _Concurrent("pursue", errors, state)
     with task_scope(label, "with_timeout", plan_code=False) as scope:
         if not engine.run([fn], label, deadline=seconds):
@@ -455,3 +562,10 @@ def __getattr__(name: str) -> Any:
 
         return plan
     raise AttributeError(f"module 'pycram.language' has no attribute {name!r}")
+
+
+# -- expressions built on the ones above (imported last: they import this module) ------------------
+
+from pycram.partial_order import partial_order  # noqa: E402
+from pycram.policy import (Policy, PolicyConditionMet, PolicyInitFailed, PolicyRun, define_policy,  # noqa: E402
+                           timeout_policy, with_policy)

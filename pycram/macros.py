@@ -110,7 +110,7 @@ except ImportError:  # pragma: no cover - only before block_forms exists
 
 EXPRESSION_FORMS: tuple[str, ...] = ("seq", "par", "pursue", "try_all", "try_in_order")
 """Block forms whose statements become branches of a language expression."""
-FORMS: tuple[str, ...] = EXPRESSION_FORMS + ("failure_handling", "whenever")
+FORMS: tuple[str, ...] = EXPRESSION_FORMS + ("failure_handling", "whenever", "partial_order", "with_policy")
 """Every block form the transform knows."""
 PYCRAM_MODULES: tuple[str, ...] = ("pycram.language", "pycram.fluent", "pycram")
 """Modules whose form objects are recognised (a module opts in by importing from one)."""
@@ -133,10 +133,10 @@ def expression(form: str) -> Callable[..., Any]:
 
 
 def new_state(name: str) -> Any:
-    """A fresh, unset state Fluent for a block's `as` target."""
-    from pycram.fluent import Fluent
+    """A fresh, unset state fluent (holding the winning branch's `result`) for a block's `as` target."""
+    from pycram.language import StateFluent
 
-    return Fluent(None, name)
+    return StateFluent(None, name)
 
 
 def retry_function() -> Callable[[], Any]:
@@ -520,6 +520,10 @@ class _Transformer:
                     return self.whenever(form, scope)
                 if form.name == "failure_handling":
                     return self.failure_handling(form, scope)
+                if form.name == "partial_order":
+                    return self.partial_order(form, scope)
+                if form.name == "with_policy":
+                    return self.with_policy(form, scope)
                 return self.expression(form, scope)
         for name in ("body", "orelse", "finalbody"):
             value = getattr(stmt, name, None)
@@ -723,6 +727,48 @@ class _Transformer:
                     ast.keyword("state", ast.Name(state, ast.Load())),
                     ast.keyword("name", ast.Constant(label)),
                 ],
+            )
+        )
+        out += self._located([call], node)
+        return out
+
+    def partial_order(self, form: _Form, scope: _Scope) -> list[ast.stmt]:
+        """`with partial_order(orderings[, errors]) as s:` — each statement is step 1, 2, ...;
+        generated as `expression("partial_order")([b1, b2, ...], orderings, errors=..., state=s)`."""
+        orderings = form.args[0] if form.args else None
+        rest = form.args[1:]
+        keywords = [k for k in form.keywords if k.arg != "orderings"]
+        orderings = orderings or next((k.value for k in form.keywords if k.arg == "orderings"), None)
+        if orderings is None:
+            raise self.error(form.node, "`with partial_order(orderings) as s:` needs the orderings, e.g. [(1, 2)]")
+        stripped = _Form(form.name, form.node, rest, keywords, form.target)
+        out = self.expression(stripped, scope)
+        call = out[-1].value  # type: ignore[attr-defined]
+        call.args = [ast.List(elts=call.args, ctx=ast.Load()), orderings]
+        self._located([out[-1]], form.node)
+        return out
+
+    def with_policy(self, form: _Form, scope: _Scope) -> list[ast.stmt]:
+        """`with with_policy(policy, *params):` — the block is the body; generated as
+        `expression("with_policy")(policy, body, *params)`."""
+        node = form.node
+        line = node.lineno
+        if form.target is not None:
+            raise self.error(node, "`with with_policy(...)` does not bind a value; remove `as ...`")
+        if not form.args or form.keywords:
+            raise self.error(node, "`with with_policy(policy, *params):` needs the policy and positional parameters only")
+        self.check_not_empty(form)
+        self.check_branch(node.body, form.name)
+        label = f"with_policy@{self.basename}:{line}"
+        out: list[ast.stmt] = self._located(self._parse("import pycram.macros as _pycram_rt"), node)
+        body = self.stmts(node.body, scope)
+        gen = self._fresh("with_policy", line)
+        out.append(self._branch_def(gen, label, body, scope, node))
+        call = ast.Expr(
+            ast.Call(
+                func=ast.Call(ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()), [ast.Constant("with_policy")], []),
+                args=[form.args[0], ast.Name(gen, ast.Load()), *form.args[1:]],
+                keywords=[],
             )
         )
         out += self._located([call], node)

@@ -63,6 +63,7 @@ from pycram.designators.motion_types import (active_motion_types, check_motion,
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
 from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
+from pycram.runtime.suspension import on_suspension, retry_after_suspension
 
 __all__ = [
     "ProcessModule",
@@ -211,6 +212,15 @@ class ProcessModule:
 
     resolvers: ClassVar[list[Callable[[Any], Optional["ProcessModule"]]]] = []
 
+    #: What suspending the executing task (`pycram.runtime.suspension`) does to a running
+    #: execution. "pause": ``_pause(designator)`` runs when the task blocks for suspension and
+    #: ``_resume(designator)`` when it is woken; ``_execute`` goes on where it waited.
+    #: "cancel": the execution is evaporated (the cancel hook runs and the module is freed for
+    #: other callers) and, after the wake-up, the designator is queued and executed again from
+    #: the start (CRAM's retry-after-suspension). An ``execute_nowait`` execution always
+    #: behaves as "pause".
+    suspension: ClassVar[str] = "pause"
+
     def __init__(self, name: Optional[str] = None) -> None:
         self.name = name or type(self).__name__
         self._cond = threading.Condition(threading.Lock())
@@ -299,12 +309,27 @@ class ProcessModule:
         (``self.current`` is then another execution or None: nothing of this designator runs,
         so stop nothing that another caller started)."""
 
+    def _pause(self, designator: Any) -> None:
+        """Suspension hook (override; "pause" modules): the executing task was suspended."""
+
+    def _resume(self, designator: Any) -> None:
+        """Wake-up hook (override; "pause" modules): the executing task was woken up."""
+
     def execute(self, designator: Any) -> Any:
         """Queue ``designator``, wait for its turn, run ``_execute`` and return its result.
 
-        Evaporable while queued and while running (see the module docstring). Raises
-        :class:`ProcessModuleFailure`, :class:`ProcessModuleOffline`.
+        Evaporable while queued and while running (see the module docstring); suspendable as
+        the class attribute ``suspension`` says. Raises :class:`ProcessModuleFailure`,
+        :class:`ProcessModuleOffline`.
         """
+        if self.suspension == "cancel":
+            return retry_after_suspension(lambda: self._execute_once(designator),
+                                          name=f"{self.name}: retry after suspension")
+        if self.suspension != "pause":
+            raise ValueError(f"{type(self).__name__}.suspension must be 'pause' or 'cancel', got {self.suspension!r}")
+        return self._execute_once(designator)
+
+    def _execute_once(self, designator: Any) -> Any:
         execution = self._submit(designator)
         self._run(execution)
         if execution.status.get_value() is ProcessModuleStatus.SUCCEEDED:
@@ -446,7 +471,8 @@ class ProcessModule:
                 execution.start = current_clock().now()
                 logger.debug("%s: executing %r", self.name, designator)
                 try:
-                    result = self._execute(designator)
+                    with on_suspension(lambda: self._pause(designator), lambda: self._resume(designator)):
+                        result = self._execute(designator)
                     outcome = ProcessModuleStatus.SUCCEEDED
                 except Exception as e:
                     failure = ProcessModuleFailure(

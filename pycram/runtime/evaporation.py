@@ -254,11 +254,15 @@ def check_evaporation() -> None:
     """Raise `Evaporated` if the calling task is evaporating.
 
     Call it in long computations that make no other PyCRAM call; plain Python loops are also
-    interrupted asynchronously, but an explicit check is immediate and exact.
+    interrupted asynchronously, but an explicit check is immediate and exact. It is also a
+    suspension point: a suspended task blocks here until woken up.
     """
     runner = current_runner()
     if runner.evaporation_due():
         raise runner.evaporated()
+    point = _suspension
+    if point is not None and point.active and point.due(runner):
+        point.block(runner)  # a suspended task stops here until woken up
 
 
 @contextmanager
@@ -305,37 +309,56 @@ def wait_until(
     `predicate` is evaluated with `condition` held, first at once and then each time the
     condition is notified. Returns True when the predicate holds, False when `timeout` [s] of
     the active clock has passed. Raises `Evaporated` at once when the calling task is (or
-    becomes) evaporating. Never polls.
+    becomes) evaporating. A suspended task (`pycram.runtime.suspension`) stays blocked here
+    until woken up, even if the predicate became true meanwhile; the time-out keeps running.
+    Never polls.
     """
+    return _wait(condition, predicate, timeout, True)
+
+
+def _wait(condition: threading.Condition, predicate: Callable[[], object], timeout: float | None,
+          suspendable: bool) -> bool:
     runner = current_runner()
     if runner.evaporation_due():
         raise runner.evaporated()
-    token = runner.enter_runtime()  # before taking the condition's lock, left after releasing it
-    try:
-        with condition:
-            satisfied = _wait_locked(runner, condition, predicate, timeout)
-    finally:
-        due = runner.leave_runtime(token)
-    if due:
-        raise Evaporated()
-    return satisfied
+    deadline = None
+    if timeout is not None and timeout > 0:
+        deadline = current_clock().now() + timeout
+    while True:
+        token = runner.enter_runtime()  # before taking the condition's lock, left after releasing it
+        try:
+            with condition:
+                satisfied = _wait_locked(runner, condition, predicate, timeout, deadline, suspendable)
+        finally:
+            due = runner.leave_runtime(token)
+        if due:
+            raise Evaporated()
+        if satisfied is not _SUSPENDED:
+            return satisfied  # type: ignore[return-value]
+        _suspension.block(runner)  # type: ignore[union-attr]
 
 
 def _wait_locked(runner: Runner, condition: threading.Condition, predicate: Callable[[], object],
-                 timeout: float | None) -> bool:
-    """The body of `wait_until`, with `condition` held and the runner in runtime mode."""
+                 timeout: float | None, deadline: float | None, suspendable: bool) -> object:
+    """The body of `wait_until`, with `condition` held and the runner in runtime mode.
+
+    Returns True / False (predicate / time-out) or `_SUSPENDED` when the task must block for
+    suspension first (the caller does that without holding `condition`)."""
+    if suspendable and _suspension is not None and _suspension.active and _suspension.due(runner):
+        return _SUSPENDED
     if predicate():
         return True
     if timeout is not None and timeout <= 0:
         return False
     clock = current_clock()
-    deadline = None if timeout is None else clock.now() + timeout
     handle = None if deadline is None else clock.register(deadline, condition)
     runner._wait_on(condition)
     try:
         while True:
             if runner.evaporation_due():
                 raise Evaporated()
+            if suspendable and _suspension is not None and _suspension.active and _suspension.due(runner):
+                return _SUSPENDED
             if predicate():
                 return True
             if deadline is not None and clock.now() >= deadline:
@@ -344,6 +367,41 @@ def _wait_locked(runner: Runner, condition: threading.Condition, predicate: Call
     finally:
         if handle is not None:
             clock.unregister(handle)
+
+
+_SUSPENDED = object()  # result of `_wait_locked`: block for suspension, then wait again
+
+
+class SuspensionPoint:
+    """What the wait loop needs from `pycram.runtime.suspension` (installed there on first use).
+
+    `active` is non-zero while any task is suspended (the fast path skips everything else);
+    `due(runner)` tells whether the runner's current task must block; `block(runner)` blocks
+    it until woken up (evaporable), called without any lock held.
+    """
+
+    active = 0
+
+    def due(self, runner: Runner) -> bool:
+        raise NotImplementedError
+
+    def block(self, runner: Runner) -> None:
+        raise NotImplementedError
+
+
+_suspension: SuspensionPoint | None = None
+
+
+def install_suspension_point(point: SuspensionPoint) -> None:
+    """Make waits and `check_evaporation` honour suspension (runtime internal)."""
+    global _suspension
+    _suspension = point
+
+
+def wait_unsuspendable(condition: threading.Condition, predicate: Callable[[], object],
+                       timeout: float | None = None) -> bool:
+    """`wait_until` that a suspension does not stop (runtime internal: the suspension block)."""
+    return _wait(condition, predicate, timeout, False)
 
 
 def notify_waiters(condition: threading.Condition) -> None:

@@ -57,6 +57,7 @@ class TaskStatus(Enum):
     SUCCEEDED = "succeeded"
     FAILED = "failed"
     EVAPORATED = "evaporated"
+    SUSPENDED = "suspended"  #: blocked by `pycram.runtime.suspension` until woken up; not done
 
     @property
     def done(self) -> bool:
@@ -625,6 +626,7 @@ _STATUS_MARK = {
     TaskStatus.SUCCEEDED: "✔",
     TaskStatus.FAILED: "✘",
     TaskStatus.EVAPORATED: "~",
+    TaskStatus.SUSPENDED: "‖",
 }
 
 

@@ -25,9 +25,11 @@ STATUS_STYLE = {
     "unfinished": "yellow",
     "interrupted": "yellow",
     "created": "grey50",
+    "suspended": "magenta",
 }
 #: One-character mark per task status.
-STATUS_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·"}
+STATUS_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·",
+               "suspended": "‖"}
 
 
 def format_duration(seconds: float | None) -> str:

@@ -47,6 +47,7 @@ STATUS_COLORS = {
     "evaporated": "#9e9e9e",
     "running": "#1e88e5",
     "created": "#cfd8dc",
+    "suspended": "#8e24aa",
     "thread": "#607d8b",
 }
 _LIGHT = {
@@ -55,6 +56,7 @@ _LIGHT = {
     "evaporated": "#f5f5f5",
     "running": "#e3f2fd",
     "created": "#fafafa",
+    "suspended": "#f3e5f5",
     "thread": "#eceff1",
 }
 
