@@ -393,15 +393,20 @@ def demo_command(
 
 #: The objects `pycram scene` places by default (a breakfast).
 _SCENE_OBJECTS = "cup,bowl,spoon,cereal,milk,plate"
+#: The scene options `pycram scene` and `pycram costmap` share.
+_SceneEnvOption = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen.")
+_SceneSeedOption = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene).")
+_SceneObjectsOption = typer.Option(_SCENE_OBJECTS, "--objects",
+                                   help="Comma-separated object types to place at random ('' for none).")
+_SceneRobotOption = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago.")
 
 
 @app.command("scene")
 def scene_command(
-    env: str = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen."),
-    seed: int = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene)."),
-    objects: str = typer.Option(_SCENE_OBJECTS, "--objects",
-                                help="Comma-separated object types to place at random ('' for none)."),
-    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    env: str = _SceneEnvOption,
+    seed: int = _SceneSeedOption,
+    objects: str = _SceneObjectsOption,
+    robot: str = _SceneRobotOption,
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
     costmap: str = typer.Option("", "--costmap",
                                 help="Draw a location designator's costmap layers and chosen poses instead, "
@@ -490,11 +495,10 @@ def _costmap_picture(world: object, robot_name: str, text: str, output: Path, ti
 @app.command("costmap")
 def costmap_command(
     location: str = typer.Argument(..., help="The location, e.g. \"to_reach cup\" or \"on table, for bowl\"."),
-    env: str = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen."),
-    seed: int = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene)."),
-    objects: str = typer.Option(_SCENE_OBJECTS, "--objects",
-                                help="Comma-separated object types to place at random ('' for none)."),
-    robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
+    env: str = _SceneEnvOption,
+    seed: int = _SceneSeedOption,
+    objects: str = _SceneObjectsOption,
+    robot: str = _SceneRobotOption,
     output: Path = typer.Option(Path("costmap.png"), "--output", "-o", help="PNG file to write."),
 ) -> None:
     """The costmap layers of a location designator over the floor plan, and the poses it chose."""
