@@ -133,6 +133,17 @@ def test_round_trip(db_url):
     assert [s.number for s in samples] == [0.0, 1.0, 2.0, 3.0]
 
 
+def test_task_locations_are_recorded(tmp_path):
+    url = f"sqlite:///{tmp_path / 'runs.sqlite3'}"
+    recorder = start_recording(url, plan="locations")
+    run_subtask("step", lambda: None, location="plan.py:12")
+    run_subtask("anonymous step", lambda: None)
+    run_id = recorder.finish("succeeded")
+    by_name = {r.name: r for r in query.tasks(run_id, url)}
+    assert by_name["step"].location == "plan.py:12"
+    assert by_name["anonymous step"].location is None
+
+
 def test_fluent_rate_limit_keeps_last_value(tmp_path):
     url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
     f = Fluent(0, name="counter")

@@ -57,9 +57,9 @@ __all__ = [
     "SUPPORTED_KINDS",
 ]
 
-#: 2: `pycram_tasks.error_origin`, `pycram_runs.clock` and `pycram_runs.lost_records` (added to
-#: older databases on connect).
-SCHEMA_VERSION = 2
+#: 2: `pycram_tasks.error_origin`, `pycram_runs.clock` and `pycram_runs.lost_records`; 3:
+#: `pycram_tasks.location` (added to older databases on connect).
+SCHEMA_VERSION = 3
 
 #: Database kinds (SQLAlchemy backend names) that can hold run traces.
 SUPPORTED_KINDS = ("sqlite", "postgresql")
@@ -191,6 +191,8 @@ tasks_table = sa.Table(
     # task_id of the task the error was raised in: this task's own id where it originated,
     # a descendant's where it only passed through; NULL without error and before schema 2
     sa.Column("error_origin", sa.Integer),
+    # where the task's code is (`file.py:line` of the call it was made for); NULL before schema 3
+    sa.Column("location", sa.String(512)),
     sa.UniqueConstraint("run_id", "task_id", name="uq_pycram_tasks_run_task"),
 )
 sa.Index("ix_pycram_tasks_name", tasks_table.c.name)

@@ -138,6 +138,9 @@ class TaskRecord:
     #: task_id of the task the error was raised in (this task's own id if it was raised here);
     #: None without error, and for tasks recorded before PyCRAM noted it.
     error_origin: int | None = None
+    #: Where the task's code is (`file.py:line`), when the runtime knows it; None for tasks
+    #: recorded before PyCRAM stored it.
+    location: str | None = None
 
     @property
     def failed(self) -> bool:
@@ -388,7 +391,8 @@ def records_from_task(task: Any, run_id: int = 0) -> list[TaskRecord]:
             start=node.start_time, end=node.end_time, duration=node.duration,
             error_type=type(error).__name__ if error is not None else None,
             error_message=str(error) if error is not None else None,
-            error_origin=error_origin(node) if error is not None else None))
+            error_origin=error_origin(node) if error is not None else None,
+            location=node.location))
     return records
 
 

@@ -472,7 +472,7 @@ class Recorder:
 
 
 _TASK_COLUMNS = ("run_id", "task_id", "parent_id", "name", "kind", "path", "thread", "status", "start", "end",
-                 "duration", "error_type", "error_message", "error_origin")
+                 "duration", "error_type", "error_message", "error_origin", "location")
 
 
 class _WriterState:
@@ -524,7 +524,7 @@ class _WriterState:
         return (self.run_id, task.id, parent.id if parent is not None else None,
                 name if len(name) <= 512 else name[:511] + "…", task.kind, task.path, thread, status,
                 start, end, end - start if start is not None and end is not None else None,
-                error_type, error_message, origin)
+                error_type, error_message, origin, task.location)
 
     def _wanted(self, task: Task) -> bool:
         scope = self.recorder.scope
