@@ -1,5 +1,35 @@
-"""Robot-agnostic plans that use designators only (the actions layer): today `search_for`."""
+"""The action library: robot-agnostic plans behind action designators.
 
-from pycram.actions.search import Lookout, ObjectNotFound, look_around, lookouts, search_for
+Each action has a typed constructor that returns an `ActionDesignator`; `perform` runs it::
 
-__all__ = ["Lookout", "ObjectNotFound", "look_around", "lookouts", "search_for"]
+    from pycram.actions import PickUp, Place, Search
+    from pycram.designator import LocationDesignator, ObjectDesignator, perform
+
+    cup = perform(Search(ObjectDesignator(type="cup")))
+    held = perform(PickUp(cup))
+    perform(Place(held, LocationDesignator([("on", "table"), ("for", "cup")])))
+
+The plans use designators, motions, fluents and the robot's belief only, so they run unchanged
+on every robot (PR2: either arm; TIAGo: its one arm). They recover from failures inside (next
+grasp or standing pose, perceiving again, searching again) a bounded number of times and then
+raise a typed failure of `pycram.failures`. The plan for an action type can be replaced per
+robot or world by an action resolver of its own (asked before the library's).
+"""
+
+from pycram.designators.action import ActionDesignator
+
+from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
+from .core import ACTION_PLANS, ActionParameterError, resolve_action
+from .manipulation import Held, PickUp, Place, held_objects
+from .search import Lookout, ObjectNotFound, look_around, lookouts, search_for
+from .transport import Transport
+
+if resolve_action not in ActionDesignator.resolvers:
+    ActionDesignator.resolvers.append(resolve_action)
+
+__all__ = [
+    "Navigate", "LookAt", "ParkArms", "MoveTorso", "SetGripper", "Detect", "Search",
+    "PickUp", "Place", "Transport", "Held", "held_objects",
+    "ACTION_PLANS", "ActionParameterError", "resolve_action",
+    "Lookout", "ObjectNotFound", "look_around", "lookouts", "search_for",
+]

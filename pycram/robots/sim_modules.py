@@ -32,7 +32,7 @@ from typing import Any, Callable, Optional
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule, ProcessModuleStatus
 from pycram.robot import Robot
-from pycram.world.navigation import NavigationFailure
+from pycram.failures import MotionFailure, NavigationFailure
 
 __all__ = [
     "SimMotionFailed",
@@ -57,7 +57,7 @@ logger = logging.getLogger(__name__)
 COMMAND_TIMEOUT = 60.0
 
 
-class SimMotionFailed(Exception):
+class SimMotionFailed(MotionFailure):
     """A simulator command ended without success.
 
     Attributes: ``command`` (what was asked, readable), ``reason`` (the

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 from pycram.fluent import Fluent
+from pycram.failures import MotionFailure
 
 __all__ = [
     "RosMotionFailed",
@@ -42,7 +43,7 @@ __all__ = [
 GOAL_STATUSES = ("succeeded", "aborted", "preempted", "rejected", "recalled", "lost")
 
 
-class RosMotionFailed(Exception):
+class RosMotionFailed(MotionFailure):
     """A goal sent over ROS ended without success.
 
     Attributes: ``command`` (what was asked, readable), ``action`` (the action's name),

@@ -321,6 +321,14 @@ class BeliefState(Belief):
         self.updated.set_value(report.stamp)
         return BeliefUpdate(tuple(added), tuple(refreshed), tuple(gone))
 
+    def put_down(self, obj: PerceivedObject, position: Iterable[float]) -> None:
+        """The robot itself put `obj` down at `position` (x, y, z) [m, map]: believe it there
+        (not gone) until the next look refreshes it. Its pose fluent pulses."""
+        with self._update_lock:
+            obj.pose = tuple(float(v) for v in position)
+            obj.gone = False
+            obj.pose_fluent.set_value(obj.pose)
+
     def _new_object(self, type_name: str, stamp: float) -> PerceivedObject:
         n = self._counts[type_name] = self._counts.get(type_name, 0) + 1
         obj = PerceivedObject(f"{type_name}-{n}", type_name, None, {"first_seen": stamp})

@@ -43,6 +43,8 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from pycram.failures import GoalUnreachable, NavigationFailure
+
 from .prospection import BasePose, as_base_pose
 
 __all__ = [
@@ -68,14 +70,8 @@ EXACT_BLOCK_CELLS = 3
 PoseCheck = Callable[[float, float, float], bool]
 
 
-class NavigationFailure(Exception):
-    """The base cannot get where it was asked to go. ``reason`` names why (see subclasses)."""
-
-    reason = "navigation_failed"
-
-
-class NoPathError(NavigationFailure):
-    """No collision-free path exists. ``reason``: ``'no_path'`` (start and goal are not connected
+class NoPathError(GoalUnreachable):
+    """No collision-free path exists (a `pycram.failures.GoalUnreachable`). ``reason``: ``'no_path'`` (start and goal are not connected
     on the free floor), ``'goal_in_collision'`` (the robot does not fit at the goal pose) or
     ``'outside_map'`` (start or goal is off the map). ``start``/``goal`` are the poses asked."""
 

@@ -1,0 +1,173 @@
+"""The action framework: typed constructors, the plan registry, and what every action plan uses.
+
+An action is a plan registered under an action type (`action_plan`), and a typed constructor
+that builds its `ActionDesignator` (`make_action`)::
+
+    @action_plan("parking_arms")
+    def park(designator): ...
+
+    def ParkArms() -> ActionDesignator:
+        return make_action("parking_arms")
+
+`perform(ParkArms())` resolves the designator through `resolve_action` (one entry of the global
+`ActionDesignator.resolvers`, added when `pycram.actions` is imported) to the registered plan and
+runs it as a task named ``perform parking_arms``. A robot or a world may still register its own
+plan for a type before the library's (their resolvers are asked first).
+
+The helpers below are what the action plans share: the active robot's arms and grippers (from
+its description: data, never code of a robot package), motions by keyword, a gripper's measured
+opening, unwrapping a process module's failure into the typed failure it carries, and running
+one attempt of an action as a task of its own so that the task tree shows every recovery.
+"""
+
+from __future__ import annotations
+
+import logging
+import weakref
+from collections.abc import Callable
+from typing import Any
+
+from pycram.designators.action import ActionDesignator
+from pycram.designators.core import DesignatorError, PropertyError
+from pycram.designators.motion import MotionDesignator
+from pycram.designators.perform import perform
+from pycram.failures import PlanFailure
+from pycram.fluent import Fluent
+from pycram.process_module import ProcessModuleError, ProcessModuleFailure
+from pycram.robot import current_robot
+
+__all__ = [
+    "ACTION_PLANS",
+    "ActionParameterError",
+    "RECOVERABLE",
+    "action_plan",
+    "make_action",
+    "resolve_action",
+    "motion",
+    "arms",
+    "arm_name",
+    "gripper_of",
+    "gripper_opening",
+    "opening_fluent",
+    "unwrap",
+    "attempt",
+]
+
+log = logging.getLogger("pycram.actions")
+
+#: Action type -> plan(designator): the plans of the action library.
+ACTION_PLANS: dict[str, Callable[[ActionDesignator], Any]] = {}
+
+#: Errors an action's recovery may handle (evaporation and programming errors always pass).
+RECOVERABLE = (PlanFailure, ProcessModuleError, DesignatorError)
+
+
+class ActionParameterError(PropertyError):
+    """An action designator's parameter is missing or invalid. Names the action, the key and,
+    where there are any, the valid values."""
+
+    def __init__(self, action: str, key: str, message: str, choices: Any = None) -> None:
+        text = f"{action}: parameter {key!r}: {message}"
+        if choices:
+            text += f" (valid: {', '.join(map(str, choices))})"
+        super().__init__(text)
+        self.action, self.key, self.choices = action, key, list(choices or ())
+
+
+def action_plan(action_type: str) -> Callable[[Callable[[ActionDesignator], Any]], Callable[[ActionDesignator], Any]]:
+    """Register the decorated function as the library's plan for `action_type`."""
+
+    def register(plan: Callable[[ActionDesignator], Any]) -> Callable[[ActionDesignator], Any]:
+        ACTION_PLANS[action_type] = plan
+        return plan
+
+    return register
+
+
+def make_action(action_type: str, **parameters: Any) -> ActionDesignator:
+    """An `ActionDesignator` of `action_type` with the parameters that are not None (a parameter
+    left None is chosen by resolution)."""
+    properties = [("type", action_type)]
+    properties += [(key, value) for key, value in parameters.items() if value is not None]
+    return ActionDesignator(properties)
+
+
+def resolve_action(designator: ActionDesignator) -> Any:
+    """Action resolver: the library's plan for the designator's type (None for other types)."""
+    return ACTION_PLANS.get(designator.prop_value("type"))
+
+
+def motion(**properties: Any) -> Any:
+    """Perform a motion designator made of `properties`; return the process module's result."""
+    return perform(MotionDesignator(**properties))
+
+
+def _description() -> Any:
+    robot = current_robot()
+    description = getattr(robot, "description", None)
+    if description is None:
+        raise PlanFailure(f"the action library needs an active robot with a description "
+                          f"(arms, grippers); active robot: {robot!r}")
+    return description
+
+
+def arms() -> list[str]:
+    """The active robot's arms, its default arm first (a one-armed robot has one)."""
+    d = _description()
+    names = list(d.ARMS)
+    default = getattr(d, "DEFAULT_ARM", names[0])
+    return [default] + [a for a in names if a != default]
+
+
+def arm_name(action: str, requested: Any) -> str | None:
+    """The robot's name for the arm `requested` (aliases allowed; None stays None)."""
+    if requested is None:
+        return None
+    d = _description()
+    aliases = getattr(d, "ARM_ALIASES", {a: a for a in d.ARMS})
+    if requested not in aliases:
+        raise ActionParameterError(action, "arm", f"the robot has no arm {requested!r}",
+                                   sorted(str(a) for a in aliases))
+    return str(aliases[requested])
+
+
+def gripper_of(arm: str) -> str:
+    """The gripper mounted on `arm`."""
+    return str(_description().ARMS[arm]["gripper"])
+
+
+_openings: weakref.WeakKeyDictionary[Any, dict[str, Fluent]] = weakref.WeakKeyDictionary()
+
+
+def opening_fluent(gripper: str) -> Fluent:
+    """A fluent that follows the measured opening [m] of `gripper` (a sensor:
+    ``subscribing_gripper``, subscribed once per robot and gripper)."""
+    robot = current_robot()
+    per_robot = _openings.setdefault(robot, {})
+    fluent = per_robot.get(gripper)
+    if fluent is None:
+        fluent = per_robot[gripper] = Fluent(name=f"{gripper} gripper opening")
+        motion(type="subscribing_gripper", gripper=gripper, fl=fluent)
+    return fluent
+
+
+def gripper_opening(gripper: str, timeout: float = 5.0) -> float:
+    """The measured opening [m] of `gripper` (see `opening_fluent`). Raises `PlanFailure` when
+    no measurement arrives within `timeout` [s of the active clock]."""
+    fluent = opening_fluent(gripper)
+    if not fluent.wait_for(timeout):
+        raise PlanFailure(f"no measurement of the {gripper} gripper's opening within {timeout} s")
+    return float(fluent.get_value())
+
+
+def unwrap(error: BaseException) -> BaseException:
+    """The typed failure inside a process module's failure (the error itself otherwise)."""
+    while isinstance(error, ProcessModuleFailure) and error.cause is not None:
+        error = error.cause
+    return error
+
+
+def attempt(name: str, body: Callable[[], Any]) -> Any:
+    """Run `body` as a task called `name` (so the task tree shows each attempt of an action)."""
+    from pycram.runtime import run_subtask
+    return run_subtask(name, body, kind="attempt")

@@ -1,0 +1,401 @@
+"""Picking up and placing objects, with recovery the CRAM way.
+
+`PickUp(object=cup)`: the object is taken from the belief (searched for when not believed);
+``('to_reach', object)`` chooses the standing pose, the arm and the grasp. One attempt drives
+there, looks at the object again, grasps (pre-grasp, grasp, close), lifts and carries. Recovery:
+
+- the standing pose cannot be driven to, the arm cannot reach, or the gripper closed on nothing:
+  the next standing pose (``next_solution()``) -- at most `STANDING_POSES` per perception;
+- the object moved since it was perceived (seen again more than `MOVED` away): location reasoning
+  again, for the new pose -- at most `PICK_ROUNDS` perceptions;
+- the object is gone from where it was believed: it is searched for again.
+
+After its attempts it raises `ObjectOutOfReach` (no standing pose at all) or `GraspFailed` (with
+every attempt's failure in ``attempts``). Success is checked from the sensors: the gripper's
+measured opening after closing and after lifting (an empty gripper closes to almost 0).
+
+`Place(object, target)`: the object held (the result of `PickUp`, or the believed object or
+designator that was picked up) is put at `target` -- a location designator (``('on', 'table')``),
+a `Spot`, a point or a surface's name. Each attempt drives to a standing pose from which the arm
+places there, puts the object down, lets go, retreats, and looks: the object must be seen within
+`PLACE_TOLERANCE` of the spot. While the base drives, the gripper's opening is watched: an object
+slipping out raises `ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
+holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
+
+Every attempt is a task of its own (kind ``attempt``), so the task tree shows each recovery.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+from pycram.designators.action import ActionDesignator
+from pycram.designators.core import NoSolutionError
+from pycram.designators.location import LocationDesignator
+from pycram.designators.object import ObjectDesignator
+from pycram.failures import (GraspFailed, GripperEmpty, NavigationFailure, ObjectNotVisible, ObjectOutOfReach,
+                             ObjectSlipped, PlacingFailed, PlanFailure)
+from pycram.language import State, pursue
+from pycram.robot import current_robot
+from pycram.world.belief import PerceivedObject
+from pycram.world.objects import Grasp, object_type
+
+from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, attempt, gripper_of,
+                   gripper_opening, make_action, motion, opening_fluent, unwrap)
+from .search import search_for
+
+__all__ = ["PickUp", "Place", "Held", "held_objects", "PICK_ROUNDS", "STANDING_POSES", "MOVED",
+           "PLACE_SPOTS", "PLACE_TOLERANCE", "HELD_FRACTION", "executable_grasps"]
+
+log = logging.getLogger("pycram.actions")
+
+#: Perceptions of the object per pick-up (the object moved or was lost in between).
+PICK_ROUNDS = 3
+#: Standing poses tried per perception.
+STANDING_POSES = 2
+#: The object counts as moved when seen again farther than this [m] from where it was planned for.
+MOVED = 0.03
+#: Spots tried per placing, and standing poses per spot.
+PLACE_SPOTS = 3
+PLACE_STANDING_POSES = 2
+#: A placed object must be seen this close [m] (horizontally) to its spot.
+PLACE_TOLERANCE = 0.05
+#: The gripper holds the object when its opening is at least this fraction of the grasp's opening.
+HELD_FRACTION = 0.5
+
+
+@dataclass
+class Held:
+    """An object in a gripper: the believed `object`, the `arm` and `gripper`, and the `grasp`."""
+
+    object: PerceivedObject
+    arm: str
+    gripper: str
+    grasp: Grasp
+
+    @property
+    def held_opening(self) -> float:
+        """Below this measured opening [m] the gripper holds nothing."""
+        return HELD_FRACTION * self.grasp.opening
+
+
+_holding: weakref.WeakKeyDictionary[Any, dict[str, Held]] = weakref.WeakKeyDictionary()
+
+
+def held_objects() -> dict[str, Held]:
+    """What the active robot's grippers hold, as far as its actions know (arm -> `Held`)."""
+    return _holding.setdefault(current_robot(), {})
+
+
+# -- constructors -------------------------------------------------------------------------------
+
+
+def PickUp(object: Any, arm: str | None = None, grasp: str | None = None) -> ActionDesignator:
+    """Pick up `object` (an object designator, or a believed object) with `arm` (None: the
+    reasoning chooses) and `grasp` (an approach such as ``'side'`` or ``'+y'``; None: any the
+    robot can execute). Returns a `Held`."""
+    return make_action("picking_up", object=object, arm=arm, grasp=grasp)
+
+
+def Place(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
+    """Put the held `object` (a `Held`, or the object designator / believed object picked up) at
+    `target`: a location designator such as ``('on', 'table')``, a `Spot`, a point (x, y, z)
+    [m, map: the object's centre] or a surface's name. Returns the believed object."""
+    return make_action("placing", object=object, target=target, arm=arm)
+
+
+# -- helpers --------------------------------------------------------------------------------------
+
+
+def executable_grasps(type_name: str, requested: str | None = None) -> list[Grasp]:
+    """The grasps of an object type that the robot's ``reaching`` motion can execute: the
+    horizontal approaches, and ``top`` when the motion type declares a ``grasp`` key."""
+    robot = current_robot()
+    types = getattr(robot, "motion_types", None) or {}
+    reaching = types.get("reaching")
+    top_ok = reaching is not None and any(k.name == "grasp" for k in reaching.all_keys())
+    grasps = [g for g in object_type(type_name).grasps if top_ok or g.approach != "top"]
+    if requested is not None:
+        grasps = [g for g in grasps if g.approach == requested]
+    return grasps
+
+
+def believed_object(action: str, wanted: Any) -> PerceivedObject:
+    """The believed object `wanted` stands for; an object designator the belief does not
+    satisfy is searched for."""
+    if isinstance(wanted, Held):
+        return wanted.object
+    if isinstance(wanted, PerceivedObject):
+        return wanted
+    if isinstance(wanted, str):
+        wanted = ObjectDesignator(type=wanted)
+    if not isinstance(wanted, ObjectDesignator):
+        raise ActionParameterError(action, "object", f"needs an object designator, a believed object or a "
+                                   f"type name, got {wanted!r}")
+    return search_for(wanted)
+
+
+def _search_again(wanted: Any, obj: PerceivedObject) -> PerceivedObject:
+    """Search for the object again (a fresh designator: the old one is equated to what was lost)."""
+    description = wanted.copy() if isinstance(wanted, ObjectDesignator) else ObjectDesignator(type=obj.type)
+    return search_for(description)
+
+
+def _grasp_point(obj: PerceivedObject, grasp: Grasp) -> list[float]:
+    x, y, z = obj.pose
+    return [x, y, z - object_type(obj.type).half_height + grasp.height]
+
+
+def _pose_text(location: Any) -> str:
+    return f"({location.x:.2f}, {location.y:.2f})"
+
+
+class _ObjectMoved(PlanFailure):
+    """Internal: the object was seen elsewhere than planned for (perceive and reason again)."""
+
+    default_reason = "object_moved"
+
+
+def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None) -> None:
+    """Best effort after a failed grasp: open the gripper, back off, arm up for driving."""
+    for step in (lambda: motion(type="setting_gripper", gripper=gripper, position=1),
+                 lambda: point and motion(type="reaching", arm=arm, target=point, phase="retreat"),
+                 lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry")):
+        try:
+            step()
+        except RECOVERABLE as error:
+            log.info("clean-up after a failed grasp: %s", unwrap(error))
+
+
+def _look_again(obj: PerceivedObject) -> None:
+    """Point the head at the believed object and look; refreshes (or marks gone) the belief."""
+    motion(type="pointing_head", coordinates=list(obj.pose))
+    motion(type="detecting", object=obj.type)
+
+
+def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
+    """One pick-up attempt from the standing pose `location` (see the module's description)."""
+    arm = location.arm
+    gripper = gripper_of(arm)
+    planned = tuple(obj.pose)
+    motion(type="setting_gripper", gripper=gripper, position=1)
+    motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    motion(type="moving", pose=location)
+    _look_again(obj)
+    if obj.gone:
+        raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
+    if math.dist(obj.pose, planned) > MOVED:
+        raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
+    point = _grasp_point(obj, grasp)
+    try:
+        motion(type="reaching", arm=arm, target=point, phase="pre_grasp")
+        motion(type="reaching", arm=arm, target=point, phase="grasp")
+        opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
+    except RECOVERABLE:
+        _let_go_and_retract(arm, gripper, point)
+        raise
+    held = Held(obj, arm, gripper, grasp)
+    if opening < held.held_opening:
+        _let_go_and_retract(arm, gripper, point)
+        raise GraspFailed(f"the {gripper} gripper closed on nothing at {_xyz(point)} "
+                          f"(opening {opening * 1000:.1f} mm)", obj)
+    motion(type="reaching", arm=arm, target=point, phase="lift")
+    motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    opening = gripper_opening(gripper)
+    if opening < held.held_opening:
+        raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting", obj)
+    return held
+
+
+def _xyz(p: Any) -> str:
+    return "(" + ", ".join(f"{v:.2f}" for v in p) + ")"
+
+
+# -- picking up -----------------------------------------------------------------------------------
+
+
+@action_plan("picking_up")
+def picking_up(designator: ActionDesignator) -> Held:
+    wanted = designator.prop_value("object")
+    if wanted is None:
+        raise ActionParameterError("picking_up", "object", "missing: what to pick up")
+    arm = arm_name("picking_up", designator.prop_value("arm"))
+    requested_grasp = designator.prop_value("grasp")
+    obj = believed_object("picking_up", wanted)
+    grasps = executable_grasps(obj.type, requested_grasp)
+    if not grasps:
+        available = [g.approach for g in object_type(obj.type).grasps]
+        raise GraspFailed(f"the robot cannot execute a grasp {requested_grasp or ''} of a {obj.type} "
+                          f"(its grasps: {', '.join(available)}; the reaching motion approaches "
+                          f"horizontally only)", designator, "no_executable_grasp")
+    by_approach = {g.approach: g for g in grasps}
+    attempts: list[str] = []
+    last: BaseException | None = None
+    for _ in range(PICK_ROUNDS):
+        properties: list[tuple[str, Any]] = [("to_reach", obj)]
+        if arm is not None:
+            properties.append(("arm", arm))
+        if requested_grasp is not None:
+            properties.append(("grasp", requested_grasp))
+        tried = 0
+        perceive_again = False
+        try:
+            for location in LocationDesignator(properties).solutions():
+                grasp = by_approach.get(location.grasp)
+                if grasp is None:
+                    continue
+                tried += 1
+                try:
+                    held = attempt(f"grasp {obj.name} from {_pose_text(location)} with the {location.arm} arm "
+                                   f"({location.grasp} grasp)", lambda: _grasp_from(location, obj, grasp))
+                except RECOVERABLE as error:
+                    cause = last = unwrap(error)
+                    attempts.append(f"from {_pose_text(location)}: {cause}")
+                    if isinstance(cause, ObjectNotVisible):
+                        obj = _search_again(wanted, obj)
+                        perceive_again = True
+                    elif isinstance(cause, _ObjectMoved):
+                        perceive_again = True
+                    if perceive_again:
+                        break
+                    if tried >= STANDING_POSES:
+                        break
+                    continue
+                held_objects()[held.arm] = held
+                log.info("picked up %s with the %s arm", obj.name, held.arm)
+                return held
+        except NoSolutionError as error:
+            if not attempts:
+                raise ObjectOutOfReach(f"no standing pose from which the robot can grasp {obj!r}: {error}",
+                                       designator, attempts=[str(error)]) from error
+            attempts.append(str(error))
+            last = error
+        if not perceive_again and tried == 0 and not attempts:
+            raise ObjectOutOfReach(f"no standing pose with a grasp the robot can execute for {obj!r}",
+                                   designator)
+        if not perceive_again:
+            break
+    message = f"could not pick up {obj!r} after {len(attempts)} attempts: " + "; ".join(attempts)
+    if isinstance(last, NavigationFailure) and all("drive" in a or "path" in a for a in attempts):
+        raise ObjectOutOfReach(message, designator, "no_drivable_pose", attempts) from last
+    raise GraspFailed(message, designator, getattr(last, "reason", None), attempts) from last
+
+
+# -- placing --------------------------------------------------------------------------------------
+
+
+def _held_for(designator: ActionDesignator) -> Held:
+    wanted = designator.prop_value("object")
+    arm = arm_name("placing", designator.prop_value("arm"))
+    holding = held_objects()
+    if isinstance(wanted, Held):
+        return wanted
+    candidates = [h for a, h in holding.items() if arm is None or a == arm]
+    if isinstance(wanted, ObjectDesignator):
+        candidates = [h for h in candidates if wanted.matches(h.object)]
+    elif isinstance(wanted, PerceivedObject):
+        candidates = [h for h in candidates if h.object is wanted]
+    elif isinstance(wanted, str):
+        candidates = [h for h in candidates if wanted in (h.object.type, h.object.name)]
+    if not candidates:
+        raise GripperEmpty(f"placing: no gripper holds {wanted!r} (holding: "
+                           f"{', '.join(f'{a}: {h.object.name}' for a, h in holding.items()) or 'nothing'})",
+                           designator)
+    return candidates[0]
+
+
+def _spots(target: Any, held: Held) -> Any:
+    """The spots `target` stands for, best first."""
+    if isinstance(target, str):
+        target = LocationDesignator([("on", target), ("for", held.object.type)])
+    if isinstance(target, LocationDesignator):
+        return target.solutions()
+    if hasattr(target, "position"):
+        return [tuple(target.position)]
+    return [tuple(float(v) for v in target)]
+
+
+def _drive_watching(location: Any, held: Held) -> None:
+    """Drive to `location`; raise `ObjectSlipped` as soon as the gripper is measured empty."""
+    fluent = opening_fluent(held.gripper)
+    dropped = fluent < held.held_opening
+    errors: list = []
+
+    def watch() -> None:
+        dropped.wait_for()
+        raise ObjectSlipped(f"{held.object.name} fell out of the {held.gripper} gripper while driving",
+                            held.object)
+
+    state = pursue(lambda: motion(type="moving", pose=location), watch, errors=errors, name="drive, holding")
+    if state.get_value() is not State.SUCCEEDED:
+        raise errors[0] if errors else PlanFailure("driving with the object did not succeed")
+
+
+def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
+    arm, gripper, obj = held.arm, held.gripper, held.object
+    motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    _drive_watching(location, held)
+    if gripper_opening(gripper) < held.held_opening:
+        raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)
+    motion(type="reaching", arm=arm, target=point, phase="pre_place")
+    motion(type="reaching", arm=arm, target=point, phase="place")
+    motion(type="setting_gripper", gripper=gripper, position=1)
+    held_objects().pop(arm, None)
+    belief = getattr(current_robot(), "belief", None)
+    if belief is not None:
+        belief.put_down(obj, spot)
+    motion(type="reaching", arm=arm, target=point, phase="retreat")
+    motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    motion(type="pointing_head", coordinates=list(spot))
+    motion(type="detecting", object=obj.type)
+    if obj.gone or math.dist(obj.pose[:2], spot[:2]) > PLACE_TOLERANCE:
+        where = "not seen" if obj.gone else f"seen at {_xyz(obj.pose)}"
+        raise PlacingFailed(f"{obj.name} does not rest at {_xyz(spot)}: {where}", obj)
+    return obj
+
+
+@action_plan("placing")
+def placing(designator: ActionDesignator) -> PerceivedObject:
+    target = designator.prop_value("target")
+    if target is None:
+        raise ActionParameterError("placing", "target", "missing: where to put the object")
+    held = _held_for(designator)
+    if gripper_opening(held.gripper) < held.held_opening:
+        held_objects().pop(held.arm, None)
+        raise GripperEmpty(f"the {held.gripper} gripper holds nothing ({held.object.name} was in it)", designator)
+    half = object_type(held.object.type).half_height
+    attempts: list[str] = []
+    last: BaseException | None = None
+    try:
+        for spot_number, spot in enumerate(_spots(target, held), start=1):
+            if spot_number > PLACE_SPOTS:
+                break
+            spot = tuple(float(v) for v in spot)
+            point = [spot[0], spot[1], spot[2] - half + held.grasp.height]
+            locations = LocationDesignator([("to_reach", tuple(point)), ("arm", held.arm), ("action", "place")])
+            try:
+                for pose_number, location in enumerate(locations.solutions(), start=1):
+                    if pose_number > PLACE_STANDING_POSES:
+                        break
+                    try:
+                        return attempt(f"place {held.object.name} at {_xyz(spot)} from {_pose_text(location)}",
+                                       lambda: _place_at(location, held, spot, point))
+                    except RECOVERABLE as error:
+                        cause = last = unwrap(error)
+                        attempts.append(f"at {_xyz(spot)} from {_pose_text(location)}: {cause}")
+                        if isinstance(cause, (ObjectSlipped, PlacingFailed)):
+                            raise cause from error
+            except NoSolutionError as error:
+                attempts.append(f"at {_xyz(spot)}: {error}")
+                last = error
+    except NoSolutionError as error:
+        raise ObjectOutOfReach(f"no spot at {target!r} for {held.object.name}: {error}", designator,
+                               attempts=attempts) from error
+    message = f"could not place {held.object.name} at {target!r}: " + "; ".join(attempts)
+    if last is None or isinstance(last, NoSolutionError):
+        raise ObjectOutOfReach(message, designator, attempts=attempts) from last
+    raise PlacingFailed(message, designator, getattr(last, "reason", None), attempts) from last

@@ -1,0 +1,62 @@
+"""Transporting: search, fetch, deliver -- one action, with the recoveries of its parts.
+
+`Transport(object=ObjectDesignator(type='cup'), target=LocationDesignator([('on', 'table')]))`
+finds the object (search when the belief does not hold it), picks it up (`PickUp`) and places it
+(`Place`). When the object is lost on the way -- it slipped or was taken from the gripper --
+it is searched for and fetched again, at most `TRANSPORT_ROUNDS` times; then the failure of the
+last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Returns the
+believed object where it was put.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from pycram.designators.action import ActionDesignator
+from pycram.designators.object import ObjectDesignator
+from pycram.designators.perform import perform
+from pycram.failures import GripperEmpty, ObjectSlipped
+
+from .core import ActionParameterError, action_plan, attempt, make_action
+from .manipulation import PickUp, Place, believed_object
+
+__all__ = ["Transport", "TRANSPORT_ROUNDS"]
+
+log = logging.getLogger("pycram.actions")
+
+#: Fetch-and-deliver rounds (the object lost on the way starts a new round).
+TRANSPORT_ROUNDS = 3
+
+
+def Transport(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
+    """Bring `object` (an object designator, a believed object or a type name) to `target` (as
+    for `Place`: a location designator, a `Spot`, a point or a surface's name) with `arm`
+    (None: chosen by the reasoning)."""
+    return make_action("transporting", object=object, target=target, arm=arm)
+
+
+@action_plan("transporting")
+def transporting(designator: ActionDesignator) -> Any:
+    wanted = designator.prop_value("object")
+    target = designator.prop_value("target")
+    if wanted is None or target is None:
+        raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
+    arm = designator.prop_value("arm")
+    last: BaseException | None = None
+    for round_number in range(1, TRANSPORT_ROUNDS + 1):
+        if round_number > 1 and isinstance(wanted, ObjectDesignator):
+            wanted = wanted.copy()  # the old one is equated to the object that was lost
+
+        def fetch_and_deliver(wanted: Any = wanted) -> Any:
+            obj = believed_object("transporting", wanted)
+            held = perform(PickUp(obj, arm=arm))
+            return perform(Place(held, target, arm=held.arm))
+
+        try:
+            return attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
+        except (ObjectSlipped, GripperEmpty) as error:
+            log.info("transporting: %s; fetching it again", error)
+            last = error
+    assert last is not None
+    raise last
