@@ -33,6 +33,7 @@ from pycram.language import State, par
 
 from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, arms, attempt, make_action,
                    motion, unwrap)
+from .core import solutions as location_solutions
 from .search import search_for
 
 __all__ = ["Navigate", "LookAt", "ParkArms", "MoveTorso", "SetGripper", "Detect", "Search",
@@ -111,7 +112,7 @@ def navigating(designator: ActionDesignator) -> Any:
     attempts: list[str] = []
     last: BaseException | None = None
     try:
-        solutions = iter(target.solutions())
+        solutions = iter(location_solutions(target))
         for number in range(1, NAVIGATION_ATTEMPTS + 1):
             pose = next(solutions, None)
             if pose is None:

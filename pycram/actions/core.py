@@ -24,11 +24,11 @@ from __future__ import annotations
 
 import logging
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
-from pycram.designators.core import DesignatorError, PropertyError
+from pycram.designators.core import DesignatorError, NoSolutionError, PropertyError
 from pycram.designators.motion import MotionDesignator
 from pycram.designators.perform import perform
 from pycram.failures import PlanFailure
@@ -49,8 +49,10 @@ __all__ = [
     "gripper_of",
     "gripper_opening",
     "opening_fluent",
+    "base_pose_fluent",
     "unwrap",
     "attempt",
+    "solutions",
 ]
 
 log = logging.getLogger("pycram.actions")
@@ -136,6 +138,7 @@ def gripper_of(arm: str) -> str:
     return str(_description().ARMS[arm]["gripper"])
 
 
+#: Sensor fluents per robot: grippers' openings by gripper name, the base pose.
 _openings: weakref.WeakKeyDictionary[Any, dict[str, Fluent]] = weakref.WeakKeyDictionary()
 
 
@@ -148,6 +151,18 @@ def opening_fluent(gripper: str) -> Fluent:
     if fluent is None:
         fluent = per_robot[gripper] = Fluent(name=f"{gripper} gripper opening")
         motion(type="subscribing_gripper", gripper=gripper, fl=fluent)
+    return fluent
+
+
+def base_pose_fluent() -> Fluent:
+    """A fluent that follows the active robot's base pose (`Pose2D`, map frame; a sensor:
+    ``subscribing_pose``, subscribed once per robot)."""
+    robot = current_robot()
+    per_robot = _openings.setdefault(robot, {})
+    fluent = per_robot.get(" base pose")
+    if fluent is None:
+        fluent = per_robot[" base pose"] = Fluent(name="base pose")
+        motion(type="subscribing_pose", fl=fluent)
     return fluent
 
 
@@ -165,6 +180,23 @@ def unwrap(error: BaseException) -> BaseException:
     while isinstance(error, ProcessModuleFailure) and error.cause is not None:
         error = error.cause
     return error
+
+
+def solutions(designator: Any) -> Iterator[Any]:
+    """The solutions of `designator`, best first. Unlike `Designator.solutions`, a designator
+    without any solution raises its `NoSolutionError` (which says what ruled the candidates
+    out); running out of further solutions ends the iteration."""
+    current = designator
+    yield current.reference()
+    while True:
+        current = current.next_solution()
+        if current is None:
+            return
+        try:
+            solution = current.reference()
+        except NoSolutionError:
+            return
+        yield solution
 
 
 def attempt(name: str, body: Callable[[], Any]) -> Any:

@@ -17,7 +17,8 @@ measured opening after closing and after lifting (an empty gripper closes to alm
 `Place(object, target)`: the object held (the result of `PickUp`, or the believed object or
 designator that was picked up) is put at `target` -- a location designator (``('on', 'table')``),
 a `Spot`, a point or a surface's name. Each attempt drives to a standing pose from which the arm
-places there, puts the object down, lets go, retreats, and looks: the object must be seen within
+places there, lowers the object until the place pose or until it touches down (the arm is
+blocked), lets go, retreats, and looks: the object must be seen within
 `PLACE_TOLERANCE` of the spot. While the base drives, the gripper's opening is watched: an object
 slipping out raises `ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
@@ -45,7 +46,8 @@ from pycram.world.belief import PerceivedObject
 from pycram.world.objects import Grasp, object_type
 
 from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, attempt, gripper_of,
-                   gripper_opening, make_action, motion, opening_fluent, unwrap)
+                   base_pose_fluent, gripper_opening, make_action, motion, opening_fluent, solutions,
+                   unwrap)
 from .search import search_for
 
 __all__ = ["PickUp", "Place", "Held", "held_objects", "PICK_ROUNDS", "STANDING_POSES", "MOVED",
@@ -59,9 +61,12 @@ PICK_ROUNDS = 3
 STANDING_POSES = 2
 #: The object counts as moved when seen again farther than this [m] from where it was planned for.
 MOVED = 0.03
-#: Spots tried per placing, and standing poses per spot.
-PLACE_SPOTS = 3
+#: Spots tried per placing (spots without a standing pose to place from included), and standing
+#: poses per spot.
+PLACE_SPOTS = 8
 PLACE_STANDING_POSES = 2
+#: A surface named as a placing target: spots near the side facing the robot, this far in [m].
+NEAR_SIDE_INSET = 0.15
 #: A placed object must be seen this close [m] (horizontally) to its spot.
 PLACE_TOLERANCE = 0.05
 #: The gripper holds the object when its opening is at least this fraction of the grasp's opening.
@@ -172,9 +177,15 @@ def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None) -> No
 
 
 def _look_again(obj: PerceivedObject) -> None:
-    """Point the head at the believed object and look; refreshes (or marks gone) the belief."""
+    """Point the head at the believed object and look: the belief is refreshed, or the object is
+    believed gone when it was not seen there."""
+    seen_before = obj.times_seen
     motion(type="pointing_head", coordinates=list(obj.pose))
     motion(type="detecting", object=obj.type)
+    if obj.times_seen == seen_before and not obj.gone:
+        belief = getattr(current_robot(), "belief", None)
+        if belief is not None:
+            belief.lost(obj)
 
 
 def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
@@ -201,6 +212,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     held = Held(obj, arm, gripper, grasp)
     if opening < held.held_opening:
         _let_go_and_retract(arm, gripper, point)
+        _look_again(obj)
+        if obj.gone:
+            raise ObjectNotVisible(f"the {gripper} gripper closed on nothing: {obj.name} is no longer at "
+                                   f"{_xyz(planned)}", obj, "lost")
         raise GraspFailed(f"the {gripper} gripper closed on nothing at {_xyz(point)} "
                           f"(opening {opening * 1000:.1f} mm)", obj)
     motion(type="reaching", arm=arm, target=point, phase="lift")
@@ -244,7 +259,7 @@ def picking_up(designator: ActionDesignator) -> Held:
         tried = 0
         perceive_again = False
         try:
-            for location in LocationDesignator(properties).solutions():
+            for location in solutions(LocationDesignator(properties)):
                 grasp = by_approach.get(location.grasp)
                 if grasp is None:
                     continue
@@ -308,12 +323,38 @@ def _held_for(designator: ActionDesignator) -> Held:
     return candidates[0]
 
 
+def _near_side(surface_name: str) -> tuple[float, float, float] | None:
+    """A point on the surface 0.15 m in from its edge nearest to the robot (None when the
+    environment does not know the surface)."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if environment is None:
+        return None
+    try:
+        surface = environment.surface(surface_name)
+    except KeyError:
+        return None
+    here = base_pose_fluent().get_value()
+    x0, y0, x1, y1 = surface.bounds
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    if here is None:
+        return (cx, cy, surface.height)
+    x, y = min(max(here.x, x0), x1), min(max(here.y, y0), y1)
+    inset = min(NEAR_SIDE_INSET, (x1 - x0) / 2, (y1 - y0) / 2)
+    x = min(max(x, x0 + inset), x1 - inset)
+    y = min(max(y, y0 + inset), y1 - inset)
+    return (x, y, surface.height)
+
+
 def _spots(target: Any, held: Held) -> Any:
-    """The spots `target` stands for, best first."""
+    """The spots `target` stands for, best first. A surface's name means: on that surface, near
+    its side facing the robot (within easy reach of every arm)."""
     if isinstance(target, str):
-        target = LocationDesignator([("on", target), ("for", held.object.type)])
+        near = _near_side(target)
+        target = LocationDesignator([("on", target), ("for", held.object.type)]
+                                    + ([("near", near)] if near is not None else []))
     if isinstance(target, LocationDesignator):
-        return target.solutions()
+        return solutions(target)
     if hasattr(target, "position"):
         return [tuple(target.position)]
     return [tuple(float(v) for v in target)]
@@ -342,13 +383,21 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     if gripper_opening(gripper) < held.held_opening:
         raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)
     motion(type="reaching", arm=arm, target=point, phase="pre_place")
-    motion(type="reaching", arm=arm, target=point, phase="place")
+    try:
+        motion(type="reaching", arm=arm, target=point, phase="place")
+    except RECOVERABLE as error:
+        if getattr(unwrap(error), "reason", None) != "blocked":
+            raise
+        log.info("placing %s: touched down before the place pose (%s)", obj.name, unwrap(error))
     motion(type="setting_gripper", gripper=gripper, position=1)
     held_objects().pop(arm, None)
     belief = getattr(current_robot(), "belief", None)
     if belief is not None:
         belief.put_down(obj, spot)
-    motion(type="reaching", arm=arm, target=point, phase="retreat")
+    try:
+        motion(type="reaching", arm=arm, target=point, phase="retreat")
+    except RECOVERABLE as error:  # the object is down: backing off is best effort
+        log.info("placing %s: retreat: %s", obj.name, unwrap(error))
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     motion(type="pointing_head", coordinates=list(spot))
     motion(type="detecting", object=obj.type)
@@ -378,7 +427,7 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
             point = [spot[0], spot[1], spot[2] - half + held.grasp.height]
             locations = LocationDesignator([("to_reach", tuple(point)), ("arm", held.arm), ("action", "place")])
             try:
-                for pose_number, location in enumerate(locations.solutions(), start=1):
+                for pose_number, location in enumerate(solutions(locations), start=1):
                     if pose_number > PLACE_STANDING_POSES:
                         break
                     try:
@@ -389,6 +438,9 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                         attempts.append(f"at {_xyz(spot)} from {_pose_text(location)}: {cause}")
                         if isinstance(cause, (ObjectSlipped, PlacingFailed)):
                             raise cause from error
+                        if held.arm not in held_objects():  # let go already: nothing to retry with
+                            raise PlacingFailed(f"{held.object.name} was let go at {_xyz(spot)}, then: {cause}",
+                                                designator, attempts=attempts) from error
             except NoSolutionError as error:
                 attempts.append(f"at {_xyz(spot)}: {error}")
                 last = error

@@ -329,6 +329,12 @@ class BeliefState(Belief):
             obj.gone = False
             obj.pose_fluent.set_value(obj.pose)
 
+    def lost(self, obj: PerceivedObject) -> None:
+        """The robot looked straight at where `obj` was believed and did not see it (its own arm
+        may have hidden the spot from the depth check): believe it gone."""
+        with self._update_lock:
+            obj.gone = True
+
     def _new_object(self, type_name: str, stamp: float) -> PerceivedObject:
         n = self._counts[type_name] = self._counts.get(type_name, 0) + 1
         obj = PerceivedObject(f"{type_name}-{n}", type_name, None, {"first_seen": stamp})

@@ -149,7 +149,7 @@ APPROACH_OFFSETS = {
     "retreat": (0.10, 0.02),
 }
 #: Position tolerance [m] of the tool per phase (grasping pushes against the item a little).
-REACH_TOLERANCE = {"grasp": 0.02, "place": 0.02, "default": 0.01}
+REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place": 0.02, "default": 0.01}
 
 #: Location reasoning: a grasp pose counts as reachable only if the tool also reaches this much
 #: [m] lower without touching anything (its forearm passes low over the furniture's edge; executed motions pass through configurations IK

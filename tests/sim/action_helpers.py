@@ -1,0 +1,117 @@
+"""Helpers of the action tests: the apartment with chosen objects at chosen spots, a robot on it,
+and judging results with the simulator's truth (never given to the plans)."""
+
+from __future__ import annotations
+
+import math
+import threading
+from contextlib import contextmanager
+from typing import Any, Iterator
+
+from sim_helpers import ok, tilt
+
+from pycram import robots
+from pycram.sim import World
+from pycram.world.objects import object_type
+
+#: Where the robot starts: in the middle of the apartment, facing the counter.
+START = (2.0, 1.5, math.pi / 2)
+#: Spots of the tests, (surface, (x, y)) [m]: free, reachable places on each kind of surface.
+COUNTER = ("counter", (1.0, 4.55))
+TABLE = ("table", (4.3, 1.7))
+CABINET = ("cabinet top", (0.3, 3.0))
+T = 60.0
+
+
+@contextmanager
+def apartment_with(robot_name: str, objects: dict[str, tuple[str, tuple[float, float]]],
+                   base_pose: tuple[float, float, float] = START) -> Iterator[tuple[World, Any]]:
+    """The apartment with `objects` (name -> (surface, (x, y))) standing upright, every other
+    object of the scene taken aside, and the robot `robot_name` active on it."""
+    names = list(objects)
+    world = World(robot_name, environment="apartment", objects=names, seed=1, base_pose=base_pose)
+    try:
+        for name, (surface, xy) in objects.items():
+            put(world, name, surface, xy)
+        robot = robots.load(robot_name, world)
+        try:
+            with robot:
+                yield world, robot
+        finally:
+            robot.shutdown()
+    finally:
+        world.close()
+
+
+def put(world: World, name: str, surface: str, xy: tuple[float, float]) -> None:
+    """Stand object `name` (an object type's name in these scenes) upright at `xy` on `surface`."""
+    height = world.environment.surface(surface).height
+    ok(world.move_item(name, (xy[0], xy[1], height + object_type(name).half_height + 0.002)))
+
+
+def rests_upright_at(world: World, name: str, surface: str, xy: tuple[float, float] | None = None,
+                     tolerance: float = 0.05) -> bool:
+    """True when `name` stands upright (< 20 deg) on `surface` (within `tolerance` [m] of `xy`)."""
+    pose = world.item_poses.get_value()[name]
+    x, y, z = pose.position
+    env_surface = world.environment.surface(surface)
+    on_it = env_surface.contains(x, y, 0.0) and abs(z - object_type(name).half_height - env_surface.height) < 0.03
+    near = xy is None or math.dist((x, y), xy) <= tolerance
+    return on_it and near and tilt(pose.orientation) < math.radians(20)
+
+
+def holding(world: World) -> set[str]:
+    """The items the robot's grippers hold (simulator truth)."""
+    return {s.holding for s in (f.get_value() for f in world.gripper_states.values()) if s and s.holding}
+
+
+def run_as_task(body: Any) -> tuple[Any, Any]:
+    """Run `body()` as a task of its own; returns (its result, the task), so that a test looks
+    only at the tasks this body started. Re-raises what the body raised."""
+    from pycram.runtime import current_task, run_subtask
+    holder: list[Any] = []
+
+    def scoped() -> Any:
+        holder.append(current_task())
+        return body()
+
+    return run_subtask("test body", scoped), holder[0]
+
+
+def tasks_named(root: Any, prefix: str) -> list[Any]:
+    """The tasks below `root` whose names start with `prefix`, in start order."""
+    return [t for t in root.walk() if str(t.name).startswith(prefix)]
+
+
+class OnceHolding:
+    """Runs `action(world)` in a thread of its own once the robot holds `item` and its base has
+    moved `distance` [m] from where it grasped it (a person acting while the robot carries).
+    Waits on fluents only; `join()` returns what the action returned."""
+
+    def __init__(self, world: World, item: str, action: Any, distance: float = 0.3) -> None:
+        self.world, self.item, self.action, self.distance = world, item, action, distance
+        self.done = threading.Event()
+        self.result: Any = None
+        self._thread = threading.Thread(target=self._run, daemon=True, name=f"person taking {item}")
+        self._thread.start()
+
+    def _run(self) -> None:
+        from pycram.fluent import Fluent
+        held = Fluent(lambda: True if self.item in holding(self.world) else None)
+        for f in self.world.gripper_states.values():
+            f.add_child(held)
+        if not held.wait_for(600.0):
+            self.done.set()
+            return
+        start = self.world.base_pose.get_value()
+        away = Fluent(lambda: True if math.hypot(self.world.base_pose.get_value().x - start.x,
+                                                  self.world.base_pose.get_value().y - start.y)
+                      > self.distance else None)
+        self.world.base_pose.add_child(away)
+        if away.wait_for(600.0):
+            self.result = self.action(self.world)
+        self.done.set()
+
+    def join(self, timeout: float = 60.0) -> Any:
+        assert self.done.wait(timeout), "the person never acted"
+        return self.result
