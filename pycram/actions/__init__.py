@@ -19,6 +19,7 @@ robot or world by an action resolver of its own (asked before the library's).
 from pycram.designators.action import ActionDesignator
 
 from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
+from .containers import Close, Open
 from .core import ACTION_PLANS, ActionParameterError, resolve_action
 from .manipulation import Held, PickUp, Place, held_objects
 from .search import Lookout, ObjectNotFound, look_around, lookouts, search_for
@@ -29,7 +30,7 @@ if resolve_action not in ActionDesignator.resolvers:
 
 __all__ = [
     "Navigate", "LookAt", "ParkArms", "MoveTorso", "SetGripper", "Detect", "Search",
-    "PickUp", "Place", "Transport", "Held", "held_objects",
+    "PickUp", "Place", "Transport", "Open", "Close", "Held", "held_objects",
     "ACTION_PLANS", "ActionParameterError", "resolve_action",
     "Lookout", "ObjectNotFound", "look_around", "lookouts", "search_for",
 ]

@@ -15,7 +15,8 @@ constructor        plan does                                 raises (after its a
 `SetGripper`       open (1) or close (0) a gripper            `MotionFailure`
 `Detect`           one look; the objects seen                 `ObjectNotVisible` (object asked, not
                                                               seen)
-`Search`           `pycram.actions.search.search_for`         `ObjectNotFound`
+`Search`           `pycram.actions.search.search_for`,         `ObjectNotFound`
+                   opening closed drawers with `Open`
 =================  ========================================  =====================================
 """
 
@@ -28,6 +29,7 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
+from pycram.designators.perform import perform
 from pycram.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
 from pycram.language import State, par
 
@@ -221,4 +223,5 @@ def searching(designator: ActionDesignator) -> Any:
         wanted = ObjectDesignator(type=wanted)
     if not isinstance(wanted, ObjectDesignator):
         raise ActionParameterError("searching", "object", f"needs an object designator or a type name, got {wanted!r}")
-    return search_for(wanted)
+    from .containers import Open
+    return search_for(wanted, open_container=lambda name: perform(Open(name)))

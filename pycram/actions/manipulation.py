@@ -117,13 +117,11 @@ def Place(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
 
 
 def executable_grasps(type_name: str, requested: str | None = None) -> list[Grasp]:
-    """The grasps of an object type that the robot's ``reaching`` motion can execute: the
-    horizontal approaches, and ``top`` when the motion type declares a ``grasp`` key."""
-    robot = current_robot()
-    types = getattr(robot, "motion_types", None) or {}
-    reaching = types.get("reaching")
-    top_ok = reaching is not None and any(k.name == "grasp" for k in reaching.all_keys())
-    grasps = [g for g in object_type(type_name).grasps if top_ok or g.approach != "top"]
+    """The grasps of an object type that picking up executes: the horizontal approaches. Top
+    grasps are left out: the ``reaching`` motion can point the tool down (``grasp='top'``), but
+    a rim grasp (bowls, plates) needs the rim's point and a spoon the object's yaw, which
+    perception does not measure yet."""
+    grasps = [g for g in object_type(type_name).grasps if g.approach != "top"]
     if requested is not None:
         grasps = [g for g in grasps if g.approach == requested]
     return grasps
@@ -141,13 +139,21 @@ def believed_object(action: str, wanted: Any) -> PerceivedObject:
     if not isinstance(wanted, ObjectDesignator):
         raise ActionParameterError(action, "object", f"needs an object designator, a believed object or a "
                                    f"type name, got {wanted!r}")
-    return search_for(wanted)
+    return _search(wanted)
+
+
+def _search(description: ObjectDesignator) -> PerceivedObject:
+    """`search_for`, opening closed drawers with the `Open` action."""
+    from pycram.designators.perform import perform
+
+    from .containers import Open
+    return search_for(description, open_container=lambda name: perform(Open(name)))
 
 
 def _search_again(wanted: Any, obj: PerceivedObject) -> PerceivedObject:
     """Search for the object again (a fresh designator: the old one is equated to what was lost)."""
     description = wanted.copy() if isinstance(wanted, ObjectDesignator) else ObjectDesignator(type=obj.type)
-    return search_for(description)
+    return _search(description)
 
 
 def _grasp_point(obj: PerceivedObject, grasp: Grasp) -> list[float]:

@@ -5,8 +5,9 @@
 1. if the robot's belief already holds one, that is the answer;
 2. it looks around from where it stands: at each likely place within `look_range` [m], nearest
    first, it points the head there and detects;
-3. it visits the likely places it has not looked at closely, nearest first: it drives to a
-   standing pose in front of each, points the head at it and detects;
+3. it visits the likely places it has not looked at closely, nearest first -- places inside
+   containers not known to be open last: it drives to a standing pose in front of each,
+   points the head at it and detects;
 4. it fails with `pycram.failures.ObjectNotFound`, which names every place it looked at and
    the places it could not look into (closed containers, places it could not reach).
 
@@ -261,8 +262,12 @@ def search_for(description: ObjectDesignator, *, belief: BeliefState | None = No
     found = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
     if found:
         return found[0]
-    # 2. visit the likely places, nearest first
-    for lookout in places:
+    # 2. visit the likely places, nearest first -- those behind a closed door or drawer last
+    #    (opening is slow, and an opened drawer stands in the way)
+    def closed_first_last(lookout: Lookout) -> bool:
+        return lookout.container is not None and belief.container_open(lookout.container) is not True
+
+    for lookout in sorted(places, key=closed_first_last):
         if lookout.name in close:
             continue
         found = _visit(description, lookout, environment, belief, open_container, looked, skipped)

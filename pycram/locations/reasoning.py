@@ -101,6 +101,12 @@ def _quat_yaw(yaw: float) -> tuple[float, float, float, float]:
     return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
 
 
+def _quat_yaw_rolled(yaw: float) -> tuple[float, float, float, float]:
+    """Tool x along `yaw`, turned 90 deg about itself: the fingers open vertically."""
+    c, s, r = math.cos(yaw / 2), math.sin(yaw / 2), math.sqrt(0.5)
+    return (c * r, c * r, s * r, s * r)
+
+
 def _quat_down(yaw: float) -> tuple[float, float, float, float]:
     """Tool x pointing down, tool y across `yaw` (rotation about z by yaw, then about y by 90 deg)."""
     cz, sz, c, s = math.cos(yaw / 2), math.sin(yaw / 2), math.cos(math.pi / 4), math.sin(math.pi / 4)
@@ -393,13 +399,19 @@ class LocationReasoner:
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
             c0, s0 = math.cos(headings[0]), math.sin(headings[0])
-            poses = [((hx - c0 * back, hy - s0 * back, hz), _quat_yaw(headings[0]))]
-            # the hand grasps the handle facing it, then follows its path (position only: the
-            # wrist turns with a door as it likes)
-            poses += [(trajectory[0], _quat_yaw(headings[0]))] + [(p, None) for p in trajectory[1:]]
+            # A drawer's handle is a horizontal bar: the fingers close on it vertically and keep
+            # that orientation along the straight pull. A door's handle is vertical: the fingers
+            # close horizontally, and the wrist turns with the door as it likes (position only).
+            if container.kind == "drawer":
+                grip, hold = _quat_yaw_rolled(headings[0]), _quat_yaw_rolled(headings[0])
+            else:
+                grip, hold = _quat_yaw(headings[0]), None
+            poses = [((hx - c0 * back, hy - s0 * back, hz), grip), (trajectory[0], grip)]
+            poses += [(p, hold) for p in trajectory[1:]]
             answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
             if answer:
-                return BaseLocation(x, y, yaw, arm, "handle", cost, joints=answer.solutions), None
+                handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
+                return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions), None
             return None, (f"unreachable for arm {arm!r}", answer.reason)
 
         target = Target(container.handle, "container", container.name, thing=container)

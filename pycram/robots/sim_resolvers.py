@@ -50,6 +50,7 @@ __all__ = [
     "physical_arm",
     "physical_gripper",
     "approach_target",
+    "REACH_GRASPS",
     "base_pose_to_reach",
     "make_location_generator",
     "known_objects_of",
@@ -132,13 +133,22 @@ def describe_free_floor(world: Any) -> str:
     return f"the free floor of {env.name} ({areas}, off the furniture)"
 
 
+#: How the tool meets its target in the ``reaching`` motion (the ``grasp`` key): along the base's
+#: heading with the fingers opening horizontally (``'front'``, the default) or vertically
+#: (``'front_vertical'``: for horizontal bars such as drawer handles), or from above
+#: (``'top'``: the tool points down, the fingers open across the base's heading).
+REACH_GRASPS = ("front", "front_vertical", "top")
+
+
 def approach_target(description: Any, base: Pose2D, target: Sequence[float],
-                    phase: Optional[str]) -> tuple[tuple[float, float, float], tuple[float, ...]]:
+                    phase: Optional[str], grasp: Optional[str] = None
+                    ) -> tuple[tuple[float, float, float], tuple[float, ...]]:
     """Tool position [m, map] and orientation (w, x, y, z) for ``phase`` of reaching ``target``.
 
-    The approach direction is the base's heading: the tool points along it (fingers opening
-    horizontally) and is moved ``back`` [m] against it and ``up`` [m] per
-    ``description.APPROACH_OFFSETS[phase]`` (no offset without a phase).
+    The approach direction is the base's heading (``grasp`` ``'front'``/``'front_vertical'``,
+    see `REACH_GRASPS`): the tool points along it and is moved ``back`` [m] against it and
+    ``up`` [m] per ``description.APPROACH_OFFSETS[phase]`` (no offset without a phase). From the
+    ``'top'`` the tool points down and both offsets lift it.
     """
     x, y, z = _point(target)
     if phase is None:
@@ -148,8 +158,30 @@ def approach_target(description: Any, base: Pose2D, target: Sequence[float],
         if phase not in offsets:
             raise ValueError(f"unknown reaching phase {phase!r}; available: {sorted(offsets)}")
         back, up = offsets[phase]
+    grasp = grasp or "front"
+    if grasp not in REACH_GRASPS:
+        raise ValueError(f"unknown reaching grasp {grasp!r}; available: {', '.join(REACH_GRASPS)}")
+    if grasp == "top":
+        return (x, y, z + back + up), _quat_down(base.yaw)
     c, s = math.cos(base.yaw), math.sin(base.yaw)
-    return (x - c * back, y - s * back, z + up), yaw_to_quat(base.yaw)
+    orientation = yaw_to_quat(base.yaw)
+    if grasp == "front_vertical":
+        orientation = _quat_multiply(orientation, (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0))
+    return (x - c * back, y - s * back, z + up), orientation
+
+
+def _quat_down(yaw: float) -> tuple[float, float, float, float]:
+    """Tool x pointing down, tool y across `yaw` (about z by `yaw`, then about y by 90 deg)."""
+    cz, sz, c, s = math.cos(yaw / 2), math.sin(yaw / 2), math.cos(math.pi / 4), math.sin(math.pi / 4)
+    return (cz * c, -sz * s, cz * s, sz * c)
+
+
+def _quat_multiply(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
+    """The rotation `a` then `b` (in `a`'s frame): Hamilton product a * b, (w, x, y, z)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw)
 
 
 def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
@@ -227,7 +259,8 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
             arm = physical_arm(d, desig.prop_value("arm"))
             phase = desig.prop_value("phase")
             target = _point(desig.prop_value("target"))
-            position, orientation = approach_target(d, world.base_pose.get_value(), target, phase)
+            position, orientation = approach_target(d, world.base_pose.get_value(), target, phase,
+                                                    desig.prop_value("grasp"))
             tolerance = d.REACH_TOLERANCE.get(phase, d.REACH_TOLERANCE["default"])
             solutions.append(desig.make_dictionary(
                 [("cmd", "reach"), ("arm", arm), ("position", position),

@@ -14,7 +14,7 @@ import math
 from typing import Any
 
 from pycram.designators.motion_types import GoalOutsideEnvironment, MotionKey, MotionType
-from pycram.robots.sim_resolvers import base_goal_in_map, describe_free_floor, on_free_floor
+from pycram.robots.sim_resolvers import REACH_GRASPS, base_goal_in_map, describe_free_floor, on_free_floor
 
 __all__ = ["motion_types"]
 
@@ -85,6 +85,10 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                        MotionKey("phase", "approach phase: offset of the tool from the target "
                                  "(default: none)", form="name", required=False,
                                  choices=tuple(d.APPROACH_OFFSETS)),
+                       MotionKey("grasp", "how the tool meets the target: 'front' along the base's "
+                                 "heading, fingers opening horizontally (default); "
+                                 "'front_vertical' fingers opening vertically; 'top' from above",
+                                 form="name", required=False, choices=REACH_GRASPS),
                    )),
         MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)",
                    (fluent,)),

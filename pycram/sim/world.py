@@ -90,8 +90,8 @@ class World:
     Items are given as `ItemSpec`s (`items`; by default the thesis kitchen's `DEFAULT_ITEMS`
     there and none elsewhere) and/or as object type names (`objects`, e.g. ``["cup", "bowl",
     "cup"]``), which are placed at random, non-overlapping spots on the environment's surfaces
-    and inside its containers, the same for the same `seed` (see `pycram.world.scenes`); they
-    are named after their type ("cup", "cup 2") and `placements` says where each started.
+    and inside its containers (only on the surfaces named in `supports`, when given), the same
+    for the same `seed` (see `pycram.world.scenes`); they are named after their type ("cup", "cup 2") and `placements` says where each started.
 
     Construction builds the scene (< 1 s) and starts the thread. `close()` (or leaving the
     `with` block) stops it and joins it; every command still running ends with reason "closed".
@@ -102,7 +102,7 @@ class World:
     def __init__(self, robot: str = "pr2", items: Sequence[ItemSpec] | None = None, *,
                  environment: str | Environment = DEFAULT_ENVIRONMENT,
                  objects: Sequence[str] | None = None, seed: int = 0,
-                 base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
+                 supports: Sequence[str] | None = None, base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
                  realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
                  offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True,
                  perception_faults: PerceptionFaults | None = None) -> None:
@@ -111,7 +111,8 @@ class World:
         self.perception_faults = perception_faults or PerceptionFaults()
         self._fault_rng = np.random.default_rng(self.perception_faults.seed)
         #: Where the `objects` started (a random scene from `seed`; empty without objects).
-        self.placements = random_scene(env, objects, seed) if objects else []
+        #: `supports` (surface names) restricts where they may start.
+        self.placements = random_scene(env, objects, seed, supports=supports) if objects else []
         if self.placements:
             items = list(items or []) + [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw)
                                          for p in self.placements]

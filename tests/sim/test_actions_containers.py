@@ -1,0 +1,67 @@
+"""Opening and closing drawers (issue 16) and searching closed drawers (issue 15), judged with
+the simulator's truth: the drawer's joint really moved, the object really was inside."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from action_helpers import TABLE, apartment_with, put, run_as_task, tasks_named
+from sim_helpers import ok
+
+from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, Search
+from pycram.designator import ObjectDesignator, perform
+from pycram.failures import ContainerFailure, ContainerStuck
+
+ROBOTS = ("pr2", "tiago")
+
+
+def opening_of(world, name: str) -> float:
+    return world.container_states.get_value()[name]
+
+
+@pytest.mark.parametrize("robot_name", ROBOTS)
+def test_a_drawer_is_opened_and_closed_by_pulling_and_pushing_its_handle(robot_name):
+    with apartment_with(robot_name, {"cup": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        measured = perform(Open("drawer 3"))
+        assert opening_of(world, "drawer 3") >= 0.15
+        assert abs(measured - opening_of(world, "drawer 3")) < 0.01  # perceived, not assumed
+        perform(Close("drawer 3"))
+        assert opening_of(world, "drawer 3") < 0.03
+
+
+def test_a_stuck_drawer_raises_container_stuck_after_every_standing_pose():
+    with apartment_with("pr2", {"cup": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        ok(world.set_container_stuck("drawer 3"))
+        with pytest.raises(ContainerStuck, match="drawer 3") as caught:
+            run_as_task(lambda: perform(Open("drawer 3")))
+        error = caught.value
+        assert error.container == "drawer 3" and len(error.attempts) >= 2
+        assert opening_of(world, "drawer 3") < 0.02
+
+
+def test_doors_are_not_opened_by_robots_yet_and_say_so():
+    with apartment_with("tiago", {"cup": TABLE}) as (world, robot):
+        with pytest.raises(ContainerFailure, match="drawers only") as caught:
+            perform(Open("fridge"))
+        assert caught.value.reason == "door_not_supported"
+        with pytest.raises(ActionParameterError, match=r"no container 'drawer 9'.*valid: drawer 1"):
+            perform(Open("drawer 9"))
+
+
+def test_search_opens_a_closed_drawer_and_finds_the_cup_inside():
+    with apartment_with("pr2", {"cup": ("drawer 2 inside", (0.3, 2.9))}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        assert opening_of(world, "drawer 2") < 0.01
+        found, task = run_as_task(lambda: perform(Search(ObjectDesignator(type="cup"))))
+        assert found.type == "cup" and found.properties["in"] == "drawer 2"
+        truth = world.item_poses.get_value()["cup"].position
+        assert math.dist(found.pose[:2], truth[:2]) < 0.05
+        assert opening_of(world, "drawer 2") >= 0.15
+        openings = tasks_named(task, "perform opening")  # drawers on the way may be opened too
+        assert openings and all(t.status.get_value().value == "succeeded" for t in openings)
