@@ -220,7 +220,7 @@ def test_to_open_stands_clear_of_the_opening_and_follows_the_handle():
         drawer = LocationDesignator([("to_open", "drawer 3"), ("opening", 0.2)]).reference()
     hx, hy = fridge.hinge
     assert math.hypot(door.x - hx, door.y - hy) > 0.7 + 0.335  # outside the door's swing
-    assert door.grasp == "handle"
+    assert door.grasp == "front" and drawer.grasp == "front_vertical"  # how the fingers meet the handle
     handle_path = asked[0][1:]
     assert handle_path[0] == pytest.approx(fridge.handle) and handle_path[-1] == pytest.approx(fridge.handle_position(1.2))
     assert drawer.x > 0.6 + 0.2 + 0.335  # in front of the drawer pulled out 0.2 m

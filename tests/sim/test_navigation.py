@@ -65,3 +65,34 @@ def test_an_obstacle_on_the_goal_fails_with_no_path_and_the_base_stays(world):
     finally:
         ok(world.remove_obstacle(obstacle))
 
+
+
+def _distance_to_segment(p, a, b) -> float:
+    (px, py), (ax, ay), (bx, by) = p, a, b
+    dx, dy = bx - ax, by - ay
+    t = max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy)))
+    return math.hypot(px - ax - t * dx, py - ay - t * dy)
+
+
+def test_a_door_left_open_across_the_route_is_driven_around():
+    from sim_helpers import settle
+
+    from pycram.sim import World
+
+    world = World("pr2", environment="apartment", base_pose=(1.5, 3.5, 0.0))
+    try:
+        fridge = world.environment.container("fridge")
+        ok(world.push_container("fridge", (0.0, -40.0, 0.0), 1.0))  # a person leaves it open
+        settle(world, 2.0)
+        q = world.container_states.get_value()["fridge"]
+        door = (fridge.hinge, fridge.handle_position(q)[:2])
+        assert _distance_to_segment((2.6, 3.5), *door) < 0.3, f"the door (q={q:.2f}) is not across the route"
+        poses = Recorder(world.base_pose)
+        out = world.drive_to(4.5, 3.5, 0.0).wait(T)
+        assert out is not None and out.succeeded, out
+        # around the door, never touching it: it is where it was left
+        assert abs(world.container_states.get_value()["fridge"] - q) < 0.02
+        closest = min(_distance_to_segment((p.x, p.y), *door) for p in poses.samples)
+        assert closest > _footprint_radius(world)
+    finally:
+        world.close()
