@@ -32,12 +32,19 @@ def default_environment() -> str:
     return "apartment" if has_environment("apartment") else KITCHEN
 
 
+#: The objects of a scene in an environment without items of its own (a random scene, seed 3).
+SCENE_OBJECTS = ("cup", "milk", "bowl", "cereal")
+
+
 def open_world(robot: str, env: str):
-    """A running `World` with `robot` in environment `env`."""
+    """A running `World` with `robot` in environment `env` (with a random breakfast scene,
+    seed 3, where the environment has no items of its own)."""
     from pycram.sim import World
 
     if "environment" in inspect.signature(World).parameters:
-        return World(robot, environment=env)
+        if env == KITCHEN:
+            return World(robot, environment=env)
+        return World(robot, environment=env, objects=list(SCENE_OBJECTS), seed=3)
     if env != KITCHEN:
         raise SystemExit(f"environment {env!r} is not available in this version; only {KITCHEN!r}")
     return World(robot)

@@ -24,7 +24,7 @@ import time
 from _worlds import default_environment, floor_planner, open_world
 
 
-def _questions(world, rng: random.Random) -> dict[str, list]:
+def _questions(world, rng: random.Random, prospection) -> dict[str, list]:
     planner = floor_planner(world)
     grid = planner.grid
     rows, cols = grid.occupied.nonzero()
@@ -39,9 +39,15 @@ def _questions(world, rng: random.Random) -> dict[str, list]:
     items = world.item_poses.get_value()
     for name, pose in items.items():
         x, y, z = pose.position
-        for _ in range(40):
+        asked = 0
+        for _ in range(400):  # base poses where the robot fits: the IK is what is measured
+            if asked == 40:
+                break
             d, a = rng.uniform(0.5, 0.8), rng.uniform(-math.pi, math.pi)
             base = (x - d * math.cos(a), y - d * math.sin(a), a)
+            if prospection.in_collision(base):
+                continue
+            asked += 1
             q = (math.cos(a / 2), 0.0, 0.0, math.sin(a / 2))
             c, s = math.cos(a), math.sin(a)
             seq = [((x - 0.1 * c, y - 0.1 * s, z), q), ((x, y, z), q), ((x, y, z + 0.1), q)]
@@ -85,7 +91,7 @@ def main(argv: list[str]) -> int:
     rng = random.Random(13)
     with open_world(args.robot, args.env) as world:
         p = world.prospection()
-        qs = _questions(world, rng)
+        qs = _questions(world, rng, p)
         print(f"prospection with the {args.robot} in {args.env!r}, {args.threads} thread(s), "
               f"the simulation running ({len(qs['reach'])} reach / {len(qs['see'])} visibility questions "
               f"about {len(world.item_poses.get_value())} objects)")
