@@ -49,8 +49,7 @@ def tilt(orientation) -> float:
 def run_one(robot_name: str, type_name: str, seed: int) -> tuple[bool, str, float, float]:
     """(succeeded, failure cause or "", simulated s, wall s) of one transport."""
     others = [t for t in DISTRACTORS.get(type_name, DISTRACTORS["default"]) if t != type_name][:2]
-    world = World(robot_name, environment="apartment", objects=[type_name, *others], seed=seed,
-                  supports=OPEN_SURFACES)
+    world = World(robot_name, environment="apartment", objects=[type_name, *others], seed=seed, supports=OPEN_SURFACES)
     start = world.placements[0]
     target = "counter" if start.support == "table" else "table"
     robot = robots.load(robot_name, world)
@@ -68,8 +67,11 @@ def run_one(robot_name: str, type_name: str, seed: int) -> tuple[bool, str, floa
         pose = world.item_poses.get_value()[start.name]
         surface = world.environment.surface(target)
         x, y, z = pose.position
-        ok = (surface.contains(x, y, 0.0) and abs(z - object_type(type_name).half_height - surface.height) < 0.03
-              and tilt(pose.orientation) < math.radians(20))
+        ok = (
+            surface.contains(x, y, 0.0)
+            and abs(z - object_type(type_name).half_height - surface.height) < 0.03
+            and tilt(pose.orientation) < math.radians(20)
+        )
         robot.shutdown()
         world.close()
     if not ok and not cause:
@@ -101,16 +103,21 @@ def main() -> None:
             all_wall += [r[3] for r in ok]
             total += len(results)
             succeeded += len(ok)
-            print(f"{robot_name:6s} {type_name:7s} {len(ok):3d}/{len(results)} succeeded  "
-                  f"sim p50 {np.median(sims):6.1f} s  wall p50 {np.median(walls):5.1f} s  "
-                  f"(x{np.median(sims) / np.median(walls):.1f} real time)", flush=True)
+            print(
+                f"{robot_name:6s} {type_name:7s} {len(ok):3d}/{len(results)} succeeded  "
+                f"sim p50 {np.median(sims):6.1f} s  wall p50 {np.median(walls):5.1f} s  "
+                f"(x{np.median(sims) / np.median(walls):.1f} real time)",
+                flush=True,
+            )
     print("\nfailures by cause:")
     for key, counter in causes.items():
         print(f"  {key}: " + ", ".join(f"{cause} x{n}" for cause, n in counter.most_common()))
     sim50 = float(np.median(all_sim)) if all_sim else float("nan")
     wall50 = float(np.median(all_wall)) if all_wall else float("nan")
-    print(f"transporting: {succeeded}/{total} succeeded ({100.0 * succeeded / max(total, 1):.0f} %), "
-          f"sim p50 {sim50:.1f} s, wall p50 {wall50:.1f} s")
+    print(
+        f"transporting: {succeeded}/{total} succeeded ({100.0 * succeeded / max(total, 1):.0f} %), "
+        f"sim p50 {sim50:.1f} s, wall p50 {wall50:.1f} s"
+    )
 
 
 if __name__ == "__main__":

@@ -37,15 +37,23 @@ def main(names: list[str]) -> int:
     if unknown:
         print(f"unknown scenario(s) {unknown}; choose from {list(SCENARIOS)}", file=sys.stderr)
         return 2
-    print(f"{'scenario':<10} {'outcome':<8} {'plan sim [s]':>12} {'plan wall [s]':>13} "
-          f"{'factor':>7} {'whole run [s]':>13}")
+    print(
+        f"{'scenario':<10} {'outcome':<8} {'plan sim [s]':>12} {'plan wall [s]':>13} "
+        f"{'factor':>7} {'whole run [s]':>13}"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         for name in names or list(SCENARIOS):
-            result = run_demo(DemoOptions(output=Path(tmp) / name, quiet=True,
-                                          db=f"sqlite:///{Path(tmp) / 'runs.sqlite3'}", **SCENARIOS[name]))
+            result = run_demo(
+                DemoOptions(
+                    output=Path(tmp) / name, quiet=True, db=f"sqlite:///{Path(tmp) / 'runs.sqlite3'}", **SCENARIOS[name]
+                )
+            )
             outcome = "success" if result.exit_code == 0 else "failure"
-            print(f"{name:<10} {outcome:<8} {result.sim_time:12.1f} {result.plan_wall_time:13.1f} "
-                  f"{result.speed_factor:6.1f}x {result.wall_time:13.1f}", flush=True)
+            print(
+                f"{name:<10} {outcome:<8} {result.sim_time:12.1f} {result.plan_wall_time:13.1f} "
+                f"{result.speed_factor:6.1f}x {result.wall_time:13.1f}",
+                flush=True,
+            )
     return 0
 
 

@@ -52,8 +52,9 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
@@ -162,7 +163,6 @@ def recording(enabled: bool, url: str | None = None) -> Iterator[Any]:
 def recording_available() -> bool:
     try:
         import pycram.trace  # noqa: F401
-
         from pycram.trace import Recorder  # noqa: F401
     except ImportError:
         return False
@@ -729,8 +729,13 @@ def import_self_seconds(module: str, repeat: int) -> float:
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
 
     def once() -> float:
-        err = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"], check=True,
-                             env=env, capture_output=True, text=True).stderr
+        err = subprocess.run(
+            [sys.executable, "-X", "importtime", "-c", f"import {module}"],
+            check=True,
+            env=env,
+            capture_output=True,
+            text=True,
+        ).stderr
         for line in err.splitlines():
             parts = [x.strip() for x in line.split("|")]
             if len(parts) == 3 and parts[2] == module:
@@ -868,12 +873,12 @@ def build_table(title: str, pc: dict[str, Any], floor: dict[str, Any], pt: dict[
         f"1,000 WaitForBlackboardVariableValue (polling; reaction latency = tick period)",
     )
     table.add_row(
-        "python -c \"import pycram.language\"\n(wall time, startup included)",
+        'python -c "import pycram.language"\n(wall time, startup included)',
         "< 0.3 s",
         f"{fmt_time(pc['import_cli'])}\n(the import alone: {fmt_time(pc['import_self'])})",
         verdict(pc["import_cli"], TARGETS["import"]),
         f"{fmt_time(floor['import_cli'])}\npython -c pass",
-        f"{fmt_time(pt['import_cli'])}\npython -c \"import py_trees\"",
+        f'{fmt_time(pt["import_cli"])}\npython -c "import py_trees"',
     )
     return table
 
@@ -944,11 +949,19 @@ def main(argv: list[str] | None = None) -> int:
     extra = Table(title="Issue 18 additions (recording off)")
     for column in ("figure", "PyCRAM", "target", "verdict"):
         extra.add_column(column)
-    extra.add_row("suspend → wake latency p50", fmt_time(pct(suspend_wake, 50)), fmt_time(TARGETS["suspend_wake"]),
-                  verdict(pct(suspend_wake, 50), TARGETS["suspend_wake"]))
+    extra.add_row(
+        "suspend → wake latency p50",
+        fmt_time(pct(suspend_wake, 50)),
+        fmt_time(TARGETS["suspend_wake"]),
+        verdict(pct(suspend_wake, 50), TARGETS["suspend_wake"]),
+    )
     extra.add_row("suspend → wake latency p99", fmt_time(pct(suspend_wake, 99)), "", "")
-    extra.add_row("policy around seq(1,000): overhead", f"{overhead:.1f} % ({fmt_time(policed)} vs {fmt_time(plain)})",
-                  f"{TARGETS['policy_overhead']:g} %", verdict(overhead, TARGETS["policy_overhead"]))
+    extra.add_row(
+        "policy around seq(1,000): overhead",
+        f"{overhead:.1f} % ({fmt_time(policed)} vs {fmt_time(plain)})",
+        f"{TARGETS['policy_overhead']:g} %",
+        verdict(overhead, TARGETS["policy_overhead"]),
+    )
     console.print(extra)
     misses += (pct(suspend_wake, 50) > TARGETS["suspend_wake"]) + (overhead > TARGETS["policy_overhead"])
     console.print(f"targets missed (recording off): {misses}")

@@ -83,8 +83,7 @@ def pct(values: list[float], q: float) -> float:
 
 
 def line(name: str, times: list[float], failures: int, total: int) -> str:
-    return (f"  {name:<22} first p50 {pct(times, 50):.3f} s, p95 {pct(times, 95):.3f} s, "
-            f"failed {failures}/{total}")
+    return f"  {name:<22} first p50 {pct(times, 50):.3f} s, p95 {pct(times, 95):.3f} s, failed {failures}/{total}"
 
 
 def main() -> int:
@@ -120,9 +119,11 @@ def main() -> int:
                     dt, works = analytic_works(world, robot.description, prospection, target, point)
                     stats["analytic"].append(dt)
                     fails["analytic"] += not works
-                    for kind, props in (("to_see", [("to_see", target)]),
-                                        ("to_open", [("to_open", world.environment.containers[seed % 4].name)]),
-                                        ("on", [("on", placement.support), ("for", "cup")])):
+                    for kind, props in (
+                        ("to_see", [("to_see", target)]),
+                        ("to_open", [("to_open", world.environment.containers[seed % 4].name)]),
+                        ("on", [("on", placement.support), ("for", "cup")]),
+                    ):
                         dt, _, error = timed(LocationDesignator(props).reference)
                         stats[kind].append(dt)
                         fails[kind] += error is not None
@@ -132,15 +133,20 @@ def main() -> int:
         n = len(chosen)
         print(f"{robot_name}: {n} scenes of the apartment, an object on a counter or the table")
         print(line("to_reach (reasoning)", stats["to_reach"], fails["to_reach"], n))
-        print(f"  {'to_reach next':<22} p50 {pct(stats['next'], 50):.3f} s, p95 {pct(stats['next'], 95):.3f} s, "
-              f"none {fails['next']}/{len(stats['next'])}")
-        print(line("to_reach (analytic)", stats["analytic"], fails["analytic"], n)
-              + "  (failed: none of its poses passes the checks)")
+        print(
+            f"  {'to_reach next':<22} p50 {pct(stats['next'], 50):.3f} s, p95 {pct(stats['next'], 95):.3f} s, "
+            f"none {fails['next']}/{len(stats['next'])}"
+        )
+        print(
+            line("to_reach (analytic)", stats["analytic"], fails["analytic"], n)
+            + "  (failed: none of its poses passes the checks)"
+        )
         for kind in ("to_see", "to_open", "on"):
             print(line(kind, stats[kind], fails[kind], n))
         first_all += stats["to_reach"]
-    print(f"first solution: p50 {pct(first_all, 50):.3f} s, p95 {pct(first_all, 95):.3f} s over "
-          f"{len(first_all)} queries")
+    print(
+        f"first solution: p50 {pct(first_all, 50):.3f} s, p95 {pct(first_all, 95):.3f} s over {len(first_all)} queries"
+    )
     return 0
 
 

@@ -69,21 +69,29 @@ def main(argv: list[str]) -> int:
         times, straight, detour, none = _plan_times(planner, pairs)
         all_times += times
         detour_times = sorted(times)[straight:] if detour else []
-        print(f"{setting:>13}: p50 {percentile(times, 50):6.1f} ms, p95 {percentile(times, 95):6.1f} ms, "
-              f"max {max(times):6.1f} ms; {straight} straight, {detour} detours, {none} without path; "
-              f"planner built in {build:.1f} ms (grid {planner.grid.shape[1]}x{planner.grid.shape[0]} cells)")
+        print(
+            f"{setting:>13}: p50 {percentile(times, 50):6.1f} ms, p95 {percentile(times, 95):6.1f} ms, "
+            f"max {max(times):6.1f} ms; {straight} straight, {detour} detours, {none} without path; "
+            f"planner built in {build:.1f} ms (grid {planner.grid.shape[1]}x{planner.grid.shape[0]} cells)"
+        )
         if detour_times:
-            print(f"{'':>13}  detours alone: p50 {percentile(detour_times, 50):6.1f} ms, "
-                  f"p95 {percentile(detour_times, 95):6.1f} ms")
+            print(
+                f"{'':>13}  detours alone: p50 {percentile(detour_times, 50):6.1f} ms, "
+                f"p95 {percentile(detour_times, 95):6.1f} ms"
+            )
         from pycram.sim.path_drive import memoized_free
 
         with_exact = []
         for pair in pairs:  # a fresh memo per plan, as drives have
             with_exact += _plan_times(planner, [pair], memoized_free(prospection))[0]
-        print(f"{'':>13}  with the whole robot checked in 3D along the path (as drives do): "
-              f"p50 {percentile(with_exact, 50):6.1f} ms, p95 {percentile(with_exact, 95):6.1f} ms")
-    print(f"planning: p50 {percentile(all_times, 50):.1f} ms, p95 {percentile(all_times, 95):.1f} ms "
-          f"over {len(all_times)} plans (target p95 <= 50 ms)")
+        print(
+            f"{'':>13}  with the whole robot checked in 3D along the path (as drives do): "
+            f"p50 {percentile(with_exact, 50):6.1f} ms, p95 {percentile(with_exact, 95):6.1f} ms"
+        )
+    print(
+        f"planning: p50 {percentile(all_times, 50):.1f} ms, p95 {percentile(all_times, 95):.1f} ms "
+        f"over {len(all_times)} plans (target p95 <= 50 ms)"
+    )
     return 0
 
 

@@ -64,8 +64,10 @@ def main() -> None:
             belief.update(world.detect(width, height).wait(30.0).value)
             round_trips.append(1000 * (time.perf_counter() - t0))
             counts.append(len(report.detections))
-        print(f"one detection at {width} x {height} px, {args.looks} looks, "
-              f"{statistics.median(counts):.0f} of {len(types)} objects detected per look")
+        print(
+            f"one detection at {width} x {height} px, {args.looks} looks, "
+            f"{statistics.median(counts):.0f} of {len(types)} objects detected per look"
+        )
         print(f"  2 renders + measure (sim thread)   {percentiles(in_thread)}")
         print(f"  belief update                      {percentiles(updates)}")
         print(f"  detect() round trip + update       {percentiles(round_trips)}")

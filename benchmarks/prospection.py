@@ -32,8 +32,7 @@ def _questions(world, rng: random.Random, prospection) -> dict[str, list]:
     hi_x = grid.origin[0] + (cols.max() + 1) * grid.resolution
     lo_y = grid.origin[1] + rows.min() * grid.resolution
     hi_y = grid.origin[1] + (rows.max() + 1) * grid.resolution
-    collision = [(rng.uniform(lo_x, hi_x), rng.uniform(lo_y, hi_y), rng.uniform(-math.pi, math.pi))
-                 for _ in range(500)]
+    collision = [(rng.uniform(lo_x, hi_x), rng.uniform(lo_y, hi_y), rng.uniform(-math.pi, math.pi)) for _ in range(500)]
     arms = list(world.description.ARMS)
     reach, see = [], []
     items = world.item_poses.get_value()
@@ -92,9 +91,11 @@ def main(argv: list[str]) -> int:
     with open_world(args.robot, args.env) as world:
         p = world.prospection()
         qs = _questions(world, rng, p)
-        print(f"prospection with the {args.robot} in {args.env!r}, {args.threads} thread(s), "
-              f"the simulation running ({len(qs['reach'])} reach / {len(qs['see'])} visibility questions "
-              f"about {len(world.item_poses.get_value())} objects)")
+        print(
+            f"prospection with the {args.robot} in {args.env!r}, {args.threads} thread(s), "
+            f"the simulation running ({len(qs['reach'])} reach / {len(qs['see'])} visibility questions "
+            f"about {len(world.item_poses.get_value())} objects)"
+        )
         rate, ans = _rate("collision", lambda b: p.in_collision(b), qs["collision"], args.seconds, args.threads)
         print(f"collision checks:     {rate:8.0f} /s   (target >= 2000; {sum(ans)}/{len(ans)} in collision)")
         rate, ans = _rate("reach", lambda q: p.reachable(*q), qs["reach"], args.seconds, args.threads)
@@ -102,13 +103,18 @@ def main(argv: list[str]) -> int:
         for a in ans:
             reasons[a.reason or "reachable"] = reasons.get(a.reason or "reachable", 0) + 1
         print(f"reachability checks:  {rate:8.0f} /s   (target >= 100; 3-pose sequences; {reasons})")
-        feasible = [q for q, a in zip(qs["reach"], ans) if a.reason in (None, "joint_limit", "out_of_reach")
-                    and a.failed_index != -1]
+        feasible = [
+            q
+            for q, a in zip(qs["reach"], ans)
+            if a.reason in (None, "joint_limit", "out_of_reach") and a.failed_index != -1
+        ]
         if feasible:
             rate, ans = _rate("reach-ik", lambda q: p.reachable(*q), feasible, args.seconds, args.threads)
             print(f"  of which IK needed: {rate:8.0f} /s   (the {len(feasible)} questions whose base pose is free)")
         rate, ans = _rate("see", lambda q: p.visible(*q), qs["see"], args.seconds, args.threads)
-        print(f"visibility checks:    {rate:8.0f} /s   (target >= 200; {sum(a.visible for a in ans)}/{len(ans)} visible)")
+        print(
+            f"visibility checks:    {rate:8.0f} /s   (target >= 200; {sum(a.visible for a in ans)}/{len(ans)} visible)"
+        )
     return 0
 
 

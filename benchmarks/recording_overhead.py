@@ -27,8 +27,8 @@ import statistics
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
@@ -55,8 +55,7 @@ def pursue_10() -> None:
         pursue(lambda: Fluent().wait_for(), _noop)
 
 
-WORKLOADS: dict[str, Callable[[], None]] = {"seq 1,000": seq_1000, "par 100": par_100,
-                                            "pursue ×10": pursue_10}
+WORKLOADS: dict[str, Callable[[], None]] = {"seq 1,000": seq_1000, "par 100": par_100, "pursue ×10": pursue_10}
 
 
 def _time(fn: Callable[[], None], repeat: int) -> list[float]:
@@ -83,8 +82,10 @@ def main(argv: list[str] | None = None) -> int:
         gc.freeze()  # start-up objects out of the collector's way: a full collection otherwise
         #              takes ~100 ms here and lands in a random iteration of either mode
         print(f"recording into {url}; median of {args.repeat} runs each")
-        print(f"{'workload':<12} {'median off':>10} {'on [ms]':>8} {'overhead':>9}   "
-              f"{'mean off':>8} {'on [ms]':>8} {'overhead':>9}")
+        print(
+            f"{'workload':<12} {'median off':>10} {'on [ms]':>8} {'overhead':>9}   "
+            f"{'mean off':>8} {'on [ms]':>8} {'overhead':>9}"
+        )
         worst = 0.0
         for name, fn in WORKLOADS.items():
             off, on = [], []
@@ -99,9 +100,11 @@ def main(argv: list[str] | None = None) -> int:
             a_off, a_on = statistics.mean(off), statistics.mean(on)
             overhead = (m_on - m_off) / m_off
             worst = max(worst, overhead)
-            print(f"{name:<12} {m_off * 1e3:>10.2f} {m_on * 1e3:>8.2f} {overhead:>+9.1%}   "
-                  f"{a_off * 1e3:>8.2f} {a_on * 1e3:>8.2f} {(a_on - a_off) / a_off:>+9.1%}"
-                  f"   (final flush {flush * 1e3:.0f} ms)")
+            print(
+                f"{name:<12} {m_off * 1e3:>10.2f} {m_on * 1e3:>8.2f} {overhead:>+9.1%}   "
+                f"{a_off * 1e3:>8.2f} {a_on * 1e3:>8.2f} {(a_on - a_off) / a_off:>+9.1%}"
+                f"   (final flush {flush * 1e3:.0f} ms)"
+            )
         shutdown_idle_workers()
         print(f"worst median overhead {worst:+.1%} (target: at most +10 %)")
     return 0

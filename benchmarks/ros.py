@@ -47,8 +47,11 @@ def demo_figures(robot: str, backend: str, runs: int, master_uri: str = "") -> d
             startup.append(time.monotonic() - started)
         try:
             with TemporaryDirectory() as output:
-                result = run_demo(DemoOptions(robot=robot, backend=backend, output=Path(output), record=False,
-                                              quiet=True, animation=False))
+                result = run_demo(
+                    DemoOptions(
+                        robot=robot, backend=backend, output=Path(output), record=False, quiet=True, animation=False
+                    )
+                )
         finally:
             if bridge is not None:
                 bridge.stop()
@@ -57,8 +60,12 @@ def demo_figures(robot: str, backend: str, runs: int, master_uri: str = "") -> d
         plan.append(result.plan_wall_time)
         run.append(result.wall_time)
         sim.append(result.sim_time)
-    return {"plan": statistics.median(plan), "run": statistics.median(run), "sim": statistics.median(sim),
-            "startup": statistics.median(startup) if startup else 0.0}
+    return {
+        "plan": statistics.median(plan),
+        "run": statistics.median(run),
+        "sim": statistics.median(sim),
+        "startup": statistics.median(startup) if startup else 0.0,
+    }
 
 
 def round_trip(samples: int) -> list[float]:
@@ -71,8 +78,9 @@ def round_trip(samples: int) -> list[float]:
 
     transport = ros1_transport()
     value = Fluent(None, name="benchmark value")
-    subscription = transport.subscribe("/pycram_benchmark/value", "std_msgs/Float64",
-                                       lambda message: value.set_value(message.data))
+    subscription = transport.subscribe(
+        "/pycram_benchmark/value", "std_msgs/Float64", lambda message: value.set_value(message.data)
+    )
     publisher = rospy.Publisher("/pycram_benchmark/value", Float64, queue_size=10)
     latencies: list[float] = []
     sent = [0.0]
@@ -129,8 +137,10 @@ def main() -> None:
     with RosMaster() as master:
         os.environ.update(ROS_MASTER_URI=master.uri, ROS_IP="127.0.0.1", ROS_HOSTNAME="127.0.0.1")
         ros = demo_figures(args.robot, "ros", args.runs, master.uri)
-        print(f"  over ROS 1      plan {ros['plan']:6.2f}   run {ros['run']:6.2f}   (simulated {ros['sim']:.1f} s; "
-              f"bridge start-up {ros['startup']:.2f} s not included)")
+        print(
+            f"  over ROS 1      plan {ros['plan']:6.2f}   run {ros['run']:6.2f}   (simulated {ros['sim']:.1f} s; "
+            f"bridge start-up {ros['startup']:.2f} s not included)"
+        )
         print(f"  ROS / in-process: plan x{ros['plan'] / sim['plan']:.2f}, run x{ros['run'] / sim['run']:.2f}")
         latencies = sorted(round_trip(args.samples))
     q = statistics.quantiles(latencies, n=100)

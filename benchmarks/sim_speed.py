@@ -41,7 +41,9 @@ def busy_run(world, seconds: float) -> tuple[float, float, str]:
     wall = time.perf_counter() - w0
     sim = world.sim_time.get_value() - s0
     track.cancel()
-    reasons = ", ".join(f"{name}: {h.outcome.reason if h.outcome else '?'}" for name, h in (("drive", drive), ("arm", arm)))
+    reasons = ", ".join(
+        f"{name}: {h.outcome.reason if h.outcome else '?'}" for name, h in (("drive", drive), ("arm", arm))
+    )
     return sim, wall, reasons
 
 
@@ -58,9 +60,11 @@ def record_run(robot: str, seconds: float, fps: float, size: tuple[int, int]) ->
         waited = time.perf_counter() - t0
     finally:
         world.close()
-    print(f"{robot} recording {fps:g} fps at {size[0]}x{size[1]}: simulated {sim:.1f} s in {wall:.2f} s wall "
-          f"-> {sim / wall:.1f}x real time ({reasons}); stop_recording waited {waited:.2f} s for the recorder; "
-          f"{len(frames)} frames, {frames.dropped} dropped")
+    print(
+        f"{robot} recording {fps:g} fps at {size[0]}x{size[1]}: simulated {sim:.1f} s in {wall:.2f} s wall "
+        f"-> {sim / wall:.1f}x real time ({reasons}); stop_recording waited {waited:.2f} s for the recorder; "
+        f"{len(frames)} frames, {frames.dropped} dropped"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
         write_animation(Path(tmp) / "recorded.gif", frames, fps)
@@ -75,8 +79,10 @@ def record_run(robot: str, seconds: float, fps: float, size: tuple[int, int]) ->
         iio.imwrite(Path(tmp) / "imageio.gif", np.stack(frames), duration=1000.0 / fps, loop=0)
         reference = time.perf_counter() - t0
         sizes = {p.name: p.stat().st_size // 1024 for p in Path(tmp).iterdir()}
-    print(f"{robot} GIF of {len(frames)} frames: recorded frames written in {recorded:.3f} s, plain list encoded "
-          f"in {plain:.2f} s, imageio (reference) {reference:.2f} s; sizes [kB] {sizes}")
+    print(
+        f"{robot} GIF of {len(frames)} frames: recorded frames written in {recorded:.3f} s, plain list encoded "
+        f"in {plain:.2f} s, imageio (reference) {reference:.2f} s; sizes [kB] {sizes}"
+    )
 
 
 def demo_runs() -> None:
@@ -85,9 +91,12 @@ def demo_runs() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for animation in (True, False):
             r = run_demo(DemoOptions(output=Path(tmp) / str(animation), quiet=True, record=False, animation=animation))
-            print(f"demo pr2, animation {'on ' if animation else 'off'}: exit {r.exit_code}, simulated {r.sim_time:.1f} s, "
-                  f"plan {r.plan_wall_time:.1f} s wall -> {r.speed_factor:.1f}x real time; whole run "
-                  f"{r.wall_time:.1f} s (load average {os.getloadavg()[0]:.1f})", flush=True)
+            print(
+                f"demo pr2, animation {'on ' if animation else 'off'}: exit {r.exit_code}, simulated {r.sim_time:.1f} s, "
+                f"plan {r.plan_wall_time:.1f} s wall -> {r.speed_factor:.1f}x real time; whole run "
+                f"{r.wall_time:.1f} s (load average {os.getloadavg()[0]:.1f})",
+                flush=True,
+            )
 
 
 def main() -> None:
@@ -116,11 +125,17 @@ def main() -> None:
         sim, wall, reasons = busy_run(world, args.seconds)
     finally:
         world.close()
-    print(f"{args.robot}: import pycram.sim {imported:.2f} s; scene load (World) "
-          + ", ".join(f"{t:.2f}" for t in loads) + " s")
-    print(f"{args.robot}: simulated {sim:.1f} s in {wall:.2f} s wall -> {sim / wall:.1f}x real time "
-          f"({reasons}; MUJOCO_GL={os.environ.get('MUJOCO_GL')}, load average "
-          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)", flush=True)
+    print(
+        f"{args.robot}: import pycram.sim {imported:.2f} s; scene load (World) "
+        + ", ".join(f"{t:.2f}" for t in loads)
+        + " s"
+    )
+    print(
+        f"{args.robot}: simulated {sim:.1f} s in {wall:.2f} s wall -> {sim / wall:.1f}x real time "
+        f"({reasons}; MUJOCO_GL={os.environ.get('MUJOCO_GL')}, load average "
+        f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)",
+        flush=True,
+    )
     if args.record:
         width, height = (int(v) for v in args.size.lower().split("x"))
         record_run(args.robot, args.seconds, args.record, (width, height))

@@ -54,8 +54,7 @@ class ToyBase(ProcessModule):
             if distance < 1e-6:
                 return x, y
             step = self.speed * self.STEP / distance
-            self.pose.set_value((goal_x, goal_y) if step >= 1.0 else
-                                (x + step * (goal_x - x), y + step * (goal_y - y)))
+            self.pose.set_value((goal_x, goal_y) if step >= 1.0 else (x + step * (goal_x - x), y + step * (goal_y - y)))
             sleep(self.STEP)  # evaporable: a pursue or with_timeout can stop the drive here
 
     def _cancel(self, designator):
@@ -122,7 +121,10 @@ if __name__ == "__main__":
         assert state.get_value() is State.SUCCEEDED and robot.process_module("base").stopped_at is not None
 
         opening = fetch((1.0, 0.5, 0.9))
-        log.info("toy base at (%.2f, %.2f); the gripper closed at %.2f m",
-                 *robot.process_module("base").pose.get_value(), opening)
+        log.info(
+            "toy base at (%.2f, %.2f); the gripper closed at %.2f m",
+            *robot.process_module("base").pose.get_value(),
+            opening,
+        )
         assert robot.process_module("base").pose.get_value() == (0.5, 0.5)
         assert [d.prop_value("position") for d in robot.process_module("gripper").executed] == [1, 0]

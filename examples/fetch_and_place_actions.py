@@ -17,6 +17,8 @@ with World(robot_name) as world:  # the thesis kitchen, with its mug at cooker #
     with robots.load(robot_name, world) as robot:
         perform(ParkArms())
         perform(MoveTorso("up"))
-        mug = perform(Transport(ObjectDesignator(type="mug"), LocationDesignator([("on", "cooker #1"), ("for", "mug")])))
+        mug = perform(
+            Transport(ObjectDesignator(type="mug"), LocationDesignator([("on", "cooker #1"), ("for", "mug")]))
+        )
         print(f"the {robot_name} put the mug down at {mug.pose[0]:.2f}, {mug.pose[1]:.2f} on {mug.properties['on']}")
     robot.shutdown()

@@ -25,7 +25,7 @@ import os
 import signal
 import sys
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 import typer
 from rich.console import Console
@@ -53,8 +53,9 @@ def _print_version(value: bool) -> None:
 @app.callback()
 def _options(
     ctx: typer.Context,
-    version: bool = typer.Option(False, "--version", help="Print PyCRAM's version and exit.",
-                                 callback=_print_version, is_eager=True),
+    version: bool = typer.Option(
+        False, "--version", help="Print PyCRAM's version and exit.", callback=_print_version, is_eager=True
+    ),
 ) -> None:
     """PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs."""
     # `pycram run` leaves logging to the script (its basicConfig must not be a no-op); the
@@ -67,8 +68,12 @@ def _options(
 #: `pycram.trace.collapse.MIN_RUN`, not imported here to keep `pycram --help` light.
 _COLLAPSE = 3
 
-DbOption = typer.Option(None, "--db", help="SQLAlchemy URL of the trace database (default: $PYCRAM_DB_URL or "
-                                           "~/.local/share/pycram/runs.sqlite3).", metavar="URL")
+DbOption = typer.Option(
+    None,
+    "--db",
+    help="SQLAlchemy URL of the trace database (default: $PYCRAM_DB_URL or ~/.local/share/pycram/runs.sqlite3).",
+    metavar="URL",
+)
 RunArgument = typer.Argument(None, help="Run id (default: the newest run).", show_default=False)
 
 
@@ -91,7 +96,7 @@ def _trace_errors(fn: Any, *args: Any, **kwargs: Any) -> Any:
         _fail(str(e))
 
 
-def _reading(db: Optional[str], fn: Any, *args: Any, **kwargs: Any) -> Any:
+def _reading(db: str | None, fn: Any, *args: Any, **kwargs: Any) -> Any:
     """`_trace_errors` for the inspecting commands: a database named with `--db` must exist
     (reading never creates one), and any database failure is a one-line error."""
     from sqlalchemy import exc as sa_exc
@@ -102,8 +107,7 @@ def _reading(db: Optional[str], fn: Any, *args: Any, **kwargs: Any) -> Any:
         _trace_errors(resolve_url, db)  # a malformed URL is reported as such
         path = sqlite_file(db)
         if path is not None and not path.exists():
-            where = (f"the folder {path.parent} does not exist" if not path.parent.is_dir()
-                     else f"{path} does not exist")
+            where = f"the folder {path.parent} does not exist" if not path.parent.is_dir() else f"{path} does not exist"
             _fail(f"no such database: {where} (`pycram run` and `pycram demo` create it when they record)")
     try:
         return _trace_errors(fn, *args, **kwargs)
@@ -123,7 +127,7 @@ def _local(when: _dt.datetime | None) -> str:
     return when.astimezone().strftime("%Y-%m-%d %H:%M:%S") if when is not None else "–"
 
 
-def _record_flag(record: Optional[bool]) -> bool:
+def _record_flag(record: bool | None) -> bool:
     if record is not None:
         return record
     from pycram.trace.recorder import recording_enabled
@@ -133,11 +137,12 @@ def _record_flag(record: Optional[bool]) -> bool:
 
 # -- inspecting runs ------------------------------------------------------------------------------
 
+
 @app.command("runs")
 def runs_command(
     limit: int = typer.Option(20, "--limit", "-n", help="Show at most this many runs (0: all)."),
-    plan: Optional[str] = typer.Option(None, "--plan", help="Only runs whose plan name contains this."),
-    db: Optional[str] = DbOption,
+    plan: str | None = typer.Option(None, "--plan", help="Only runs whose plan name contains this."),
+    db: str | None = DbOption,
 ) -> None:
     """List recorded runs, newest first: id, start, plan, robot, outcome, wall-clock duration
     and why a run failed."""
@@ -158,9 +163,15 @@ def runs_command(
     for run in found:
         state = run.state
         style = STATUS_STYLE.get(state, "white")
-        table.add_row(str(run.id), _local(run.started_at), escape(run.plan or "–"), escape(run.robot or "–"),
-                      f"[{style}]{state}[/{style}]", format_duration(run.elapsed),
-                      escape(_reason(run)))
+        table.add_row(
+            str(run.id),
+            _local(run.started_at),
+            escape(run.plan or "–"),
+            escape(run.robot or "–"),
+            f"[{style}]{state}[/{style}]",
+            format_duration(run.elapsed),
+            escape(_reason(run)),
+        )
     console.print(table)
 
 
@@ -175,11 +186,14 @@ def _reason(run: Any) -> str:
 
 @app.command("show")
 def show_command(
-    run: Optional[int] = RunArgument,
+    run: int | None = RunArgument,
     max_nodes: int = typer.Option(2000, "--max-nodes", help="Stop printing after this many tree lines."),
-    expand: bool = typer.Option(False, "--expand", help="One line per task: do not collapse runs of "
-                                                         "identical successful siblings into one line (×N)."),
-    db: Optional[str] = DbOption,
+    expand: bool = typer.Option(
+        False,
+        "--expand",
+        help="One line per task: do not collapse runs of identical successful siblings into one line (×N).",
+    ),
+    db: str | None = DbOption,
 ) -> None:
     """Print a run's task tree with statuses, durations and failures.
 
@@ -198,9 +212,11 @@ def show_command(
     executions = _reading(db, query.executions, info.id, url=db)
     state = info.state
     style = STATUS_STYLE.get(state, "white")
-    title = (f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
-             f"[{style}]{state}[/{style}] · took {format_duration(info.elapsed)} (wall-clock) · "
-             f"started {_local(info.started_at)}\n[grey50]times in the tree: {escape(clock_label(info.clock))}[/grey50]")
+    title = (
+        f"run {info.id}: {escape(info.plan or '–')} · robot {escape(info.robot or '–')} · "
+        f"[{style}]{state}[/{style}] · took {format_duration(info.elapsed)} (wall-clock) · "
+        f"started {_local(info.started_at)}\n[grey50]times in the tree: {escape(clock_label(info.clock))}[/grey50]"
+    )
     shown_records = records + execution_records
     tree, shown = task_tree(title, shown_records, expand=expand, max_nodes=max_nodes)
     console.print(tree)
@@ -217,16 +233,18 @@ def show_command(
     if info.error:
         console.print(f"[red]{escape(info.error)}[/red]")
     if info.lost_records:
-        console.print(f"[yellow]{info.lost_records} trace records of this run could not be written: "
-                      "the tree may be incomplete[/yellow]")
+        console.print(
+            f"[yellow]{info.lost_records} trace records of this run could not be written: "
+            "the tree may be incomplete[/yellow]"
+        )
 
 
 @app.command("graph")
 def graph_command(
-    run: Optional[int] = RunArgument,
+    run: int | None = RunArgument,
     output: Path = typer.Option(Path("task-tree.svg"), "--output", "-o", help="SVG file to write."),
     expand: bool = typer.Option(False, "--expand", help="One box per task (do not collapse identical siblings)."),
-    db: Optional[str] = DbOption,
+    db: str | None = DbOption,
 ) -> None:
     """Draw a run's task tree as an SVG picture (identical successful siblings: one box ×N)."""
     from pycram.trace.pictures import write_tree_svg
@@ -237,11 +255,13 @@ def graph_command(
 
 @app.command("timeline")
 def timeline_command(
-    run: Optional[int] = RunArgument,
+    run: int | None = RunArgument,
     output: Path = typer.Option(Path("timeline.png"), "--output", "-o", help="PNG file to write."),
     max_rows: int = typer.Option(200, "--max-rows", help="At most this many task rows (deeper tasks are left out)."),
-    expand: bool = typer.Option(False, "--expand", help="One row per task (do not share rows between identical siblings)."),
-    db: Optional[str] = DbOption,
+    expand: bool = typer.Option(
+        False, "--expand", help="One row per task (do not share rows between identical siblings)."
+    ),
+    db: str | None = DbOption,
 ) -> None:
     """Draw which branches ran when (a Gantt chart, one row per task; identical successful
     siblings share a row) as a PNG picture."""
@@ -253,16 +273,19 @@ def timeline_command(
 
 # -- running plans --------------------------------------------------------------------------------
 
+
 @app.command("run", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def run_command(
     ctx: typer.Context,
-    file: Path = typer.Argument(..., help="Plan script to run (block syntax is switched on).", exists=True,
-                                dir_okay=False),
-    record: Optional[bool] = typer.Option(None, "--record/--no-record",
-                                          help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
-    db: Optional[str] = DbOption,
-    plan: Optional[str] = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
-    robot: Optional[str] = typer.Option(None, "--robot", help="Robot name recorded for the run."),
+    file: Path = typer.Argument(
+        ..., help="Plan script to run (block syntax is switched on).", exists=True, dir_okay=False
+    ),
+    record: bool | None = typer.Option(
+        None, "--record/--no-record", help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."
+    ),
+    db: str | None = DbOption,
+    plan: str | None = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
+    robot: str | None = typer.Option(None, "--robot", help="Robot name recorded for the run."),
 ) -> None:
     """Run a plan script; arguments after FILE go to the script (in sys.argv).
 
@@ -281,8 +304,11 @@ def run_command(
     if _record_flag(record):
         from pycram.trace.recorder import Recorder
 
-        recorder = _trace_errors(lambda: Recorder(db, plan=plan or file.name, robot=robot,
-                                                  command=" ".join(["pycram run", str(file), *ctx.args])).start())
+        recorder = _trace_errors(
+            lambda: Recorder(
+                db, plan=plan or file.name, robot=robot, command=" ".join(["pycram run", str(file), *ctx.args])
+            ).start()
+        )
     outcome, error, code = "succeeded", None, 0
     ended: BaseException | None = None  # what ended the main thread's root task
     with StopSignals(stop_main=True) as stop:
@@ -312,8 +338,10 @@ def run_command(
                 run_id = recorder.finish(outcome, error)
                 err.print(f"recorded as run {run_id} ({outcome}); see `pycram show {run_id}`")
                 if recorder.lost_records:
-                    err.print(f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
-                              soft_wrap=True)
+                    err.print(
+                        f"[yellow]trace of run {run_id} incomplete: {escape(recorder.loss_report())}[/yellow]",
+                        soft_wrap=True,
+                    )
     raise typer.Exit(code)
 
 
@@ -357,24 +385,40 @@ def _check_output_folder(output: str) -> None:
 @app.command("demo")
 def demo_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
-    output: Optional[str] = typer.Option(None, "--output", "-o", help="Folder for pictures (default: the run's "
-                                         "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded)."),
-    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
-                                help="Where the item starts: position 1, 2 or 3 (0: no item)."),
-    steal: int = typer.Option(0, "--steal", min=0, max=_MAX_STEALS,
-                              help="How many times the item is taken from the gripper while the robot carries it."),
+    output: str | None = typer.Option(
+        None,
+        "--output",
+        "-o",
+        help="Folder for pictures (default: the run's "
+        "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded).",
+    ),
+    item_at: int = typer.Option(
+        1, "--item-at", min=0, max=3, help="Where the item starts: position 1, 2 or 3 (0: no item)."
+    ),
+    steal: int = typer.Option(
+        0,
+        "--steal",
+        min=0,
+        max=_MAX_STEALS,
+        help="How many times the item is taken from the gripper while the robot carries it.",
+    ),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed (a non-negative integer)."),
     realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
     interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
-    record: Optional[bool] = typer.Option(None, "--record/--no-record",
-                                          help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."),
-    db: Optional[str] = DbOption,
+    record: bool | None = typer.Option(
+        None, "--record/--no-record", help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."
+    ),
+    db: str | None = DbOption,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
-    animation: bool = typer.Option(True, "--animation/--no-animation",
-                                   help="Record the animation run.gif (--no-animation: a faster run)."),
-    backend: str = typer.Option("sim", "--backend",
-                                help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
-                                     "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set)."),
+    animation: bool = typer.Option(
+        True, "--animation/--no-animation", help="Record the animation run.gif (--no-animation: a faster run)."
+    ),
+    backend: str = typer.Option(
+        "sim",
+        "--backend",
+        help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
+        "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set).",
+    ),
 ) -> None:
     """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
     if output is not None:
@@ -385,9 +429,21 @@ def demo_command(
         if e.name and e.name.startswith("pycram.demos"):
             _fail("the kitchen demo (pycram.demos.kitchen) is not available in this installation")
         _fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
-    code = _trace_errors(demo_main, robot=robot, output=output, item_at=item_at, steal=steal, seed=seed,
-                         realtime=realtime, interactive=interactive, db=db, record=_record_flag(record),
-                         quiet=quiet, animation=animation, backend=backend)
+    code = _trace_errors(
+        demo_main,
+        robot=robot,
+        output=output,
+        item_at=item_at,
+        steal=steal,
+        seed=seed,
+        realtime=realtime,
+        interactive=interactive,
+        db=db,
+        record=_record_flag(record),
+        quiet=quiet,
+        animation=animation,
+        backend=backend,
+    )
     raise typer.Exit(int(code or 0))
 
 
@@ -396,8 +452,9 @@ _SCENE_OBJECTS = "cup,bowl,spoon,cereal,milk,plate"
 #: The scene options `pycram scene` and `pycram costmap` share.
 _SceneEnvOption = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen.")
 _SceneSeedOption = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene).")
-_SceneObjectsOption = typer.Option(_SCENE_OBJECTS, "--objects",
-                                   help="Comma-separated object types to place at random ('' for none).")
+_SceneObjectsOption = typer.Option(
+    _SCENE_OBJECTS, "--objects", help="Comma-separated object types to place at random ('' for none)."
+)
 _SceneRobotOption = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago.")
 
 
@@ -408,11 +465,15 @@ def scene_command(
     objects: str = _SceneObjectsOption,
     robot: str = _SceneRobotOption,
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
-    costmap: str = typer.Option("", "--costmap",
-                                help="Draw a location designator's costmap layers and chosen poses instead, "
-                                     "e.g. \"to_reach cup\" or \"on table, for bowl\"."),
-    belief: bool = typer.Option(False, "--belief",
-                                help="Let the robot look around and draw its belief beside the ground truth."),
+    costmap: str = typer.Option(
+        "",
+        "--costmap",
+        help="Draw a location designator's costmap layers and chosen poses instead, "
+        'e.g. "to_reach cup" or "on table, for bowl".',
+    ),
+    belief: bool = typer.Option(
+        False, "--belief", help="Let the robot look around and draw its belief beside the ground truth."
+    ),
 ) -> None:
     """A labelled picture of a scene: plan and overview with surfaces, containers and objects
     (with --belief: what the robot perceived from where it stands beside what is).
@@ -457,8 +518,11 @@ def _perceive_named_objects(robot: Any, properties: list) -> None:
     with robot:
         look_around()
         for _, value in properties:
-            if isinstance(value, str) and value in OBJECT_TYPES \
-                    and not any(obj.type == value for obj in robot.belief.objects()):
+            if (
+                isinstance(value, str)
+                and value in OBJECT_TYPES
+                and not any(obj.type == value for obj in robot.belief.objects())
+            ):
                 try:
                     search_for(ObjectDesignator(type=value))
                 except ObjectNotFound as e:
@@ -494,7 +558,7 @@ def _costmap_picture(world: object, robot_name: str, text: str, output: Path, ti
 
 @app.command("costmap")
 def costmap_command(
-    location: str = typer.Argument(..., help="The location, e.g. \"to_reach cup\" or \"on table, for bowl\"."),
+    location: str = typer.Argument(..., help='The location, e.g. "to_reach cup" or "on table, for bowl".'),
     env: str = _SceneEnvOption,
     seed: int = _SceneSeedOption,
     objects: str = _SceneObjectsOption,
@@ -508,15 +572,24 @@ def costmap_command(
 @app.command("sim-ros-bridge")
 def sim_ros_bridge_command(
     robot: str = typer.Option("pr2", "--robot", help="Robot: pr2 or tiago."),
-    item_at: int = typer.Option(1, "--item-at", min=0, max=3,
-                                help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."),
-    realtime: bool = typer.Option(False, "--realtime", help="Simulate at real-time speed (default: as fast as "
-                                  "possible; /clock carries the simulation time)."),
+    item_at: int = typer.Option(
+        1, "--item-at", min=0, max=3, help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."
+    ),
+    realtime: bool = typer.Option(
+        False,
+        "--realtime",
+        help="Simulate at real-time speed (default: as fast as possible; /clock carries the simulation time).",
+    ),
     publish_rate: float = typer.Option(50.0, "--publish-rate", min=1.0, help="Sensor topics per second [Hz, wall]."),
-    host: str = typer.Option("127.0.0.1", "--host", help="Address the node binds to and advertises (ROS_IP). "
-                             "Loopback by default: nothing outside this machine can command the robot."),
-    allow_remote_master: bool = typer.Option(False, "--allow-remote-master",
-                                             help="Accept a ROS_MASTER_URI that is not on loopback."),
+    host: str = typer.Option(
+        "127.0.0.1",
+        "--host",
+        help="Address the node binds to and advertises (ROS_IP). "
+        "Loopback by default: nothing outside this machine can command the robot.",
+    ),
+    allow_remote_master: bool = typer.Option(
+        False, "--allow-remote-master", help="Accept a ROS_MASTER_URI that is not on loopback."
+    ),
 ) -> None:
     """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
     /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
@@ -534,8 +607,13 @@ def sim_ros_bridge_command(
     os.environ.setdefault("MUJOCO_GL", "egl")
     from pycram.ros.bridge import run_bridge
 
-    run_bridge(robot, item_at=item_at, realtime=realtime, publish_rate=publish_rate,
-               ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True))
+    run_bridge(
+        robot,
+        item_at=item_at,
+        realtime=realtime,
+        publish_rate=publish_rate,
+        ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True),
+    )
 
 
 def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Path:

@@ -34,7 +34,8 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 __all__ = [
     "DESIGNATOR_PERFORMED",
@@ -108,8 +109,14 @@ def designator_performed(designator: Any, solution: Any = None, error: BaseExcep
         publish(DESIGNATOR_PERFORMED, designator=designator, solution=solution, error=error)
 
 
-def process_module_executed(module: Any, designator: Any, outcome: Any, start: float | None,
-                            end: float | None, error: BaseException | None = None) -> None:
+def process_module_executed(
+    module: Any,
+    designator: Any,
+    outcome: Any,
+    start: float | None,
+    end: float | None,
+    error: BaseException | None = None,
+) -> None:
     """Announce that `module` executed `designator` with `outcome` between `start` and `end`.
 
     `outcome` may be an enum (its `.value` is used) or a string; times are on the active
@@ -118,5 +125,12 @@ def process_module_executed(module: Any, designator: Any, outcome: Any, start: f
     """
     callbacks = _subscribers.get(PROCESS_MODULE_EXECUTED)
     if callbacks:
-        publish(PROCESS_MODULE_EXECUTED, module=module, designator=designator, outcome=outcome,
-                start=start, end=end, error=error)
+        publish(
+            PROCESS_MODULE_EXECUTED,
+            module=module,
+            designator=designator,
+            outcome=outcome,
+            start=start,
+            end=end,
+            error=error,
+        )

@@ -64,8 +64,9 @@ class PlanFailure(Exception):
     #: The reason when none is given.
     default_reason = "failed"
 
-    def __init__(self, message: str, designator: Any = None, reason: str | None = None,
-                 attempts: Sequence[str] = ()) -> None:
+    def __init__(
+        self, message: str, designator: Any = None, reason: str | None = None, attempts: Sequence[str] = ()
+    ) -> None:
         super().__init__(message)
         self.designator = designator
         self.reason = reason if reason is not None else self.default_reason
@@ -164,8 +165,14 @@ class ContainerFailure(PlanFailure):
 
     default_reason = "container_failed"
 
-    def __init__(self, message: str, container: str | None = None, designator: Any = None,
-                 reason: str | None = None, attempts: Sequence[str] = ()) -> None:
+    def __init__(
+        self,
+        message: str,
+        container: str | None = None,
+        designator: Any = None,
+        reason: str | None = None,
+        attempts: Sequence[str] = (),
+    ) -> None:
         super().__init__(message, designator, reason, attempts)
         self.container = container
 

@@ -32,8 +32,9 @@ import logging
 import operator
 import threading
 import weakref
+from collections.abc import Callable, Iterator
 from enum import Enum
-from typing import Any, Callable, Iterator
+from typing import Any
 
 from pycram.block_forms import BlockForm
 from pycram.runtime.evaporation import Evaporated, current_runner, notify_waiters, wait_until
@@ -66,8 +67,18 @@ class Fluent:
     changes). `name` defaults to a random string.
     """
 
-    __slots__ = ("_value", "_name", "_cv", "_children", "_live", "_pulses", "_handle_missed", "_callbacks",
-                 "_changes_only", "__weakref__")
+    __slots__ = (
+        "_value",
+        "_name",
+        "_cv",
+        "_children",
+        "_live",
+        "_pulses",
+        "_handle_missed",
+        "_callbacks",
+        "_changes_only",
+        "__weakref__",
+    )
 
     def __init__(self, value: Any = None, name: str | None = None, changes_only: bool = False) -> None:
         self._value = value

@@ -24,8 +24,9 @@ import os
 import signal
 import sys
 import threading
+from collections.abc import Callable
 from types import FrameType
-from typing import Any, Callable
+from typing import Any
 
 __all__ = ["Interrupted", "StopSignals", "signal_reason", "exit_code_of"]
 
@@ -140,8 +141,10 @@ class StopSignals:
                 if self.on_second is not None:
                     self.on_second()
                 sys.stdout.flush()
-                sys.stderr.write(f"\npycram: {signal_reason(signum)} again while stopping; exiting at once "
-                                 f"(pictures and trace may be incomplete)\n")
+                sys.stderr.write(
+                    f"\npycram: {signal_reason(signum)} again while stopping; exiting at once "
+                    f"(pictures and trace may be incomplete)\n"
+                )
                 sys.stderr.flush()
             finally:
                 os._exit(self.exit_code)

@@ -37,17 +37,24 @@ The thesis' block syntax (`with par(errors) as s:`) is a front end to these func
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Sequence
 from enum import Enum
-from typing import Any, Callable, Sequence
+from typing import Any
 
 from pycram.block_forms import BRANCHES, BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
-from pycram.runtime.evaporation import check_evaporation, shielded, wait_until
-from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
 from pycram.runtime.detached import detached_children
-from pycram.runtime.suspension import (is_suspended, on_suspension, retry_after_suspension, suspend,
-                                       wake_up, with_task_suspended)
+from pycram.runtime.evaporation import check_evaporation, shielded, wait_until
+from pycram.runtime.suspension import (
+    is_suspended,
+    on_suspension,
+    retry_after_suspension,
+    suspend,
+    wake_up,
+    with_task_suspended,
+)
 from pycram.runtime.tags import Tags, find_task, find_tasks, tag, with_tags
+from pycram.runtime.task import Task, TaskGroup, TaskStatus, current_task, run_subtask, task_scope
 from pycram.runtime.task_variables import TaskVariable
 
 __all__ = [
@@ -371,6 +378,7 @@ def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Br
         raise TypeError(f"{form}(): items must be iterable, got {type(items).__name__}: {items!r}") from None
     branches = []
     for index, item in enumerate(items):
+
         def branch(item: Any = item) -> Any:
             return body(item)
 
@@ -379,8 +387,13 @@ def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Br
     return branches
 
 
-def try_each_in_order(items: Any, body: Callable[[Any], Any], errors: list | None = None,
-                      name: str | None = None, state: Fluent | None = None) -> Fluent:
+def try_each_in_order(
+    items: Any,
+    body: Callable[[Any], Any],
+    errors: list | None = None,
+    name: str | None = None,
+    state: Fluent | None = None,
+) -> Fluent:
     """`try_in_order` over `body(item)` for each item (CRAM's `try-each-in-order`).
 
     Calls `body(item)` for the items in order until one returns without raising; returns the
@@ -391,8 +404,13 @@ def try_each_in_order(items: Any, body: Callable[[Any], Any], errors: list | Non
     return try_in_order(*branches, errors=errors, state=state, name=name or "try_each_in_order")
 
 
-def par_loop(items: Any, body: Callable[[Any], Any], errors: list | None = None,
-             name: str | None = None, state: Fluent | None = None) -> Fluent:
+def par_loop(
+    items: Any,
+    body: Callable[[Any], Any],
+    errors: list | None = None,
+    name: str | None = None,
+    state: Fluent | None = None,
+) -> Fluent:
     """`par` over `body(item)` for each item (CRAM's `par-loop`): one branch per item.
 
     SUCCEEDED when every call returned — `result` is then the list of return values in item
@@ -567,5 +585,12 @@ def __getattr__(name: str) -> Any:
 # -- expressions built on the ones above (imported last: they import this module) ------------------
 
 from pycram.partial_order import partial_order  # noqa: E402
-from pycram.policy import (Policy, PolicyConditionMet, PolicyInitFailed, PolicyRun, define_policy,  # noqa: E402
-                           timeout_policy, with_policy)
+from pycram.policy import (  # noqa: E402
+    Policy,
+    PolicyConditionMet,
+    PolicyInitFailed,
+    PolicyRun,
+    define_policy,
+    timeout_policy,
+    with_policy,
+)

@@ -76,8 +76,9 @@ import sys
 import tokenize
 import traceback
 import types
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping, Sequence, TypeVar
+from typing import Any, TypeVar
 
 __all__ = [
     "NOT_ENABLED_MESSAGE",
@@ -149,9 +150,7 @@ def whenever_loop(fluent: Any, where: str) -> Any:
     from pycram.fluent import Fluent, whenever
 
     if not isinstance(fluent, Fluent):
-        raise TypeError(
-            f"`with whenever(...)` at {where} needs a Fluent, got {type(fluent).__name__}: {fluent!r}"
-        )
+        raise TypeError(f"`with whenever(...)` at {where} needs a Fluent, got {type(fluent).__name__}: {fluent!r}")
     return whenever(fluent)
 
 
@@ -432,8 +431,12 @@ def _what_it_does(stmt: ast.stmt) -> str | None:
     for node in ast.walk(value):
         if isinstance(node, ast.keyword) and node.arg == "type":
             kind = node.value
-        elif isinstance(node, (ast.Tuple, ast.List)) and len(node.elts) == 2 and \
-                isinstance(node.elts[0], ast.Constant) and node.elts[0].value == "type":
+        elif (
+            isinstance(node, (ast.Tuple, ast.List))
+            and len(node.elts) == 2
+            and isinstance(node.elts[0], ast.Constant)
+            and node.elts[0].value == "type"
+        ):
             kind = node.elts[1]
         else:
             continue
@@ -479,7 +482,9 @@ class _Transformer:
     def function(self, node: ast.FunctionDef | ast.AsyncFunctionDef, outer: _Scope | None = None) -> None:
         scope = _Scope(
             "function",
-            enclosing=(outer.enclosing | outer.local_names) if outer is not None and outer.kind == "function" else set(),
+            enclosing=(outer.enclosing | outer.local_names)
+            if outer is not None and outer.kind == "function"
+            else set(),
             global_names=_declared(node.body, ast.Global),
             nonlocal_names=_declared(node.body, ast.Nonlocal),
             params=_parameters(node.args),
@@ -514,7 +519,10 @@ class _Transformer:
             form = self.recognise(stmt)
             if form is not None:
                 if scope.kind == "class":
-                    raise self.error(stmt, f"`with {form.name}` block syntax cannot be used directly in a class body; put it in a method")
+                    raise self.error(
+                        stmt,
+                        f"`with {form.name}` block syntax cannot be used directly in a class body; put it in a method",
+                    )
                 self.changed = True
                 if form.name == "whenever":
                     return self.whenever(form, scope)
@@ -571,17 +579,30 @@ class _Transformer:
                 if in_whenever and node.value is None:
                     return
                 if in_whenever:
-                    raise self.error(node, f"`return <value>` inside a `whenever` that is a branch of {what} cannot return from the enclosing function; use a bare `return` to leave the loop and end the branch, and pass results through a variable")
-                raise self.error(node, f"`return` is not allowed inside {what}: each statement runs as its own branch (a task), so it cannot return from the enclosing function. Assign a variable in the branch and return after the block")
+                    raise self.error(
+                        node,
+                        f"`return <value>` inside a `whenever` that is a branch of {what} cannot return from the enclosing function; use a bare `return` to leave the loop and end the branch, and pass results through a variable",
+                    )
+                raise self.error(
+                    node,
+                    f"`return` is not allowed inside {what}: each statement runs as its own branch (a task), so it cannot return from the enclosing function. Assign a variable in the branch and return after the block",
+                )
             if isinstance(node, (ast.Yield, ast.YieldFrom, ast.Await)):
                 kind = "await" if isinstance(node, ast.Await) else "yield"
-                raise self.error(node, f"`{kind}` is not allowed inside {what}: its statements run as separate branches (tasks)")
+                raise self.error(
+                    node, f"`{kind}` is not allowed inside {what}: its statements run as separate branches (tasks)"
+                )
             if isinstance(node, (ast.Global, ast.Nonlocal)):
                 kind = "global" if isinstance(node, ast.Global) else "nonlocal"
-                raise self.error(node, f"`{kind}` is not allowed inside {what}; declare it at the top of the enclosing function")
+                raise self.error(
+                    node, f"`{kind}` is not allowed inside {what}; declare it at the top of the enclosing function"
+                )
             if isinstance(node, (ast.Break, ast.Continue)) and loops == 0:
                 kind = "break" if isinstance(node, ast.Break) else "continue"
-                raise self.error(node, f"`{kind}` inside {what} cannot leave the block: its statements run as separate branches (tasks)")
+                raise self.error(
+                    node,
+                    f"`{kind}` inside {what} cannot leave the block: its statements run as separate branches (tasks)",
+                )
             if isinstance(node, ast.With):
                 inner = self.recognise(node)
                 if inner is not None:
@@ -609,7 +630,10 @@ class _Transformer:
             )
 
         if all(trivial(s) for s in form.node.body):
-            raise self.error(form.node, f"`with {form.name}` block has no statements; each statement of the block is one {'step' if form.name in ('seq', 'try_in_order') else 'branch'}")
+            raise self.error(
+                form.node,
+                f"`with {form.name}` block has no statements; each statement of the block is one {'step' if form.name in ('seq', 'try_in_order') else 'branch'}",
+            )
 
     # -- code generation --------------------------------------------------------------------------
 
@@ -637,7 +661,15 @@ class _Transformer:
         self._counter += 1
         return f"{_P}{kind}_L{line}_{self._counter}"
 
-    def _branch_def(self, gen_name: str, nice: str, body: list[ast.stmt], scope: _Scope, where: ast.AST, prelude: list[ast.stmt] = ()) -> ast.FunctionDef:  # type: ignore[assignment]
+    def _branch_def(
+        self,
+        gen_name: str,
+        nice: str,
+        body: list[ast.stmt],
+        scope: _Scope,
+        where: ast.AST,
+        prelude: list[ast.stmt] = (),
+    ) -> ast.FunctionDef:  # type: ignore[assignment]
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
         if scope.first_param is not None:
@@ -657,7 +689,9 @@ class _Transformer:
         self._located([*decls], where)
         fn = ast.FunctionDef(
             name=gen_name,
-            args=ast.arguments(posonlyargs=[], args=[], vararg=None, kwonlyargs=[], kw_defaults=[], kwarg=None, defaults=[]),
+            args=ast.arguments(
+                posonlyargs=[], args=[], vararg=None, kwonlyargs=[], kw_defaults=[], kwarg=None, defaults=[]
+            ),
             body=[*decls, *prelude, *body],
             decorator_list=[],
             returns=None,
@@ -689,7 +723,9 @@ class _Transformer:
         out += self._parse(f"{state} = _pycram_rt.new_state({label!r})")
         if form.target is not None:
             if not isinstance(form.target, (ast.Name, ast.Attribute, ast.Subscript)):
-                raise self.error(form.target, f"`with {form.name} as ...` needs a name (or attribute) to bind the state fluent to")
+                raise self.error(
+                    form.target, f"`with {form.name} as ...` needs a name (or attribute) to bind the state fluent to"
+                )
             out.append(ast.Assign(targets=[form.target], value=ast.Name(state, ast.Load())))
         errors_expr: ast.expr = ast.Constant(None)
         if errors is not None:
@@ -704,9 +740,7 @@ class _Transformer:
                     and not self.resolver.is_bound(errors.id)
                 )
             ):
-                out += self._parse(
-                    f"try:\n    {tmp} = {errors.id}\nexcept NameError:\n    {tmp} = {errors.id} = []"
-                )
+                out += self._parse(f"try:\n    {tmp} = {errors.id}\nexcept NameError:\n    {tmp} = {errors.id} = []")
             else:
                 out.append(ast.Assign(targets=[ast.Name(tmp, ast.Store())], value=errors))
             errors_expr = ast.Name(tmp, ast.Load())
@@ -720,7 +754,11 @@ class _Transformer:
             branch_names.append(gen)
         call = ast.Expr(
             ast.Call(
-                func=ast.Call(ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()), [ast.Constant(form.name)], []),
+                func=ast.Call(
+                    ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()),
+                    [ast.Constant(form.name)],
+                    [],
+                ),
                 args=[ast.Name(n, ast.Load()) for n in branch_names],
                 keywords=[
                     ast.keyword("errors", errors_expr),
@@ -756,7 +794,9 @@ class _Transformer:
         if form.target is not None:
             raise self.error(node, "`with with_policy(...)` does not bind a value; remove `as ...`")
         if not form.args or form.keywords:
-            raise self.error(node, "`with with_policy(policy, *params):` needs the policy and positional parameters only")
+            raise self.error(
+                node, "`with with_policy(policy, *params):` needs the policy and positional parameters only"
+            )
         self.check_not_empty(form)
         self.check_branch(node.body, form.name)
         label = f"with_policy@{self.basename}:{line}"
@@ -766,7 +806,11 @@ class _Transformer:
         out.append(self._branch_def(gen, label, body, scope, node))
         call = ast.Expr(
             ast.Call(
-                func=ast.Call(ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()), [ast.Constant("with_policy")], []),
+                func=ast.Call(
+                    ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()),
+                    [ast.Constant("with_policy")],
+                    [],
+                ),
                 args=[form.args[0], ast.Name(gen, ast.Load()), *form.args[1:]],
                 keywords=[],
             )
@@ -795,7 +839,11 @@ class _Transformer:
             args.append(limit)
         call = ast.Expr(
             ast.Call(
-                func=ast.Call(ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()), [ast.Constant("failure_handling")], []),
+                func=ast.Call(
+                    ast.Attribute(ast.Name("_pycram_rt", ast.Load()), "expression", ast.Load()),
+                    [ast.Constant("failure_handling")],
+                    [],
+                ),
                 args=args,
                 keywords=[ast.keyword("name", ast.Constant(label))],
             )
@@ -863,20 +911,25 @@ def _explicit_super(stmts: list[ast.stmt], first_param: str) -> None:
 
 
 def _has_docstring(body: list[ast.stmt]) -> bool:
-    return bool(body) and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str)
-
-
-def _rename_code(code: types.CodeType, names: Mapping[str, str], qualname_fix: tuple[str, str] | None = None) -> types.CodeType:
-    """Give generated branch code objects their helpful names (recursively, at compile time)."""
-    consts = tuple(
-        _rename_code(c, names, qualname_fix) if isinstance(c, types.CodeType) else c for c in code.co_consts
+    return (
+        bool(body)
+        and isinstance(body[0], ast.Expr)
+        and isinstance(body[0].value, ast.Constant)
+        and isinstance(body[0].value.value, str)
     )
+
+
+def _rename_code(
+    code: types.CodeType, names: Mapping[str, str], qualname_fix: tuple[str, str] | None = None
+) -> types.CodeType:
+    """Give generated branch code objects their helpful names (recursively, at compile time)."""
+    consts = tuple(_rename_code(c, names, qualname_fix) if isinstance(c, types.CodeType) else c for c in code.co_consts)
     changes: dict[str, Any] = {}
     if any(a is not b for a, b in zip(consts, code.co_consts)):
         changes["co_consts"] = consts
     qualname = code.co_qualname
     if qualname_fix is not None and qualname.startswith(qualname_fix[0]):
-        qualname = qualname_fix[1] + qualname[len(qualname_fix[0]):]
+        qualname = qualname_fix[1] + qualname[len(qualname_fix[0]) :]
     if code.co_name in names:
         nice = names[code.co_name]
         changes["co_name"] = nice
@@ -933,7 +986,9 @@ def plan(fn: F) -> F:
     if fn.__globals__.get(_TRANSFORMED_MARK):
         return fn
     if getattr(fn, "__wrapped__", None) is not None:
-        raise TypeError(f"@plan must be the innermost decorator (directly above `def {fn.__name__}`): it re-compiles the function's source")
+        raise TypeError(
+            f"@plan must be the innermost decorator (directly above `def {fn.__name__}`): it re-compiles the function's source"
+        )
     if fn.__name__ == "<lambda>":
         raise TypeError("@plan cannot be applied to a lambda; use `def`")
     code = fn.__code__
@@ -941,7 +996,9 @@ def plan(fn: F) -> F:
     try:
         lines, start = inspect.getsourcelines(fn)
     except (OSError, TypeError) as exc:
-        raise TypeError(f"@plan cannot find the source of {fn.__qualname__} ({filename}); the block syntax needs source code. Use the functional forms (par(f1, f2, ...)) instead") from exc
+        raise TypeError(
+            f"@plan cannot find the source of {fn.__qualname__} ({filename}); the block syntax needs source code. Use the functional forms (par(f1, f2, ...)) instead"
+        ) from exc
     source = "".join(lines)
     indented = bool(lines) and lines[0][:1] in (" ", "\t")
     offset = start - 1
@@ -971,7 +1028,15 @@ def plan(fn: F) -> F:
     freevars = code.co_freevars
     factory = ast.FunctionDef(
         name=f"{_P}factory",
-        args=ast.arguments(posonlyargs=[], args=[ast.arg(n) for n in freevars], vararg=None, kwonlyargs=[], kw_defaults=[], kwarg=None, defaults=[]),
+        args=ast.arguments(
+            posonlyargs=[],
+            args=[ast.arg(n) for n in freevars],
+            vararg=None,
+            kwonlyargs=[],
+            kw_defaults=[],
+            kwarg=None,
+            defaults=[],
+        ),
         body=[fdef, ast.Return(ast.Name(fdef.name, ast.Load()))],
         decorator_list=[],
         returns=None,
@@ -1104,7 +1169,9 @@ class PlanLoader(importlib.machinery.SourceFileLoader):
 class PlanFinder(importlib.abc.MetaPathFinder):
     """Meta path finder: modules that `opts_in` are loaded by `PlanLoader`; others are left alone."""
 
-    def find_spec(self, fullname: str, path: Sequence[str] | None, target: types.ModuleType | None = None) -> importlib.machinery.ModuleSpec | None:
+    def find_spec(
+        self, fullname: str, path: Sequence[str] | None, target: types.ModuleType | None = None
+    ) -> importlib.machinery.ModuleSpec | None:
         if fullname == "pycram" or fullname.startswith("pycram."):
             return None
         spec = importlib.machinery.PathFinder.find_spec(fullname, path, target)

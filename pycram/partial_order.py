@@ -19,7 +19,8 @@ by its number (1 = first statement).
 
 from __future__ import annotations
 
-from typing import Any, Hashable, Iterable, Mapping, Sequence
+from collections.abc import Hashable, Iterable, Mapping, Sequence
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.language import Branch, _BlockUse, par
@@ -51,7 +52,7 @@ def _cycle(after: list[set[int]], labels: list[str]) -> list[str] | None:
         stack.append(node)
         for prev in sorted(after[node]):
             if state[prev] == 1:
-                cycle = stack[stack.index(prev):] + [prev]
+                cycle = stack[stack.index(prev) :] + [prev]
                 return [labels[i] for i in cycle]
             if state[prev] == 0:
                 found = visit(prev)
@@ -69,8 +70,14 @@ def _cycle(after: list[set[int]], labels: list[str]) -> list[str] | None:
     return None
 
 
-def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None, *,
-                  errors: list | None = None, state: Fluent | None = None, name: str | None = None) -> Any:
+def partial_order(
+    steps: Any,
+    orderings: Iterable[tuple[Any, Any]] | None = None,
+    *,
+    errors: list | None = None,
+    state: Fluent | None = None,
+    name: str | None = None,
+) -> Any:
     """Run `steps` concurrently under the `(before, after)` `orderings` (see the module doc).
 
     Returns the state fluent (as `par`). Raises `TypeError` / `ValueError` naming the step or
@@ -86,7 +93,8 @@ def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None
         if not callable(fn):
             which = repr(keys[index]) if keys else str(index + 1)
             raise TypeError(
-                f"{label}: step {which} must be a callable taking no arguments, got {type(fn).__name__}: {fn!r}")
+                f"{label}: step {which} must be a callable taking no arguments, got {type(fn).__name__}: {fn!r}"
+            )
     names = _step_names(steps)
     after: list[set[int]] = [set() for _ in fns]
     fluents: list[list[Fluent]] = [[] for _ in fns]
@@ -94,7 +102,7 @@ def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None
         if not (isinstance(ordering, (tuple, list)) and len(ordering) == 2):
             raise ValueError(f"{label}: an ordering must be a pair (before, after), got {ordering!r}")
         before, later = ordering
-        for key in ((later,) if isinstance(before, Fluent) else (before, later)):
+        for key in (later,) if isinstance(before, Fluent) else (before, later):
             if key not in names:
                 raise ValueError(f"{label}: ordering {ordering!r} names unknown step {key!r}; steps: {list(names)}")
         if isinstance(before, Fluent):
@@ -105,7 +113,8 @@ def partial_order(steps: Any, orderings: Iterable[tuple[Any, Any]] | None = None
     cycle = _cycle(after, labels)
     if cycle:
         raise ValueError(
-            f"{label}: the orderings form a cycle {' -> '.join(reversed(cycle))}; no step of it could ever start")
+            f"{label}: the orderings form a cycle {' -> '.join(reversed(cycle))}; no step of it could ever start"
+        )
     ended = [Fluent(name=f"{label}: step {labels[i]} ended") for i in range(len(fns))]
 
     def constrained(index: int) -> Branch:

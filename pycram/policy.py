@@ -33,14 +33,22 @@ given to `with_policy`::
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.language import State, pursue
 from pycram.runtime import TaskStatus, current_task, sleep
 
-__all__ = ["Policy", "PolicyRun", "PolicyConditionMet", "PolicyInitFailed", "define_policy", "with_policy",
-           "timeout_policy"]
+__all__ = [
+    "Policy",
+    "PolicyRun",
+    "PolicyConditionMet",
+    "PolicyInitFailed",
+    "define_policy",
+    "with_policy",
+    "timeout_policy",
+]
 
 Phase = Callable[..., Any]
 
@@ -79,8 +87,15 @@ class Policy:
 
     __slots__ = ("name", "check", "init", "recover", "clean_up", "description")
 
-    def __init__(self, name: str, check: Phase, init: Phase | None = None, recover: Phase | None = None,
-                 clean_up: Phase | None = None, description: str = "") -> None:
+    def __init__(
+        self,
+        name: str,
+        check: Phase,
+        init: Phase | None = None,
+        recover: Phase | None = None,
+        clean_up: Phase | None = None,
+        description: str = "",
+    ) -> None:
         for phase, fn in (("check", check), ("init", init), ("recover", recover), ("clean_up", clean_up)):
             if fn is not None and not callable(fn):
                 raise TypeError(f"policy {name!r}: {phase} must be callable, got {type(fn).__name__}: {fn!r}")
@@ -99,8 +114,15 @@ class Policy:
         return f"<Policy {self.name}>"
 
 
-def define_policy(name: str, *, check: Phase, init: Phase | None = None, recover: Phase | None = None,
-                  clean_up: Phase | None = None, description: str = "") -> Policy:
+def define_policy(
+    name: str,
+    *,
+    check: Phase,
+    init: Phase | None = None,
+    recover: Phase | None = None,
+    clean_up: Phase | None = None,
+    description: str = "",
+) -> Policy:
     """A `Policy` with the given phases (see the module doc for when each runs)."""
     if not isinstance(name, str) or not name:
         raise TypeError(f"define_policy(): name must be a non-empty string, got {name!r}")
@@ -119,7 +141,8 @@ def with_policy(policy: Policy, body: Callable[[], Any], *params: Any) -> Any:
         raise TypeError(
             f"with_policy({policy.name!r}): body must be a callable taking no arguments, got {body!r}; "
             f"the block form `with with_policy(policy, *params):` needs the block syntax (`@plan`, "
-            f"`pycram run FILE.py` or `import pycram.activate`)")
+            f"`pycram run FILE.py` or `import pycram.activate`)"
+        )
     run = PolicyRun(policy, params)
     if policy.init is not None and not policy.init(run, *params):
         raise PolicyInitFailed(policy, params)
@@ -137,6 +160,7 @@ def with_policy(policy: Policy, body: Callable[[], Any], *params: Any) -> Any:
         monitor.__pycram_name__ = f"policy {policy.name}"  # type: ignore[attr-defined]
         body_branch = body
         if getattr(body, "__name__", "<lambda>") == "<lambda>" and not getattr(body, "__pycram_name__", None):
+
             def body_branch() -> Any:
                 return body()
 

@@ -52,14 +52,14 @@ import itertools
 import logging
 import threading
 from collections import deque
+from collections.abc import Callable
 from enum import Enum
-from typing import Any, Callable, ClassVar, Optional
+from typing import Any, ClassVar
 
 from pycram import events
 from pycram.designators.core import DesignatorError, callable_name, known_solution
 from pycram.designators.motion import MotionDesignator
-from pycram.designators.motion_types import (active_motion_types, check_motion,
-                                             describe_known_types)
+from pycram.designators.motion_types import active_motion_types, check_motion, describe_known_types
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
 from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
@@ -95,15 +95,15 @@ class ProcessModuleStatus(Enum):
     @property
     def done(self) -> bool:
         """True for the outcomes SUCCEEDED, FAILED and CANCELLED."""
-        return self in (ProcessModuleStatus.SUCCEEDED, ProcessModuleStatus.FAILED,
-                        ProcessModuleStatus.CANCELLED)
+        return self in (ProcessModuleStatus.SUCCEEDED, ProcessModuleStatus.FAILED, ProcessModuleStatus.CANCELLED)
 
 
 class ProcessModuleError(Exception):
     """Base class of process-module errors. Attributes: ``designator``, ``module``, ``cause``."""
 
-    def __init__(self, message: str, designator: Any = None, module: Any = None,
-                 cause: Optional[BaseException] = None) -> None:
+    def __init__(
+        self, message: str, designator: Any = None, module: Any = None, cause: BaseException | None = None
+    ) -> None:
         super().__init__(message)
         self.designator = designator
         self.module = module
@@ -131,8 +131,7 @@ class UnknownMotionTypeError(NoProcessModuleError):
     active robot declares (``robot.motion_types``); the message lists them. ``motion_type`` is
     the unknown type, ``known_types`` the declared ones."""
 
-    def __init__(self, message: str, designator: Any = None, motion_type: Any = None,
-                 known_types: Any = ()) -> None:
+    def __init__(self, message: str, designator: Any = None, motion_type: Any = None, known_types: Any = ()) -> None:
         super().__init__(message, designator=designator)
         self.motion_type = motion_type
         self.known_types = sorted(known_types, key=str)
@@ -146,18 +145,17 @@ class Execution:
     ``wait()`` blocks for the outcome, ``cancel()`` stops it.
     """
 
-    def __init__(self, module: "ProcessModule", designator: Any) -> None:
+    def __init__(self, module: ProcessModule, designator: Any) -> None:
         self.id = next(_ids)
         self.module = module
         self.designator = designator
-        self.status = Fluent(ProcessModuleStatus.WAITING,
-                             name=f"{module.name}.execution-{self.id}.status")
+        self.status = Fluent(ProcessModuleStatus.WAITING, name=f"{module.name}.execution-{self.id}.status")
         self.result: Any = None
-        self.exception: Optional[BaseException] = None
+        self.exception: BaseException | None = None
         #: Active-clock times [s] when ``_execute`` started and when the outcome was settled
         #: (``None`` if it never started).
-        self.start: Optional[float] = None
-        self.end: Optional[float] = None
+        self.start: float | None = None
+        self.end: float | None = None
         self._task: Any = None  # the child task of a nowait execution
         self._group: Any = None
         self._cancel_requested = False
@@ -166,7 +164,7 @@ class Execution:
     def done(self) -> bool:
         return self.status.get_value().done
 
-    def wait(self, timeout: Optional[float] = None) -> Any:
+    def wait(self, timeout: float | None = None) -> Any:
         """Block until the execution ended and return ``_execute``'s result.
 
         Raises :class:`ProcessModuleFailure` if it failed, :class:`ExecutionCancelled` if it was
@@ -183,7 +181,10 @@ class Execution:
         if status is ProcessModuleStatus.CANCELLED:
             raise ExecutionCancelled(
                 f"execution of {self.designator!r} on {self.module.name} was cancelled",
-                designator=self.designator, module=self.module, cause=self.exception)
+                designator=self.designator,
+                module=self.module,
+                cause=self.exception,
+            )
         assert self.exception is not None
         raise self.exception
 
@@ -197,8 +198,7 @@ class Execution:
             task.evaporate()
 
     def __repr__(self) -> str:
-        return (f"<Execution {self.id} of {self.designator!r} on {self.module.name} "
-                f"{self.status.get_value().value}>")
+        return f"<Execution {self.id} of {self.designator!r} on {self.module.name} {self.status.get_value().value}>"
 
 
 class ProcessModule:
@@ -210,7 +210,7 @@ class ProcessModule:
     are asked first.
     """
 
-    resolvers: ClassVar[list[Callable[[Any], Optional["ProcessModule"]]]] = []
+    resolvers: ClassVar[list[Callable[[Any], ProcessModule | None]]] = []
 
     #: What suspending the executing task (`pycram.runtime.suspension`) does to a running
     #: execution. "pause": ``_pause(designator)`` runs when the task blocks for suspension and
@@ -221,11 +221,11 @@ class ProcessModule:
     #: behaves as "pause".
     suspension: ClassVar[str] = "pause"
 
-    def __init__(self, name: Optional[str] = None) -> None:
+    def __init__(self, name: str | None = None) -> None:
         self.name = name or type(self).__name__
         self._cond = threading.Condition(threading.Lock())
         self._queue: deque[Execution] = deque()
-        self._current: Optional[Execution] = None
+        self._current: Execution | None = None
         self._offline = False
         self.status = Fluent(ProcessModuleStatus.WAITING, name=f"{self.name}.status")
         #: Number of designators waiting in the queue (not counting the running one).
@@ -264,7 +264,7 @@ class ProcessModule:
         return ProcessModule.resolve(designator).execute_nowait(designator)
 
     @staticmethod
-    def resolve(designator: Any) -> "ProcessModule":
+    def resolve(designator: Any) -> ProcessModule:
         """The module chosen for ``designator`` by the active robot's resolvers, then the
         global ``ProcessModule.resolvers``. Raises :class:`NoProcessModuleError`."""
         resolvers = gather("process_module_resolvers", ProcessModule.resolvers)
@@ -275,13 +275,17 @@ class ProcessModule:
                 raise ProcessModuleError(
                     f"process-module resolver {callable_name(resolver)} failed for "
                     f"{designator!r} ({describe_active_robot()}): {e!r}",
-                    designator=designator, cause=e) from e
+                    designator=designator,
+                    cause=e,
+                ) from e
             if module is None:
                 continue
             if not isinstance(module, ProcessModule):
                 raise ProcessModuleError(
                     f"process-module resolver {callable_name(resolver)} returned {module!r} "
-                    f"for {designator!r}, not a ProcessModule", designator=designator)
+                    f"for {designator!r}, not a ProcessModule",
+                    designator=designator,
+                )
             return module
         types = active_motion_types()
         motion_type = _type_of(designator)
@@ -289,14 +293,18 @@ class ProcessModule:
             raise UnknownMotionTypeError(
                 f"no process module for {designator!r}: unknown motion type {motion_type!r}; "
                 f"{describe_known_types(types, motion_type)}",
-                designator=designator, motion_type=motion_type, known_types=types)
+                designator=designator,
+                motion_type=motion_type,
+                known_types=types,
+            )
         robot = current_robot()
         available = sorted(robot.process_modules) if robot is not None else []
         raise NoProcessModuleError(
             f"no process module for {designator!r} ({describe_active_robot()}"
             + (f" with modules {available}" if robot is not None else "")
             + f"); resolvers asked: {[callable_name(r) for r in resolvers]}",
-            designator=designator)
+            designator=designator,
+        )
 
     def _execute(self, designator: Any) -> Any:
         """Execute ``designator`` (override). Runs in the caller's task; may be evaporated."""
@@ -323,8 +331,9 @@ class ProcessModule:
         :class:`ProcessModuleOffline`.
         """
         if self.suspension == "cancel":
-            return retry_after_suspension(lambda: self._execute_once(designator),
-                                          name=f"{self.name}: retry after suspension")
+            return retry_after_suspension(
+                lambda: self._execute_once(designator), name=f"{self.name}: retry after suspension"
+            )
         if self.suspension != "pause":
             raise ValueError(f"{type(self).__name__}.suspension must be 'pause' or 'cancel', got {self.suspension!r}")
         return self._execute_once(designator)
@@ -336,8 +345,9 @@ class ProcessModule:
             return execution.result
         if execution.exception is not None:
             raise execution.exception
-        raise ExecutionCancelled(f"execution of {designator!r} on {self.name} was cancelled",
-                                 designator=designator, module=self)
+        raise ExecutionCancelled(
+            f"execution of {designator!r} on {self.name} was cancelled", designator=designator, module=self
+        )
 
     def execute_nowait(self, designator: Any) -> Execution:
         """Queue ``designator`` and return its :class:`Execution` handle at once.
@@ -360,8 +370,7 @@ class ProcessModule:
             # The group is detached: nothing propagates to the caller's task.
             self._run(execution)
 
-        execution._task = group.spawn(f"{self.name}: {_type_of(designator)}", body,
-                                      kind="process-module")
+        execution._task = group.spawn(f"{self.name}: {_type_of(designator)}", body, kind="process-module")
         if execution._cancel_requested:
             execution._task.evaporate()
         return execution
@@ -374,9 +383,15 @@ class ProcessModule:
         with self._cond:
             self._offline = True
             for execution in list(self._queue):
-                self._finish_locked(execution, ProcessModuleStatus.CANCELLED, ProcessModuleOffline(
-                    f"{self.name} went offline before {execution.designator!r} ran",
-                    designator=execution.designator, module=self))
+                self._finish_locked(
+                    execution,
+                    ProcessModuleStatus.CANCELLED,
+                    ProcessModuleOffline(
+                        f"{self.name} went offline before {execution.designator!r} ran",
+                        designator=execution.designator,
+                        module=self,
+                    ),
+                )
             self._queue.clear()
             self.queued.set_value(0)
             if self._current is None:
@@ -398,7 +413,7 @@ class ProcessModule:
             return len(self._queue)
 
     @property
-    def current(self) -> Optional[Execution]:
+    def current(self) -> Execution | None:
         """The running execution, if any."""
         return self._current
 
@@ -418,8 +433,9 @@ class ProcessModule:
         execution = Execution(self, designator)
         with self._cond:
             if self._offline:
-                raise ProcessModuleOffline(f"{self.name} is offline; cannot execute {designator!r}",
-                                           designator=designator, module=self)
+                raise ProcessModuleOffline(
+                    f"{self.name} is offline; cannot execute {designator!r}", designator=designator, module=self
+                )
             self._queue.append(execution)
             self.queued.set_value(len(self._queue))
         return execution
@@ -477,7 +493,10 @@ class ProcessModule:
                 except Exception as e:
                     failure = ProcessModuleFailure(
                         f"{self.name} failed to execute {designator!r}: {type(e).__name__}: {e}",
-                        designator=designator, module=self, cause=e)
+                        designator=designator,
+                        module=self,
+                        cause=e,
+                    )
                     failure.__cause__ = e
                     error, outcome = failure, ProcessModuleStatus.FAILED
                 except BaseException as e:  # SystemExit, KeyboardInterrupt: failed, not cancelled
@@ -491,8 +510,14 @@ class ProcessModule:
         if not started and execution.exception is not None:
             raise execution.exception  # e.g. ProcessModuleOffline while queued
 
-    def _settle(self, execution: Execution, started: bool, outcome: ProcessModuleStatus,
-                error: Optional[BaseException], result: Any) -> None:
+    def _settle(
+        self,
+        execution: Execution,
+        started: bool,
+        outcome: ProcessModuleStatus,
+        error: BaseException | None,
+        result: Any,
+    ) -> None:
         """Run the cancel hook if the execution was cancelled (see `_cancel`), then free the
         module / leave the queue and record the outcome. Idempotent for a settled execution.
         Raises ``Evaporated`` at the end if the calling task is evaporating."""
@@ -505,8 +530,7 @@ class ProcessModule:
                     logger.debug("%s: cancelling %r", self.name, execution.designator)
                     self._cancel(execution.designator)
                 except Exception:
-                    logger.exception("%s: cancel hook failed for %r", self.name,
-                                     execution.designator)
+                    logger.exception("%s: cancel hook failed for %r", self.name, execution.designator)
             with self._cond:
                 if started and execution.end is None:
                     execution.end = current_clock().now()  # before waiters see the outcome
@@ -517,18 +541,17 @@ class ProcessModule:
                     self._current = None
                     execution.result = result
                     self._running.set_value(False)
-                    self.status.set_value(ProcessModuleStatus.OFFLINE if self._offline
-                                          else outcome)
+                    self.status.set_value(ProcessModuleStatus.OFFLINE if self._offline else outcome)
                 if not execution.done:
                     self._finish_locked(execution, outcome, error)
                 self._cond.notify_all()
             if started:
                 cause = error.cause if isinstance(error, ProcessModuleFailure) else error
-                events.process_module_executed(self, execution.designator, outcome.value,
-                                               execution.start, execution.end, cause)
+                events.process_module_executed(
+                    self, execution.designator, outcome.value, execution.start, execution.end, cause
+                )
 
-    def _finish_locked(self, execution: Execution, outcome: ProcessModuleStatus,
-                       error: Optional[BaseException]) -> None:
+    def _finish_locked(self, execution: Execution, outcome: ProcessModuleStatus, error: BaseException | None) -> None:
         execution.exception = error
         execution.status.set_value(outcome)
 

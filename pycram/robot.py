@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import Any, Callable, Iterable, Optional
+from collections.abc import Callable, Iterable
+from typing import Any
 
 __all__ = [
     "ResolverSet",
@@ -40,8 +41,8 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 _lock = threading.RLock()
-_active_robot: Optional["Robot"] = None
-_active_world: Optional["ResolverSet"] = None
+_active_robot: Robot | None = None
+_active_world: ResolverSet | None = None
 
 
 class ResolverSet:
@@ -85,7 +86,7 @@ class ResolverSet:
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
 
-    def __enter__(self) -> "ResolverSet":
+    def __enter__(self) -> ResolverSet:
         self._previous_world = use_world(self)
         return self
 
@@ -106,11 +107,11 @@ class Robot(ResolverSet):
     stop its process modules.
     """
 
-    def __init__(self, name: str, process_modules: Optional[dict[str, Any]] = None) -> None:
+    def __init__(self, name: str, process_modules: dict[str, Any] | None = None) -> None:
         super().__init__(name)
         self.process_modules: dict[str, Any] = dict(process_modules or {})
         self.process_module_resolvers: list[Callable[..., Any]] = []
-        self._previous_stack: list[Optional[Robot]] = []
+        self._previous_stack: list[Robot | None] = []
         self._stack_lock = threading.Lock()
 
     def add_process_module(self, name: str, module: Any) -> Any:
@@ -127,11 +128,10 @@ class Robot(ResolverSet):
             return self.process_modules[name]
         except KeyError:
             raise KeyError(
-                f"robot {self.name!r} has no process module {name!r}; "
-                f"available: {sorted(self.process_modules)}"
+                f"robot {self.name!r} has no process module {name!r}; available: {sorted(self.process_modules)}"
             ) from None
 
-    def __enter__(self) -> "Robot":
+    def __enter__(self) -> Robot:
         previous = use_robot(self)
         with self._stack_lock:
             self._previous_stack.append(previous)
@@ -143,7 +143,7 @@ class Robot(ResolverSet):
         use_robot(previous)
 
 
-def use_robot(robot: Optional[Robot]) -> Optional[Robot]:
+def use_robot(robot: Robot | None) -> Robot | None:
     """Make ``robot`` the active robot for the whole process (``None`` deactivates).
 
     Returns the previously active robot so callers can restore it. Prefer ``with robot:``.
@@ -157,12 +157,12 @@ def use_robot(robot: Optional[Robot]) -> Optional[Robot]:
     return previous
 
 
-def current_robot() -> Optional[Robot]:
+def current_robot() -> Robot | None:
     """The active robot, or ``None`` when the thesis' global resolver lists are in use."""
     return _active_robot
 
 
-def use_world(world: Optional[ResolverSet]) -> Optional[ResolverSet]:
+def use_world(world: ResolverSet | None) -> ResolverSet | None:
     """Make ``world`` the active world resolver set (``None`` deactivates); returns the previous."""
     global _active_world
     if world is not None and not isinstance(world, ResolverSet):
@@ -172,7 +172,7 @@ def use_world(world: Optional[ResolverSet]) -> Optional[ResolverSet]:
     return previous
 
 
-def current_world() -> Optional[ResolverSet]:
+def current_world() -> ResolverSet | None:
     """The active world resolver set, or ``None``."""
     return _active_world
 
@@ -186,9 +186,11 @@ def current_prospection() -> Any:
     for resolver_set in active_resolver_sets():
         if resolver_set.prospection is not None:
             return resolver_set.prospection
-    raise LookupError(f"no prospection available: {describe_active_robot()}, active world "
-                      f"{_active_world!r}; activate a robot whose world supports prospection "
-                      f"(e.g. a simulated one)")
+    raise LookupError(
+        f"no prospection available: {describe_active_robot()}, active world "
+        f"{_active_world!r}; activate a robot whose world supports prospection "
+        f"(e.g. a simulated one)"
+    )
 
 
 def active_resolver_sets() -> list[ResolverSet]:

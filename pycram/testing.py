@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import threading
 from collections import deque
-from typing import Any, Callable, Iterable, Iterator, Optional
+from collections.abc import Callable, Iterable, Iterator
+from typing import Any
 
 from pycram.process_module import ProcessModule
 from pycram.runtime import wait_until
@@ -36,8 +37,13 @@ class ScriptedProcessModule(ProcessModule):
     - ``max_concurrency``: the largest number of simultaneous ``_execute`` calls observed.
     """
 
-    def __init__(self, name: Optional[str] = None, script: Iterable[Any] = (),
-                 hold: bool = False, default: Optional[Callable[[Any], Any]] = None) -> None:
+    def __init__(
+        self,
+        name: str | None = None,
+        script: Iterable[Any] = (),
+        hold: bool = False,
+        default: Callable[[Any], Any] | None = None,
+    ) -> None:
         super().__init__(name)
         self.script: deque[Any] = deque(script)
         self.hold = hold

@@ -18,15 +18,28 @@ class Command:
     by threads of their own (both kept whole in `stdout` / `stderr`)."""
 
     def __init__(self, args: list[str], db: str, cwd: Path) -> None:
-        env = dict(os.environ, PYCRAM_DB_URL=db, PYTHONUNBUFFERED="1", COLUMNS="200",
-                   MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
-        self.process = subprocess.Popen([sys.executable, "-m", "pycram", *args], stdout=subprocess.PIPE,
-                                        stderr=subprocess.PIPE, text=True, env=env, cwd=cwd)
+        env = dict(
+            os.environ,
+            PYCRAM_DB_URL=db,
+            PYTHONUNBUFFERED="1",
+            COLUMNS="200",
+            MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"),
+        )
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "pycram", *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+            cwd=cwd,
+        )
         self._lines: queue.SimpleQueue[str | None] = queue.SimpleQueue()
         self._out: list[str] = []
         self._err: list[str] = []
-        self._readers = [threading.Thread(target=self._read, args=(self.process.stdout, self._out), daemon=True),
-                         threading.Thread(target=self._read, args=(self.process.stderr, self._err), daemon=True)]
+        self._readers = [
+            threading.Thread(target=self._read, args=(self.process.stdout, self._out), daemon=True),
+            threading.Thread(target=self._read, args=(self.process.stderr, self._err), daemon=True),
+        ]
         for reader in self._readers:
             reader.start()
 

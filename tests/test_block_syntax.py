@@ -50,7 +50,9 @@ def run(source: str, tmp_path: Path, name: str = "plan_src.py") -> dict[str, Any
 
 
 def test_each_statement_is_one_branch_and_state_is_bound_first() -> None:
-    tree, names = transform_source(HEADER + "with par(errors) as s:\n    a = 1\n    if True:\n        b = 2\n        c = 3\n", "/x/demo.py")
+    tree, names = transform_source(
+        HEADER + "with par(errors) as s:\n    a = 1\n    if True:\n        b = 2\n        c = 3\n", "/x/demo.py"
+    )
     module = ast.unparse(tree)
     assert sorted(names.values()) == ["par@demo.py:3#1", "par@demo.py:3#2"]
     assert module.index("s = _pycram_state") < module.index("def _pycram_par")  # bound before branches
@@ -60,7 +62,10 @@ def test_each_statement_is_one_branch_and_state_is_bound_first() -> None:
 
 
 def test_thesis_macros_import_is_dropped(tmp_path: Path) -> None:
-    ns = run("from pycram.language import macros, par\nfrom pycram.fluent import macros, Fluent\nwith par as s:\n    x = 1\n", tmp_path)
+    ns = run(
+        "from pycram.language import macros, par\nfrom pycram.fluent import macros, Fluent\nwith par as s:\n    x = 1\n",
+        tmp_path,
+    )
     assert ns["s"].get_value() is State.SUCCEEDED and ns["x"] == 1
 
 
@@ -473,7 +478,10 @@ def test_python_dash_m_pycram_failure_points_at_user_line(tmp_path: Path) -> Non
     path = _write(tmp_path / "boom.py", HEADER + "with failure_handling():\n    raise KeyError('boom')\n")
     proc = subprocess.run(
         [sys.executable, "-m", "pycram", str(path)],
-        capture_output=True, text=True, timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
     )
     assert proc.returncode == 1
     assert f'File "{path}", line 4, in failure_handling@boom.py:3' in proc.stderr
@@ -492,7 +500,11 @@ def test_import_hook_transforms_only_opted_in_modules(tmp_path: Path, monkeypatc
     pkg = tmp_path / "hooked_pkg"
     pkg.mkdir()
     _write(pkg / "__init__.py", "")
-    _write(pkg / "plan_mod.py", HEADER + "from pycram.language import plan\nwith par as s:\n    x = 1\n\n@plan\ndef f():\n    with seq as t:\n        v = 2\n    return v\n")
+    _write(
+        pkg / "plan_mod.py",
+        HEADER
+        + "from pycram.language import plan\nwith par as s:\n    x = 1\n\n@plan\ndef f():\n    with seq as t:\n        v = 2\n    return v\n",
+    )
     _write(pkg / "plain_mod.py", "import contextlib\npar = contextlib.nullcontext\nwith par():\n    y = 1\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     installed = install_import_hook()
@@ -543,7 +555,11 @@ def test_import_hook_reports_misuse_with_file_and_line(tmp_path: Path, monkeypat
     monkeypatch.syspath_prepend(str(tmp_path))
     installed = install_import_hook()
     try:
-        for name, line, match in (("returns", 5, "`return` is not allowed"), ("empty", 3, "has no statements"), ("broken", 4, "never closed")):
+        for name, line, match in (
+            ("returns", 5, "`return` is not allowed"),
+            ("empty", 3, "has no statements"),
+            ("broken", 4, "never closed"),
+        ):
             with pytest.raises(SyntaxError, match=match) as info:
                 importlib.import_module(f"bad_hooked_pkg.{name}")
             assert (info.value.filename, info.value.lineno) == (str(pkg / f"{name}.py"), line)
@@ -587,7 +603,9 @@ def test_plan_tracebacks_and_task_names_point_at_the_user_lines() -> None:
     frame = traceback.extract_tb(error.__traceback__)[-1]
     par_line = _line_of("# marker: traceback par")
     assert (frame.filename, frame.lineno, frame.name) == (
-        __file__, _line_of("# marker: traceback failure"), f"par@test_block_syntax.py:{par_line}#2"
+        __file__,
+        _line_of("# marker: traceback failure"),
+        f"par@test_block_syntax.py:{par_line}#2",
     )
     assert frame.line.startswith('{}["missing"]')
     task = current_task().children[-1]
@@ -610,7 +628,7 @@ def test_a_branch_that_is_a_single_call_is_named_after_the_callee() -> None:
     def fetch() -> None:
         with par:  # marker: names par
             grab_item()  # marker: names grab
-            ProcessModule.perform([('type', 'moving'), ('pose', (1, 2, 0))])
+            ProcessModule.perform([("type", "moving"), ("pose", (1, 2, 0))])
             pose = motion(type="looking", target="cup")
             if True:  # marker: names block
                 x = 1
@@ -637,7 +655,11 @@ def test_a_branch_that_is_a_single_call_is_named_after_the_callee() -> None:
 
 def _line_of(marker: str) -> int:
     """The line of this file that holds `marker` (once, besides this lookup's own argument)."""
-    lines = [i for i, text in enumerate(Path(__file__).read_text().splitlines(), 1) if marker in text and "_line_of(" not in text]
+    lines = [
+        i
+        for i, text in enumerate(Path(__file__).read_text().splitlines(), 1)
+        if marker in text and "_line_of(" not in text
+    ]
     assert len(lines) == 1, lines
     return lines[0]
 
@@ -645,12 +667,17 @@ def _line_of(marker: str) -> int:
 def test_pdb_breakpoint_inside_a_par_branch_in_a_worker_thread(tmp_path: Path) -> None:
     path = _write(
         tmp_path / "pdb_plan.py",
-        HEADER + "with par as s:\n    if True:\n        answer = 41 + 1\n        breakpoint()\n        after = answer\n    other = 1\n",
+        HEADER
+        + "with par as s:\n    if True:\n        answer = 41 + 1\n        breakpoint()\n        after = answer\n    other = 1\n",
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONBREAKPOINT": "pdb.set_trace"}
     proc = subprocess.run(
-        [sys.executable, "-m", "pycram", str(path)], input="p answer\nwhere\nnext\np after\ncontinue\n",
-        capture_output=True, text=True, timeout=60, env=env,
+        [sys.executable, "-m", "pycram", str(path)],
+        input="p answer\nwhere\nnext\np after\ncontinue\n",
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     out = proc.stdout
@@ -665,7 +692,8 @@ def test_coverage_style_line_tracing_sees_branch_lines_in_every_thread(tmp_path:
     sys.settrace/threading.settrace: branch bodies must be attributed to the user's lines."""
     path = _write(
         tmp_path / "covered.py",
-        HEADER + "out = []\nwith par as s:\n    out.append(1)\n    if True:\n        out.append(2)\n        out.append(3)\nwith seq as t:\n    out.append(4)\n",
+        HEADER
+        + "out = []\nwith par as s:\n    out.append(1)\n    if True:\n        out.append(2)\n        out.append(3)\nwith seq as t:\n    out.append(4)\n",
     )
     code = (
         "import json, sys, trace\n"
@@ -675,8 +703,13 @@ def test_coverage_style_line_tracing_sees_branch_lines_in_every_thread(tmp_path:
         f"lines = sorted(line for (name, line) in tracer.results().counts if name == {str(path)!r})\n"
         "print(json.dumps(lines))\n"
     )
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert proc.returncode == 0, proc.stderr
     lines = set(json.loads(proc.stdout.strip().splitlines()[-1]))
     assert set(range(3, 11)) <= lines  # every statement, in the main thread and in the branch threads
@@ -687,13 +720,18 @@ def test_debugger_breakpoint_on_a_line_of_a_concurrent_branch(tmp_path: Path) ->
     there although the branch runs in a worker thread: branches inherit the debugger's tracer."""
     import bdb
 
-    path = _write(tmp_path / "dbg_par.py", HEADER + "hits = []\nwith par as s:\n    hits.append(1)\n    hits.append(2)\nafter = 3\n")
+    path = _write(
+        tmp_path / "dbg_par.py",
+        HEADER + "hits = []\nwith par as s:\n    hits.append(1)\n    hits.append(2)\nafter = 3\n",
+    )
     stops: list[tuple[int, str, bool]] = []
 
     class Recorder(bdb.Bdb):
         def user_line(self, frame: types.FrameType) -> None:
             if self.break_here(frame):
-                stops.append((frame.f_lineno, frame.f_code.co_name, threading.current_thread() is threading.main_thread()))
+                stops.append(
+                    (frame.f_lineno, frame.f_code.co_name, threading.current_thread() is threading.main_thread())
+                )
             self.set_continue()
 
     debugger = Recorder()

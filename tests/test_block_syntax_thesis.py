@@ -41,13 +41,22 @@ EXPECTED_LISTINGS: dict[str, Any] = {
     "failure_handling_unlimited": 20,
 }
 TARGETS = [[1, 0], [2, 0], [3, 0]]
-RESET_KINDS = sorted(["setting_gripper", "setting_gripper", "setting_arm_joints", "setting_arm_joints", "setting_torso"])
+RESET_KINDS = sorted(
+    ["setting_gripper", "setting_gripper", "setting_arm_joints", "setting_arm_joints", "setting_torso"]
+)
 DEMO_KINDS = [  # after reset_robot, without the head motions of the concurrent `whenever`
-    "moving", "setting_gripper", "setting_gripper",  # attempt 1: nothing at x=0.1
-    "moving", "setting_gripper", "setting_gripper",  # attempt 2: nothing at x=-0.2
-    "moving", "setting_gripper",  # attempt 3: grabbed at x=0.4
+    "moving",
+    "setting_gripper",
+    "setting_gripper",  # attempt 1: nothing at x=0.1
+    "moving",
+    "setting_gripper",
+    "setting_gripper",  # attempt 2: nothing at x=-0.2
+    "moving",
+    "setting_gripper",  # attempt 3: grabbed at x=0.4
     "moving",  # to cooker #1: the item falls out
-    "cancelling_movement", "setting_gripper", "setting_gripper",  # put back; raise; retry()
+    "cancelling_movement",
+    "setting_gripper",
+    "setting_gripper",  # put back; raise; retry()
     "moving",  # attempt 2 of failure_handling: arrives
     "setting_gripper",  # place_item
 ]
@@ -139,8 +148,14 @@ def test_pycram_run_console_script(tmp_path: Path) -> None:
     if not pycram.exists():
         pytest.skip(f"the `pycram` console script is not installed next to {sys.executable}")
     env = {**os.environ, "PYTHONPATH": str(ROOT), "PYCRAM_RECORD": "0"}
-    proc = subprocess.run([str(pycram), "run", "--no-record", str(MODULE_LISTINGS)], capture_output=True,
-                          text=True, timeout=60, cwd=tmp_path, env=env)
+    proc = subprocess.run(
+        [str(pycram), "run", "--no-record", str(MODULE_LISTINGS)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=tmp_path,
+        env=env,
+    )
     assert proc.returncode == 0, proc.stderr
     check_module_results(json.loads(proc.stdout.strip().splitlines()[-1]))
 
@@ -172,11 +187,7 @@ def test_import_hook_in_process(tmp_path: Path, monkeypatch: pytest.MonkeyPatch)
 
 def test_import_pycram_activate(tmp_path: Path) -> None:
     make_plan_package(tmp_path)
-    code = (
-        "import json, pycram.activate\n"
-        "import plans.thesis_module as m\n"
-        "print(json.dumps(m.RESULTS, default=list))\n"
-    )
+    code = "import json, pycram.activate\nimport plans.thesis_module as m\nprint(json.dumps(m.RESULTS, default=list))\n"
     proc = _python("-c", code, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     check_module_results(json.loads(proc.stdout.strip().splitlines()[-1]))

@@ -159,13 +159,42 @@ def test_demo_passes_options_through(monkeypatch, db):
     fake = types.ModuleType("pycram.demos.kitchen")
     fake.main = fake_main
     monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
-    result = _invoke("demo", "--robot", "tiago", "--output", "out", "--item-at", "2", "--steal", "1",
-                     "--seed", "7", "--realtime", "--db", "sqlite:///x.sqlite3", "--no-record", "--quiet",
-                     "--no-animation", "--backend", "ros")
+    result = _invoke(
+        "demo",
+        "--robot",
+        "tiago",
+        "--output",
+        "out",
+        "--item-at",
+        "2",
+        "--steal",
+        "1",
+        "--seed",
+        "7",
+        "--realtime",
+        "--db",
+        "sqlite:///x.sqlite3",
+        "--no-record",
+        "--quiet",
+        "--no-animation",
+        "--backend",
+        "ros",
+    )
     assert result.exit_code == 0, result.output
-    assert calls == dict(robot="tiago", output="out", item_at=2, steal=1, seed=7, realtime=True,
-                         interactive=False, db="sqlite:///x.sqlite3", record=False, quiet=True, animation=False,
-                         backend="ros")
+    assert calls == dict(
+        robot="tiago",
+        output="out",
+        item_at=2,
+        steal=1,
+        seed=7,
+        realtime=True,
+        interactive=False,
+        db="sqlite:///x.sqlite3",
+        record=False,
+        quiet=True,
+        animation=False,
+        backend="ros",
+    )
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")
     assert calls["record"] is False and calls["robot"] == "pr2"
@@ -188,8 +217,7 @@ def test_demo_output_that_cannot_be_written_is_one_line_and_exit_2(fake_demo, tm
     """Tests run as root: a path under a regular file is what cannot be created."""
     a_file = tmp_path / "a-file"
     a_file.write_text("not a folder")
-    for output, expected in ((a_file / "sub", f"{a_file} is not a folder"),
-                             (a_file, "exists and is not a folder")):
+    for output, expected in ((a_file / "sub", f"{a_file} is not a folder"), (a_file, "exists and is not a folder")):
         result = _invoke("demo", "--output", str(output))
         assert result.exit_code == 2, result.output
         lines = result.output.strip().splitlines()
@@ -200,8 +228,9 @@ def test_demo_output_that_cannot_be_written_is_one_line_and_exit_2(fake_demo, tm
     assert not (tmp_path / "new").exists()  # the check creates nothing; the demo does
 
 
-@pytest.mark.parametrize("option,value", [("--steal", "-1"), ("--steal", "101"), ("--item-at", "4"),
-                                          ("--item-at", "-1"), ("--seed", "-3")])
+@pytest.mark.parametrize(
+    "option,value", [("--steal", "-1"), ("--steal", "101"), ("--item-at", "4"), ("--item-at", "-1"), ("--seed", "-3")]
+)
 def test_demo_options_out_of_range_are_refused_with_exit_2(fake_demo, option, value):
     result = _invoke("demo", option, value)
     assert result.exit_code == 2, result.output
@@ -221,8 +250,9 @@ def test_console_script_subprocess(tmp_path, plan_file):
     env.pop("PYCRAM_RECORD", None)
     exe = Path(sys.executable).with_name("pycram")
     command = [str(exe)] if exe.exists() else [sys.executable, "-m", "pycram"]
-    out = subprocess.run([*command, "run", str(plan_file)], capture_output=True, text=True, env=env,
-                         cwd=REPO, timeout=120)
+    out = subprocess.run(
+        [*command, "run", str(plan_file)], capture_output=True, text=True, env=env, cwd=REPO, timeout=120
+    )
     assert out.returncode == 0, out.stderr
     assert "recorded as run 1" in out.stderr
     out = subprocess.run([*command, "runs"], capture_output=True, text=True, env=env, cwd=REPO, timeout=60)
@@ -277,8 +307,10 @@ def test_db_option_names_the_database(tmp_path, plan_file, monkeypatch):
     monkeypatch.delenv("PYCRAM_RECORD", raising=False)
     monkeypatch.setenv("PYCRAM_DB_URL", f"sqlite:///{tmp_path / 'env.sqlite3'}")
     other = tmp_path / "other.sqlite3"
-    assert _invoke("run", str(plan_file), "--db", f"sqlite:///{other}", "--plan", "by option",
-                   "--robot", "pr2").exit_code == 0
+    assert (
+        _invoke("run", str(plan_file), "--db", f"sqlite:///{other}", "--plan", "by option", "--robot", "pr2").exit_code
+        == 0
+    )
     assert other.exists() and not (tmp_path / "env.sqlite3").exists()
     line = _invoke("runs", "--db", str(other)).output.splitlines()[1]  # a bare path works too
     fields = [field.strip() for field in line.split("  ") if field.strip()]
@@ -301,8 +333,10 @@ par(wait_long, wait_long)
 """
 
 
-@pytest.mark.parametrize("signame, code, reason", [("SIGINT", 130, "interrupted by Ctrl-C (SIGINT)"),
-                                                   ("SIGTERM", 143, "terminated by SIGTERM")])
+@pytest.mark.parametrize(
+    "signame, code, reason",
+    [("SIGINT", 130, "interrupted by Ctrl-C (SIGINT)"), ("SIGTERM", 143, "terminated by SIGTERM")],
+)
 def test_run_ends_as_interrupted_on_a_signal(tmp_path, signame, code, reason):
     """The script waits in two `par` branches; the signal stops it (its branches end too), the
     run is recorded as interrupted with the reason, the exit code is 128 + signal, one line says

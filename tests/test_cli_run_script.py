@@ -14,7 +14,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parent.parent
 
-FAILING_SCRIPT = '''\
+FAILING_SCRIPT = """\
 import logging
 from pycram.language import seq
 
@@ -32,7 +32,7 @@ def fetch():
 
 seq(lambda: None)
 fetch()
-'''
+"""
 
 
 def _commands(tmp_path: Path) -> dict[str, list[str]]:
@@ -44,8 +44,7 @@ def _commands(tmp_path: Path) -> dict[str, list[str]]:
 def _run(command: list[str], *args: str, tmp_path: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ, PYTHONPATH=str(REPO), PYCRAM_DB_URL=f"sqlite:///{tmp_path / 'runs.sqlite3'}")
     env.pop("PYCRAM_RECORD", None)
-    return subprocess.run([*command, *args], capture_output=True, text=True, env=env, cwd=tmp_path,
-                          timeout=120)
+    return subprocess.run([*command, *args], capture_output=True, text=True, env=env, cwd=tmp_path, timeout=120)
 
 
 @pytest.mark.parametrize("how", ["pycram run", "python -m pycram"])
@@ -53,8 +52,12 @@ def test_the_script_configures_logging(how, tmp_path):
     """examples/language_tour.py logs at INFO with its own basicConfig: every line shows."""
     out = _run(_commands(tmp_path)[how], str(REPO / "examples" / "language_tour.py"), tmp_path=tmp_path)
     assert out.returncode == 0, out.stderr
-    for line in ("driving: State.SUCCEEDED", "grasping: State.SUCCEEDED after 1 failed attempt(s)",
-                 "placed the item on try 3", "park arms"):
+    for line in (
+        "driving: State.SUCCEEDED",
+        "grasping: State.SUCCEEDED after 1 failed attempt(s)",
+        "placed the item on try 3",
+        "park arms",
+    ):
         assert line in out.stderr, out.stderr
     assert not out.stderr.startswith("INFO "), "the CLI's format must not replace the script's"
 
@@ -66,10 +69,11 @@ def test_a_scripts_traceback_starts_at_the_scripts_code(how, tmp_path):
     out = _run(_commands(tmp_path)[how], str(script), tmp_path=tmp_path)
     assert out.returncode == 1
     assert "starting the plan" in out.stderr  # the script's own logging
-    report = out.stderr[out.stderr.index("Traceback (most recent call last):"):]
+    report = out.stderr[out.stderr.index("Traceback (most recent call last):") :]
     files = re.findall(r'^  File "([^"]+)", line (\d+), in (\S+)', report, flags=re.MULTILINE)
-    assert files == [(str(script), "17", "<module>"), (str(script), "14", "fetch"),
-                     (str(script), "11", "grasp")], report
+    assert files == [(str(script), "17", "<module>"), (str(script), "14", "fetch"), (str(script), "11", "grasp")], (
+        report
+    )
     assert report.rstrip().endswith("GraspFailed: nothing between the fingers")
     for internal in ("typer", "click", "cli.py", "macros.py", "runpy"):
         assert internal not in report, report

@@ -76,7 +76,6 @@ def test_with_tags_1_tags_introduce_no_hidden_parallelism() -> None:
 
 from pycram.language import partial_order  # noqa: E402
 
-
 _end_order = itertools.count()  # a global order of the workers' end times
 
 
@@ -97,15 +96,17 @@ def test_partial_order_1_one_task_directly_depends_on_another() -> None:
 
 def test_partial_order_2_sequential_ordering_of_three_tasks() -> None:
     times: dict = {}
-    partial_order([_worker(f"worker-{i}", times) for i in (1, 2, 3)],
-                  [("worker-1", "worker-3"), ("worker-3", "worker-2")])
+    partial_order(
+        [_worker(f"worker-{i}", times) for i in (1, 2, 3)], [("worker-1", "worker-3"), ("worker-3", "worker-2")]
+    )
     assert times["worker-1"] < times["worker-3"] < times["worker-2"]
 
 
 def test_partial_order_3_task_constrained_by_two_parallel_tasks() -> None:
     times: dict = {}
-    partial_order([_worker(f"worker-{i}", times) for i in (1, 2, 3)],
-                  [("worker-1", "worker-3"), ("worker-2", "worker-3")])
+    partial_order(
+        [_worker(f"worker-{i}", times) for i in (1, 2, 3)], [("worker-1", "worker-3"), ("worker-2", "worker-3")]
+    )
     assert times["worker-1"] < times["worker-3"] and times["worker-2"] < times["worker-3"]
 
 
@@ -114,8 +115,10 @@ def test_partial_order_4_ring_dependencies_are_rejected_instead_of_deadlocking()
     # hang). PyCRAM refuses the cycle before anything runs.
     ran = []
     with pytest.raises(ValueError, match="cycle"):
-        partial_order([tag("worker-1", lambda: ran.append(1)), tag("worker-2", lambda: ran.append(2))],
-                      [("worker-1", "worker-2"), ("worker-2", "worker-1")])
+        partial_order(
+            [tag("worker-1", lambda: ran.append(1)), tag("worker-2", lambda: ran.append(2))],
+            [("worker-1", "worker-2"), ("worker-2", "worker-1")],
+        )
     assert ran == []
 
 
@@ -155,12 +158,16 @@ def test_with_task_suspended_2_suspends_and_wakes_a_whole_tree() -> None:
     with with_tags() as tags:
 
         def waiters():
-            return pursue(tag("winner", lambda: (knob.wait_for(), "A")[1]),
-                          lambda: (end_of_time.wait_for(), "B")[1],
-                          lambda: (end_of_time.wait_for(), "C")[1])
+            return pursue(
+                tag("winner", lambda: (knob.wait_for(), "A")[1]),
+                lambda: (end_of_time.wait_for(), "B")[1],
+                lambda: (end_of_time.wait_for(), "C")[1],
+            )
 
-        state = par(tag("waiters", waiters),
-                    lambda: with_task_suspended(tags.wait_task("waiters", TIMEOUT), lambda: knob.set_value(True)))
+        state = par(
+            tag("waiters", waiters),
+            lambda: with_task_suspended(tags.wait_task("waiters", TIMEOUT), lambda: knob.set_value(True)),
+        )
     assert state.get_value() is State.SUCCEEDED
     assert tags["winner"].result == "A"
 
@@ -238,15 +245,16 @@ def test_failure_1_failures_of_a_suspended_tree_are_propagated() -> None:
     errors: list = []
 
     def slave():
-        state = pursue(lambda: (knob.wait_for(), _raise(Fail("slave")))[1],
-                       lambda: sleep(3.0), lambda: sleep(3.0))
+        state = pursue(lambda: (knob.wait_for(), _raise(Fail("slave")))[1], lambda: sleep(3.0), lambda: sleep(3.0))
         if state.get_value() is State.FAILED:
             raise Fail("pursue failed")
 
     with with_tags() as tags:
-        state = par(tag("slave", slave),
-                    lambda: with_task_suspended(tags.wait_task("slave", TIMEOUT), lambda: knob.set_value(True)),
-                    errors=errors)
+        state = par(
+            tag("slave", slave),
+            lambda: with_task_suspended(tags.wait_task("slave", TIMEOUT), lambda: knob.set_value(True)),
+            errors=errors,
+        )
     assert state.get_value() is State.FAILED and [str(e) for e in errors] == ["pursue failed"]
 
 
@@ -312,8 +320,10 @@ def test_walk_with_tag_handler_simple() -> None:
 
 def test_walk_with_tag_handler_nested_tags_and_paths() -> None:
     with with_tags() as tags:
-        par(tag("tag1", lambda: [1, 2]),
-            tag("tag2", lambda: seq(tag("tag3", tag("tag4", lambda: None)), tag("tag5", lambda: None))))
+        par(
+            tag("tag1", lambda: [1, 2]),
+            tag("tag2", lambda: seq(tag("tag3", tag("tag4", lambda: None)), tag("tag5", lambda: None))),
+        )
     assert _tags_in(tags) == {"tag1", "tag2", "tag3", "tag4", "tag5"}
     tag4 = tags["tag4"]
     assert tag4.parent is tags["tag3"] and tags["tag2"].path.endswith("/par/tag2")  # a branch: no extra level

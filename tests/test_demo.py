@@ -32,8 +32,8 @@ def grasp_attempts(tree_text: str) -> list[str]:
 
 
 def assert_pictures(result):
-    from PIL import Image
     import numpy as np
+    from PIL import Image
 
     for name in ("start.png", "end.png", "timeline.png"):
         image = np.asarray(Image.open(result.output / name).convert("RGB"), dtype=float)
@@ -79,10 +79,13 @@ def test_no_item_ends_with_a_clear_failure(tmp_path):
     assert not result.item_on_cooker_1
 
 
-@pytest.mark.parametrize("option, value, expected", [
-    ("robot", "nao", "--robot must be 'pr2' or 'tiago'"),
-    ("item_at", 4, "--item-at must be 0 (no item) or a position 1, 2 or 3"),
-])
+@pytest.mark.parametrize(
+    "option, value, expected",
+    [
+        ("robot", "nao", "--robot must be 'pr2' or 'tiago'"),
+        ("item_at", 4, "--item-at must be 0 (no item) or a position 1, 2 or 3"),
+    ],
+)
 def test_bad_options_get_a_clear_message_and_exit_code_2(tmp_path, capsys, option, value, expected):
     from pycram.demos.kitchen import main
 
@@ -103,6 +106,7 @@ def test_the_command_prints_the_collapsed_task_tree_and_a_verdict(tmp_path, caps
 
 
 # -- the pictures tell the story (issue 12, point 5) -----------------------------------------------
+
 
 def item_pixels(rgb) -> int:
     """How many pixels of an RGB image show the demo's yellow item."""
@@ -130,9 +134,17 @@ def test_the_pictures_show_the_item_and_each_frame_says_what_happens(tmp_path):
     times = [t for t, _ in result.captions]
     assert all(a < b for a, b in zip(times, times[1:]))
     texts = [text for _, text in result.captions]
-    story = ["resetting the robot", "fetching: grasp 1 of 3", "fetching: grasp 1 of 3 failed, trying position 2",
-             "fetching: grasp 2 of 3 failed, trying position 3", "transporting", "item taken (1x): recovering",
-             "transporting (recovered 1x)", "placing", "done"]
+    story = [
+        "resetting the robot",
+        "fetching: grasp 1 of 3",
+        "fetching: grasp 1 of 3 failed, trying position 2",
+        "fetching: grasp 2 of 3 failed, trying position 3",
+        "transporting",
+        "item taken (1x): recovering",
+        "transporting (recovered 1x)",
+        "placing",
+        "done",
+    ]
     missing = [part for part in story if part not in texts]
     assert not missing, f"no frame says {missing}; the captions: {sorted(set(texts))}"
     assert [texts.index(part) for part in story] == sorted(texts.index(part) for part in story)
@@ -172,6 +184,7 @@ def test_each_run_writes_to_its_own_folder(tmp_path, monkeypatch):
 
 # -- SIGINT and SIGTERM end a run as "interrupted" (issue 12, point 6) ------------------------------
 
+
 def _run_record(db: str):
     from pycram.trace import query
 
@@ -179,8 +192,10 @@ def _run_record(db: str):
     return info, {record.name: record for record in query.tasks(info.id, db)}
 
 
-@pytest.mark.parametrize("signame, code, reason", [("SIGINT", 130, "interrupted by Ctrl-C (SIGINT)"),
-                                                   ("SIGTERM", 143, "terminated by SIGTERM")])
+@pytest.mark.parametrize(
+    "signame, code, reason",
+    [("SIGINT", 130, "interrupted by Ctrl-C (SIGINT)"), ("SIGTERM", 143, "terminated by SIGTERM")],
+)
 def test_a_signal_during_the_plan_ends_the_run_as_interrupted(tmp_path, signame, code, reason):
     import signal
 

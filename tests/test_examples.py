@@ -17,10 +17,8 @@ EXAMPLES = REPO / "examples"
 #: example (with arguments) -> lines its log must contain
 EXPECTED = {
     "language_tour.py": ["driving: State.SUCCEEDED", "placed the item on try 3"],
-    "first_plan_on_sim.py": ["saw the mug (mug-1) at (0.1", "holding the mug",
-                             "back at the start with the mug"],
-    "first_plan_on_sim.py tiago": ["saw the mug (mug-1) at (0.1", "holding the mug",
-                                   "back at the start with the mug"],
+    "first_plan_on_sim.py": ["saw the mug (mug-1) at (0.1", "holding the mug", "back at the start with the mug"],
+    "first_plan_on_sim.py tiago": ["saw the mug (mug-1) at (0.1", "holding the mug", "back at the start with the mug"],
     "fetch_and_place_actions.py": ["the pr2 put the mug down at -0.7", "on cooker #1"],
     "fetch_and_place_actions.py tiago": ["the tiago put the mug down at -0.7", "on cooker #1"],
     "custom_robot.py": ["toy base: stopped at (0.", "toy base at (0.50, 0.50); the gripper closed at 0.03 m"],
@@ -36,8 +34,14 @@ def test_example_runs(example, tmp_path):
     name, *args = example.split()
     env = dict(os.environ, PYTHONPATH=str(REPO), PYCRAM_RECORD="0")
     env.setdefault("MUJOCO_GL", "egl")
-    out = subprocess.run([sys.executable, "-m", "pycram", str(EXAMPLES / name), *args], capture_output=True,
-                         text=True, env=env, cwd=tmp_path, timeout=300)
+    out = subprocess.run(
+        [sys.executable, "-m", "pycram", str(EXAMPLES / name), *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=300,
+    )
     assert out.returncode == 0, f"stdout:\n{out.stdout}\nstderr:\n{out.stderr}"
     for line in EXPECTED[example]:
         assert line in out.stderr + out.stdout, out.stderr + out.stdout

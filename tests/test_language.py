@@ -449,7 +449,7 @@ class Resource:
     def __init__(self, log: list) -> None:
         self.log = log
 
-    def __enter__(self) -> "Resource":
+    def __enter__(self) -> Resource:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:

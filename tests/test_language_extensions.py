@@ -292,8 +292,10 @@ def test_tagged_task_is_found_by_other_branches_and_evaporated() -> None:
 
 def test_tag_registers_at_any_depth_and_waits_for_the_end() -> None:
     with with_tags() as tags:
-        state = par(lambda: seq(tag("deep", lambda: 41 + 1)),
-                    lambda: tags.wait_task("deep", TIMEOUT).status.IS(TaskStatus.SUCCEEDED).wait_for(TIMEOUT))
+        state = par(
+            lambda: seq(tag("deep", lambda: 41 + 1)),
+            lambda: tags.wait_task("deep", TIMEOUT).status.IS(TaskStatus.SUCCEEDED).wait_for(TIMEOUT),
+        )
     assert state.get_value() is State.SUCCEEDED and tags["deep"].result == 42
     assert "deep" in tags and tags.names() == ["deep"]
 
@@ -346,8 +348,9 @@ def test_partial_order_failure_evaporates_waiting_and_running_steps() -> None:
 def test_partial_order_fluent_constraint_and_results() -> None:
     door = Fluent()
     order = []
-    state = partial_order({"enter": lambda: order.append("enter") or "in", "open": lambda: door.set_value(True)},
-                          [(door, "enter")])
+    state = partial_order(
+        {"enter": lambda: order.append("enter") or "in", "open": lambda: door.set_value(True)}, [(door, "enter")]
+    )
     assert state.result == ["in", None] and order == ["enter"]
 
 
@@ -520,10 +523,13 @@ class RecordingModule(ProcessModule):
         self.log.append("resume")
 
 
-@pytest.mark.parametrize("mode, expected", [
-    ("pause", ["execute", "pause", "resume"]),
-    ("cancel", ["execute", "cancel", "execute"]),
-])
+@pytest.mark.parametrize(
+    "mode, expected",
+    [
+        ("pause", ["execute", "pause", "resume"]),
+        ("cancel", ["execute", "cancel", "execute"]),
+    ],
+)
 def test_process_module_execution_paused_or_cancelled_on_suspension(mode: str, expected: list) -> None:
     module = RecordingModule(mode)
     tags, thread, box = _spawn_tagged("move", lambda: module.execute("goal"))
@@ -552,8 +558,11 @@ def _recording_policy(log: list, init_ok: bool = True):
     return define_policy(
         "watch",
         init=lambda run, limit: (log.append(("init", limit)), run.vars.setdefault("limit", limit), init_ok)[-1],
-        check=lambda run, limit: (log.append("check"), run.vars["sensor"] > run.vars["limit"])[-1]
-        if "sensor" in run.vars else _wait_sensor(run, limit),
+        check=lambda run, limit: (
+            (log.append("check"), run.vars["sensor"] > run.vars["limit"])[-1]
+            if "sensor" in run.vars
+            else _wait_sensor(run, limit)
+        ),
         recover=lambda run, limit: log.append("recover"),
         clean_up=lambda run, limit: log.append("clean_up"),
     )

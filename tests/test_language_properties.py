@@ -324,9 +324,7 @@ def check_invocation(inv: Invocation, problems: list[str]) -> None:
                 agreeing = [k for k in ended if (_st(k) is S) == (state is State.SUCCEEDED)]
                 # ties: another branch may have reported first within a few ms (GIL switch)
                 if state is not want and (not agreeing or agreeing[0].end_time - ended[0].end_time > 0.02):
-                    problems.append(
-                        f"{where}: pursue {state} but first-ended branch {ended[0].name} {_st(ended[0])}"
-                    )
+                    problems.append(f"{where}: pursue {state} but first-ended branch {ended[0].name} {_st(ended[0])}")
 
 
 def check_failure_handling(inv: Invocation, task: Task, attempts: list, problems: list[str]) -> None:
@@ -364,7 +362,7 @@ def check_tree(root: Task, problems: list[str]) -> None:
                     problems.append(f"{task.path}: evaporated under a par that SUCCEEDED")
                 retried = any(isinstance(k.exception, RetryRequested) for k in parent.children)
                 if parent.kind == "try_all" and p is F and not retried:
-                        problems.append(f"{task.path}: evaporated under a try_all that FAILED")
+                    problems.append(f"{task.path}: evaporated under a try_all that FAILED")
             else:
                 problems.append(f"{task.path} [{task.kind}] EVAPORATED under {parent.kind} {p.name}")
 
@@ -487,6 +485,8 @@ def test_stress_random_nested_plans_with_many_seeds() -> None:
     finally:
         check_random_nested_plan._hypothesis_internal_use_seed = None  # as the decorator left it
     took = time.monotonic() - started
-    print(f"stress: {STRESS_RUNS} runs of {EXAMPLES} random plans (seeds {first}..{first + STRESS_RUNS - 1}) "
-          f"in {took:.0f} s, {len(failures)} failed")
+    print(
+        f"stress: {STRESS_RUNS} runs of {EXAMPLES} random plans (seeds {first}..{first + STRESS_RUNS - 1}) "
+        f"in {took:.0f} s, {len(failures)} failed"
+    )
     assert not failures, "\n\n".join(failures)

@@ -41,8 +41,8 @@ from pycram.language import (
     TaskVariable,
     par_loop,
     partial_order,
-    tag,
     suspend,
+    tag,
     timeout_policy,
     try_each_in_order,
     wake_up,
@@ -52,8 +52,13 @@ from pycram.language import (
 from pycram.runtime import Task, TaskStatus, add_task_listener, current_task, remove_task_listener
 from pycram.runtime.workers import shutdown_idle_workers
 
-S, F, E, R, P = (TaskStatus.SUCCEEDED, TaskStatus.FAILED, TaskStatus.EVAPORATED, TaskStatus.RUNNING,
-                 TaskStatus.SUSPENDED)
+S, F, E, R, P = (
+    TaskStatus.SUCCEEDED,
+    TaskStatus.FAILED,
+    TaskStatus.EVAPORATED,
+    TaskStatus.RUNNING,
+    TaskStatus.SUSPENDED,
+)
 EXAMPLES = 120
 VARIABLE = TaskVariable("property-test variable", default=None)
 
@@ -69,8 +74,23 @@ VARIABLE = TaskVariable("property-test variable", default=None)
 def plans(draw: Any, depth: int = 0, must_end: bool = True, in_fh: bool = False) -> tuple:
     if depth >= base.MAX_DEPTH or (depth > 0 and draw(st.integers(0, 9)) < 2 * depth):
         return ("var",) if draw(st.integers(0, 5)) == 0 else draw(base.leaves(must_end, in_fh))
-    kind = draw(st.sampled_from(["seq", "par", "pursue", "fh", "timeout", "partial_order", "par_loop", "try_each",
-                                 "policy", "bind", "tagged"]))
+    kind = draw(
+        st.sampled_from(
+            [
+                "seq",
+                "par",
+                "pursue",
+                "fh",
+                "timeout",
+                "partial_order",
+                "par_loop",
+                "try_each",
+                "policy",
+                "bind",
+                "tagged",
+            ]
+        )
+    )
     if kind == "bind":
         return (kind, draw(st.integers(0, 99)), draw(plans(depth + 1, must_end, in_fh)))
     if kind == "tagged":
@@ -167,8 +187,14 @@ class Plan(base.Plan):
 
             self.order_checks.append((times, orderings))
             steps = [timed(i, fn) for i, fn in enumerate(fns)]
-            self._invoke("par", len(fns), lambda inv: partial_order(
-                steps, [(a + 1, b + 1) for a, b in orderings], errors=inv.errors, state=inv.state), raise_on_fail)
+            self._invoke(
+                "par",
+                len(fns),
+                lambda inv: partial_order(
+                    steps, [(a + 1, b + 1) for a, b in orderings], errors=inv.errors, state=inv.state
+                ),
+                raise_on_fail,
+            )
 
         return run_partial_order
 
@@ -176,8 +202,12 @@ class Plan(base.Plan):
         form, as_kind = (par_loop, "par") if kind == "par_loop" else (try_each_in_order, "try_in_order")
 
         def run_loop() -> None:
-            self._invoke(as_kind, len(fns), lambda inv: form(fns, lambda fn: fn(), errors=inv.errors,
-                                                             state=inv.state), raise_on_fail)
+            self._invoke(
+                as_kind,
+                len(fns),
+                lambda inv: form(fns, lambda fn: fn(), errors=inv.errors, state=inv.state),
+                raise_on_fail,
+            )
 
         return run_loop
 
@@ -320,7 +350,8 @@ def run_plan(spec: tuple, actions: list) -> list[str]:
 
 
 actions_strategy = st.lists(
-    st.tuples(st.integers(0, 15), st.integers(0, 10), st.booleans(), st.integers(0, 1000)), max_size=4)
+    st.tuples(st.integers(0, 15), st.integers(0, 10), st.booleans(), st.integers(0, 1000)), max_size=4
+)
 
 _examples_run = [0]
 

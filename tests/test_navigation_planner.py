@@ -44,7 +44,7 @@ def test_dilate_matches_brute_force():
     R, C = np.mgrid[0:40, 0:50]
     expected = np.zeros_like(mask)
     for r, c in zip(rr, cc):
-        expected |= (R - r) ** 2 + (C - c) ** 2 <= 3.5 ** 2
+        expected |= (R - r) ** 2 + (C - c) ** 2 <= 3.5**2
     assert np.array_equal(out, expected)
 
 
@@ -66,8 +66,11 @@ def test_around_a_wall_through_its_gap():
     start, goal = BasePose(1.0, 1.0, 0.0), BasePose(5.0, 1.0, math.pi / 2)
     path = planner.plan(start, goal)
     assert path[-1] == goal and len(path) >= 2
-    crossings = [p.y + (q.y - p.y) * (3.0 - p.x) / (q.x - p.x)
-                 for p, q in zip([start] + path, path) if (p.x - 3.0) * (q.x - 3.0) < 0]
+    crossings = [
+        p.y + (q.y - p.y) * (3.0 - p.x) / (q.x - p.x)
+        for p, q in zip([start] + path, path)
+        if (p.x - 3.0) * (q.x - 3.0) < 0
+    ]
     assert len(crossings) == 1 and 4.5 < crossings[0] < 5.5  # through the gap
     _check_path(planner, start, path)
     assert planner.plan(start, goal) == path  # deterministic

@@ -9,9 +9,16 @@ import pytest
 from pycram.designator import MotionDesignator, perform
 from pycram.fluent import Fluent
 from pycram.language import State, par, pursue
-from pycram.process_module import (Execution, ExecutionCancelled, NoProcessModuleError,
-                                   ProcessModule, ProcessModuleError, ProcessModuleFailure,
-                                   ProcessModuleOffline, ProcessModuleStatus)
+from pycram.process_module import (
+    Execution,
+    ExecutionCancelled,
+    NoProcessModuleError,
+    ProcessModule,
+    ProcessModuleError,
+    ProcessModuleFailure,
+    ProcessModuleOffline,
+    ProcessModuleStatus,
+)
 from pycram.robot import Robot, use_robot, use_world
 from pycram.runtime import Evaporated, TaskGroup, current_task
 from pycram.testing import ScriptedProcessModule
@@ -38,11 +45,11 @@ def route_all_to(module):
 
 
 def motion(i, **more):
-    return MotionDesignator([('type', 'moving'), ('n', i)], **more)
+    return MotionDesignator([("type", "moving"), ("n", i)], **more)
 
 
 def wait_true(fluent_network, timeout=TIMEOUT):
-    assert fluent_network.wait_for(timeout), f'timed out waiting for {fluent_network!r}'
+    assert fluent_network.wait_for(timeout), f"timed out waiting for {fluent_network!r}"
 
 
 # --------------------------------------------------------------------------- thesis API
@@ -54,29 +61,30 @@ def test_thesis_perform_execute_and_overridable_execute():
     class Pr2Navigation(ProcessModule):
         def _execute(self, designator):
             solution = designator.reference()
-            if solution['cmd'] == 'move':
-                calls.append((solution['pose'], solution['wait'], solution['frame']))
-            return 'moved'
+            if solution["cmd"] == "move":
+                calls.append((solution["pose"], solution["wait"], solution["frame"]))
+            return "moved"
 
     def pr2_motion_designators(desig):
         solutions = []
-        if desig.check_constraints([('type', 'moving'), 'pose']):
-            solutions.append(desig.make_dictionary([('cmd', 'move'), 'pose', ('wait', True),
-                                                    ('frame', 'base_footprint')]))
+        if desig.check_constraints([("type", "moving"), "pose"]):
+            solutions.append(
+                desig.make_dictionary([("cmd", "move"), "pose", ("wait", True), ("frame", "base_footprint")])
+            )
         return solutions
 
     pr2_navigation = Pr2Navigation()
 
     def available_pr2_process_modules(design):
-        if design.check_constraints([('type', 'moving')]):
+        if design.check_constraints([("type", "moving")]):
             return pr2_navigation
         return None
 
     MotionDesignator.resolvers.append(pr2_motion_designators)
     ProcessModule.resolvers.append(available_pr2_process_modules)
-    assert ProcessModule.perform(MotionDesignator([('type', 'moving'), ('pose', 'p0')])) == 'moved'
-    assert perform(MotionDesignator(type='moving', pose='p1')) == 'moved'
-    assert calls == [('p0', True, 'base_footprint'), ('p1', True, 'base_footprint')]
+    assert ProcessModule.perform(MotionDesignator([("type", "moving"), ("pose", "p0")])) == "moved"
+    assert perform(MotionDesignator(type="moving", pose="p1")) == "moved"
+    assert calls == [("p0", True, "base_footprint"), ("p1", True, "base_footprint")]
     assert pr2_navigation.status.get_value() is S.SUCCEEDED
     assert pr2_navigation._running.get_value() is False
     assert ProcessModule().execute(motion(0)) is None  # default _execute does nothing
@@ -86,7 +94,7 @@ def test_thesis_perform_execute_and_overridable_execute():
 
 
 def test_fifo_and_mutual_exclusion_with_50_performers():
-    module = ScriptedProcessModule('arm', hold=True, default=lambda d: d.prop_value('n'))
+    module = ScriptedProcessModule("arm", hold=True, default=lambda d: d.prop_value("n"))
     route_all_to(module)
     results = [None] * 50
     group = TaskGroup()
@@ -94,28 +102,29 @@ def test_fifo_and_mutual_exclusion_with_50_performers():
     def performer(i):
         def run():
             results[i] = perform(motion(i))
+
         return run
 
-    group.spawn('performer-0', performer(0))
+    group.spawn("performer-0", performer(0))
     assert module.wait_started(1, TIMEOUT)
     for i in range(1, 50):  # arrive one after the other: i-1 designators already queued
-        group.spawn(f'performer-{i}', performer(i))
+        group.spawn(f"performer-{i}", performer(i))
         wait_true(module.queued >= i)
     assert module.status.get_value() is S.RUNNING
-    assert module._designators[0].prop_value('n') == 0 and len(module._designators) == 50
+    assert module._designators[0].prop_value("n") == 0 and len(module._designators) == 50
     module.release(50)
     group.wait_all()
-    assert [d.prop_value('n') for d in module.executed] == list(range(50))
+    assert [d.prop_value("n") for d in module.executed] == list(range(50))
     assert module.max_concurrency == 1
     assert results == list(range(50))  # each performer got its own designator's result
-    assert all(t.status.get_value().name == 'SUCCEEDED' for t in group.tasks)
+    assert all(t.status.get_value().name == "SUCCEEDED" for t in group.tasks)
     assert module.status.get_value() is S.SUCCEEDED and module.queued.get_value() == 0
 
 
 def test_mutual_exclusion_under_a_burst_of_concurrent_performers():
     class Exclusive(ProcessModule):
         def __init__(self):
-            super().__init__('exclusive')
+            super().__init__("exclusive")
             self.inside = 0
             self.overlaps = 0
             self.count = 0
@@ -137,20 +146,20 @@ def test_mutual_exclusion_under_a_burst_of_concurrent_performers():
         def run():
             barrier.wait(TIMEOUT)
             perform(motion(i))
+
         return run
 
     group = TaskGroup()
     for i in range(50):
-        group.spawn(f'p{i}', performer(i))
+        group.spawn(f"p{i}", performer(i))
     group.wait_all()
     assert module.count == 50 and module.overlaps == 0
 
 
 def test_two_modules_run_concurrently():
-    left, right = ScriptedProcessModule('left', hold=True), ScriptedProcessModule('right', hold=True)
-    ProcessModule.resolvers.append(lambda d: left if d.prop_value('arm') == 'left' else right)
-    handles = [ProcessModule.perform_nowait(MotionDesignator(type='moving', arm=a))
-               for a in ('left', 'right')]
+    left, right = ScriptedProcessModule("left", hold=True), ScriptedProcessModule("right", hold=True)
+    ProcessModule.resolvers.append(lambda d: left if d.prop_value("arm") == "left" else right)
+    handles = [ProcessModule.perform_nowait(MotionDesignator(type="moving", arm=a)) for a in ("left", "right")]
     assert left.wait_started(1, TIMEOUT) and right.wait_started(1, TIMEOUT)  # both at once
     assert left.status.get_value() is S.RUNNING and right.status.get_value() is S.RUNNING
     left.release()
@@ -163,14 +172,14 @@ def test_two_modules_run_concurrently():
 
 
 def test_status_transitions():
-    module = ScriptedProcessModule('nav', hold=True, script=['ok', RuntimeError('blocked')])
+    module = ScriptedProcessModule("nav", hold=True, script=["ok", RuntimeError("blocked")])
     route_all_to(module)
     assert module.status.get_value() is S.WAITING
     h = ProcessModule.perform_nowait(motion(1))
     wait_true(module.status == S.RUNNING)
     assert h.status.get_value() is S.RUNNING
     module.release()
-    assert h.wait(TIMEOUT) == 'ok'
+    assert h.wait(TIMEOUT) == "ok"
     assert module.status.get_value() is S.SUCCEEDED and h.status.get_value() is S.SUCCEEDED
     h2 = ProcessModule.perform_nowait(motion(2))
     wait_true(module.status == S.RUNNING)
@@ -180,7 +189,7 @@ def test_status_transitions():
     assert module.status.get_value() is S.FAILED and h2.status.get_value() is S.FAILED
     module.shutdown()
     assert module.status.get_value() is S.OFFLINE
-    with pytest.raises(ProcessModuleOffline, match='nav is offline'):
+    with pytest.raises(ProcessModuleOffline, match="nav is offline"):
         perform(motion(3))
     module.start()
     assert module.status.get_value() is S.WAITING
@@ -199,24 +208,33 @@ class RecordingFluent(Fluent):
 
 
 def test_status_fluent_exact_transitions_over_every_outcome():
-    module = ScriptedProcessModule('arm', hold=True, script=['ok', RuntimeError('stuck'), 'never'])
+    module = ScriptedProcessModule("arm", hold=True, script=["ok", RuntimeError("stuck"), "never"])
     module.status = RecordingFluent(module.status.get_value())
     route_all_to(module)
     module.release(2)
-    assert perform(motion(1)) == 'ok'
+    assert perform(motion(1)) == "ok"
     with pytest.raises(ProcessModuleFailure):
         perform(motion(2))
     state = pursue(lambda: perform(motion(3)), lambda: module.wait_started(3, TIMEOUT))
     assert state.get_value() is State.SUCCEEDED
     module.shutdown()
     module.start()
-    assert module.status.history == [S.WAITING, S.RUNNING, S.SUCCEEDED, S.RUNNING, S.FAILED,
-                                     S.RUNNING, S.CANCELLED, S.OFFLINE, S.WAITING]
+    assert module.status.history == [
+        S.WAITING,
+        S.RUNNING,
+        S.SUCCEEDED,
+        S.RUNNING,
+        S.FAILED,
+        S.RUNNING,
+        S.CANCELLED,
+        S.OFFLINE,
+        S.WAITING,
+    ]
 
 
 def test_plan_waits_on_the_status_fluent():
     """A plan branch waits for the module to be RUNNING, then for its outcome."""
-    module = ScriptedProcessModule('head', hold=True)
+    module = ScriptedProcessModule("head", hold=True)
     route_all_to(module)
     seen = []
 
@@ -232,7 +250,7 @@ def test_plan_waits_on_the_status_fluent():
 
 
 def test_shutdown_fails_queued_designators():
-    module = ScriptedProcessModule('nav', hold=True)
+    module = ScriptedProcessModule("nav", hold=True)
     route_all_to(module)
     running = ProcessModule.perform_nowait(motion(1))
     assert module.wait_started(1, TIMEOUT)
@@ -245,28 +263,28 @@ def test_shutdown_fails_queued_designators():
     module.release()
     running.wait(TIMEOUT)  # the running one finishes
     assert module.status.get_value() is S.OFFLINE
-    assert [d.prop_value('n') for d in module.executed] == [1]
+    assert [d.prop_value("n") for d in module.executed] == [1]
 
 
 # --------------------------------------------------------------------------- failures
 
 
 def test_failure_reaches_caller_with_cause_and_module_is_freed():
-    module = ScriptedProcessModule('arm', script=[RuntimeError('arm stuck')])
+    module = ScriptedProcessModule("arm", script=[RuntimeError("arm stuck")])
     route_all_to(module)
     with pytest.raises(ProcessModuleFailure) as info:
-        perform(motion(1, arm='left'))
+        perform(motion(1, arm="left"))
     error = info.value
     assert isinstance(error.cause, RuntimeError) and error.__cause__ is error.cause
-    assert error.module is module and error.designator.prop_value('n') == 1
-    assert 'arm stuck' in str(error) and "('arm', 'left')" in str(error)
+    assert error.module is module and error.designator.prop_value("n") == 1
+    assert "arm stuck" in str(error) and "('arm', 'left')" in str(error)
     assert isinstance(error, ProcessModuleError)
     assert perform(motion(2)) is None  # freed: the next one runs
     assert module.status.get_value() is S.SUCCEEDED
 
 
 def test_failure_inside_par_reaches_the_plan():
-    module = ScriptedProcessModule('arm', script=[ValueError('bad joint')])
+    module = ScriptedProcessModule("arm", script=[ValueError("bad joint")])
     route_all_to(module)
     errors = []
     state = par(lambda: perform(motion(1)), errors=errors)
@@ -276,24 +294,24 @@ def test_failure_inside_par_reaches_the_plan():
 
 def test_no_module_names_designator_and_active_robot():
     with pytest.raises(NoProcessModuleError) as info:
-        perform(MotionDesignator([('type', 'flying'), ('height', 2)]))
-    assert "('type', 'flying')" in str(info.value) and 'no active robot' in str(info.value)
-    robot = Robot('one-armed-test-robot')
-    robot.add_process_module('arm', ScriptedProcessModule('arm'))
+        perform(MotionDesignator([("type", "flying"), ("height", 2)]))
+    assert "('type', 'flying')" in str(info.value) and "no active robot" in str(info.value)
+    robot = Robot("one-armed-test-robot")
+    robot.add_process_module("arm", ScriptedProcessModule("arm"))
     with robot, pytest.raises(NoProcessModuleError) as info:
-        perform(MotionDesignator([('type', 'flying')]))
+        perform(MotionDesignator([("type", "flying")]))
     assert "'one-armed-test-robot'" in str(info.value) and "['arm']" in str(info.value)
 
 
 def test_resolver_errors_are_clear():
     def broken(d):
-        raise KeyError('arm')
+        raise KeyError("arm")
 
     ProcessModule.resolvers.append(broken)
-    with pytest.raises(ProcessModuleError, match='broken'):
+    with pytest.raises(ProcessModuleError, match="broken"):
         perform(motion(1))
-    ProcessModule.resolvers[:] = [lambda d: 'not a module']
-    with pytest.raises(ProcessModuleError, match='not a ProcessModule'):
+    ProcessModule.resolvers[:] = [lambda d: "not a module"]
+    with pytest.raises(ProcessModuleError, match="not a ProcessModule"):
         perform(motion(1))
 
 
@@ -301,30 +319,30 @@ def test_resolver_errors_are_clear():
 
 
 def test_cancel_on_evaporation_while_queued():
-    module = ScriptedProcessModule('nav', hold=True)
+    module = ScriptedProcessModule("nav", hold=True)
     route_all_to(module)
-    first = ProcessModule.perform_nowait(motion('A'))
+    first = ProcessModule.perform_nowait(motion("A"))
     assert module.wait_started(1, TIMEOUT)
-    state = pursue(lambda: perform(motion('B')), lambda: wait_true(module.queued >= 1))
+    state = pursue(lambda: perform(motion("B")), lambda: wait_true(module.queued >= 1))
     assert state.get_value() is State.SUCCEEDED  # the waiter won; B was evaporated in the queue
     assert module.queued.get_value() == 0
-    third = ProcessModule.perform_nowait(motion('C'))
+    third = ProcessModule.perform_nowait(motion("C"))
     wait_true(module.queued >= 1)
     module.release(2)
     first.wait(TIMEOUT)
     third.wait(TIMEOUT)
-    assert [d.prop_value('n') for d in module.executed] == ['A', 'C']
-    assert [d.prop_value('n') for d in module.cancelled] == ['B']  # the hook ran for B, which never ran
+    assert [d.prop_value("n") for d in module.executed] == ["A", "C"]
+    assert [d.prop_value("n") for d in module.cancelled] == ["B"]  # the hook ran for B, which never ran
 
 
 def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
-    module = ScriptedProcessModule('nav', hold=True)
+    module = ScriptedProcessModule("nav", hold=True)
     route_all_to(module)
     queued = []
 
     def queue_next_and_release_it():  # a caller outside the pursue, queued behind 'A'
         if module.wait_started(1, TIMEOUT):
-            queued.append(ProcessModule.perform_nowait(motion('next')))
+            queued.append(ProcessModule.perform_nowait(motion("next")))
             if module.wait_started(2, TIMEOUT):
                 module.release()
 
@@ -332,7 +350,7 @@ def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
 
     def mover():
         tasks.append(current_task())
-        perform(motion('A'))
+        perform(motion("A"))
 
     def stopper():
         wait_true(module.queued >= 1)
@@ -342,16 +360,16 @@ def test_cancel_on_evaporation_while_running_runs_hook_and_frees_module():
     state = pursue(mover, stopper)
     helper.join(TIMEOUT)
     assert state.get_value() is State.SUCCEEDED
-    assert [d.prop_value('n') for d in module.cancelled] == ['A']
-    assert tasks[0].status.get_value().name == 'EVAPORATED'
+    assert [d.prop_value("n") for d in module.cancelled] == ["A"]
+    assert tasks[0].status.get_value().name == "EVAPORATED"
     # the module was freed: the next queued designator started and ran
     assert queued[0].wait(TIMEOUT) is None
-    assert [e for e, _ in module.log] == ['start', 'cancel', 'start', 'end']
+    assert [e for e, _ in module.log] == ["start", "cancel", "start", "end"]
     assert module.status.get_value() is S.SUCCEEDED
 
 
 def test_evaporating_a_task_blocked_in_perform():
-    module = ScriptedProcessModule('head', hold=True)
+    module = ScriptedProcessModule("head", hold=True)
     route_all_to(module)
     group = TaskGroup()
     caught = []
@@ -363,11 +381,11 @@ def test_evaporating_a_task_blocked_in_perform():
             caught.append(True)
             raise
 
-    task = group.spawn('looker', body)
+    task = group.spawn("looker", body)
     assert module.wait_started(1, TIMEOUT)
     task.evaporate()
     group.wait_all()
-    assert caught == [True] and module.cancelled[0].prop_value('n') == 1
+    assert caught == [True] and module.cancelled[0].prop_value("n") == 1
     assert module.status.get_value() is S.CANCELLED and module.current is None
 
 
@@ -375,9 +393,9 @@ def test_evaporating_a_task_blocked_in_perform():
 
 
 def test_nowait_via_wait_false_property_and_handle():
-    module = ScriptedProcessModule('gripper', hold=True, script=[7])
+    module = ScriptedProcessModule("gripper", hold=True, script=[7])
     route_all_to(module)
-    handle = perform(MotionDesignator([('type', 'setting_gripper'), ('wait', False)]))
+    handle = perform(MotionDesignator([("type", "setting_gripper"), ("wait", False)]))
     assert isinstance(handle, Execution)
     wait_true(handle.status == S.RUNNING)
     with pytest.raises(TimeoutError):
@@ -387,7 +405,7 @@ def test_nowait_via_wait_false_property_and_handle():
 
 
 def test_handle_cancel_while_running_and_while_queued():
-    module = ScriptedProcessModule('arm', hold=True)
+    module = ScriptedProcessModule("arm", hold=True)
     route_all_to(module)
     running = ProcessModule.perform_nowait(motion(1))
     assert module.wait_started(1, TIMEOUT)
@@ -400,10 +418,10 @@ def test_handle_cancel_while_running_and_while_queued():
     running.cancel()
     with pytest.raises(ExecutionCancelled):
         running.wait(TIMEOUT)
-    assert [d.prop_value('n') for d in module.cancelled] == [1]
+    assert [d.prop_value("n") for d in module.cancelled] == [1]
     module.release()
     last.wait(TIMEOUT)
-    assert [d.prop_value('n') for d in module.executed] == [1, 3]
+    assert [d.prop_value("n") for d in module.executed] == [1, 3]
     running.cancel()  # idempotent, no effect once done
     assert running.status.get_value() is S.CANCELLED
 
@@ -413,7 +431,7 @@ def test_cancel_while_running_plain_python_execute():
 
     class Busy(ProcessModule):
         def __init__(self):
-            super().__init__('busy')
+            super().__init__("busy")
             self.started = threading.Event()
             self.stopped = []
 
@@ -424,7 +442,7 @@ def test_cancel_while_running_plain_python_execute():
                 x += 1
 
         def _cancel(self, designator):
-            self.stopped.append(designator.prop_value('n'))
+            self.stopped.append(designator.prop_value("n"))
 
     module = Busy()
     route_all_to(module)
@@ -438,15 +456,14 @@ def test_executions_and_performed_designators_are_published_as_events():
     from pycram import events
 
     executed, performed = [], []
-    unsubscribe = [events.subscribe(events.PROCESS_MODULE_EXECUTED,
-                                    lambda **kw: executed.append(kw)),
-                   events.subscribe(events.DESIGNATOR_PERFORMED,
-                                    lambda **kw: performed.append(kw))]
+    unsubscribe = [
+        events.subscribe(events.PROCESS_MODULE_EXECUTED, lambda **kw: executed.append(kw)),
+        events.subscribe(events.DESIGNATOR_PERFORMED, lambda **kw: performed.append(kw)),
+    ]
     try:
-        module = ScriptedProcessModule('nav', hold=True,
-                                       script=[lambda d: d.reference(), KeyError('map')])
+        module = ScriptedProcessModule("nav", hold=True, script=[lambda d: d.reference(), KeyError("map")])
         route_all_to(module)
-        MotionDesignator.resolvers.append(lambda d: [{'cmd': 'move', 'n': d.prop_value('n')}])
+        MotionDesignator.resolvers.append(lambda d: [{"cmd": "move", "n": d.prop_value("n")}])
         module.release(2)
         perform(motion(1))
         with pytest.raises(ProcessModuleFailure):
@@ -455,14 +472,20 @@ def test_executions_and_performed_designators_are_published_as_events():
     finally:
         for u in unsubscribe:
             u()
-    assert [(e['module'], e['designator'].prop_value('n'), e['outcome']) for e in executed] == [
-        (module, 1, 'succeeded'), (module, 2, 'failed'), (module, 3, 'cancelled')]
-    assert all(e['start'] is not None and e['start'] <= e['end'] for e in executed)
-    assert isinstance(executed[1]['error'], KeyError)  # the module's own error
-    assert executed[0]['error'] is None and executed[2]['error'] is None
-    assert [(p['designator'].prop_value('n'), type(p['error']).__name__) for p in performed] == [
-        (1, 'NoneType'), (2, 'ProcessModuleFailure'), (3, 'Evaporated')]
-    assert performed[0]['solution'] == {'cmd': 'move', 'n': 1}  # resolved by _execute
+    assert [(e["module"], e["designator"].prop_value("n"), e["outcome"]) for e in executed] == [
+        (module, 1, "succeeded"),
+        (module, 2, "failed"),
+        (module, 3, "cancelled"),
+    ]
+    assert all(e["start"] is not None and e["start"] <= e["end"] for e in executed)
+    assert isinstance(executed[1]["error"], KeyError)  # the module's own error
+    assert executed[0]["error"] is None and executed[2]["error"] is None
+    assert [(p["designator"].prop_value("n"), type(p["error"]).__name__) for p in performed] == [
+        (1, "NoneType"),
+        (2, "ProcessModuleFailure"),
+        (3, "Evaporated"),
+    ]
+    assert performed[0]["solution"] == {"cmd": "move", "n": 1}  # resolved by _execute
 
 
 def test_public_surface():
@@ -477,7 +500,7 @@ def test_public_surface():
 
 @pytest.mark.parametrize("exit_exception", [SystemExit(3), KeyboardInterrupt()])
 def test_execution_ended_by_systemexit_or_keyboardinterrupt_is_failed_not_cancelled(exit_exception):
-    module = ScriptedProcessModule('nav', script=[exit_exception])
+    module = ScriptedProcessModule("nav", script=[exit_exception])
     route_all_to(module)
     with pytest.raises(type(exit_exception)) as raised:
         ProcessModule.perform(motion(1))
@@ -485,12 +508,12 @@ def test_execution_ended_by_systemexit_or_keyboardinterrupt_is_failed_not_cancel
     assert module.status.get_value() is S.FAILED
     assert module.cancelled == []  # not a cancellation: the cancel hook did not run
     # the module is free again
-    module.script.append('ok')
-    assert ProcessModule.perform(motion(2)) == 'ok'
+    module.script.append("ok")
+    assert ProcessModule.perform(motion(2)) == "ok"
 
 
 def test_nowait_execution_ended_by_keyboardinterrupt_reports_failed():
-    module = ScriptedProcessModule('nav', script=[KeyboardInterrupt()])
+    module = ScriptedProcessModule("nav", script=[KeyboardInterrupt()])
     route_all_to(module)
     handle = ProcessModule.perform_nowait(motion(1))
     with pytest.raises(KeyboardInterrupt):

@@ -42,7 +42,7 @@ BLOCKS = [block for document in DOCUMENTS for block in python_blocks(document)]
 
 #: A plan that leaves one failed grasp and one non-waited drive in the trace: the data the
 #: README's query example asks for. It runs on a robot of test doubles (pycram.testing).
-RECORDED_PLAN = textwrap.dedent('''
+RECORDED_PLAN = textwrap.dedent("""
     from pycram.designator import MotionDesignator, perform
     from pycram.language import seq
     from pycram.robot import Robot
@@ -61,7 +61,7 @@ RECORDED_PLAN = textwrap.dedent('''
     with robot:
         assert perform(MotionDesignator(type="moving", pose=(1.0, 2.0, 0.0), wait=False)).wait() == "arrived"
         seq(grasp, name="grasp")
-''')
+""")
 
 
 def test_the_documents_have_python_blocks():
@@ -113,8 +113,9 @@ def _run_block(code: str, tmp_path: Path, **extra_env: str) -> subprocess.Comple
     env = dict(os.environ, PYTHONPATH=str(REPO), PYCRAM_RECORD="0", **extra_env)
     env.setdefault("MUJOCO_GL", "egl")
     env.setdefault("PYCRAM_DB_URL", f"sqlite:///{tmp_path / 'runs.sqlite3'}")
-    return subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env,
-                          cwd=tmp_path, timeout=BLOCK_TIMEOUT)
+    return subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, env=env, cwd=tmp_path, timeout=BLOCK_TIMEOUT
+    )
 
 
 def _record_a_run(db_url: str, tmp_path: Path) -> None:
@@ -122,8 +123,14 @@ def _record_a_run(db_url: str, tmp_path: Path) -> None:
     plan.write_text(RECORDED_PLAN)
     env = dict(os.environ, PYTHONPATH=str(REPO), PYCRAM_DB_URL=db_url)
     env.pop("PYCRAM_RECORD", None)
-    out = subprocess.run([sys.executable, "-m", "pycram.cli", "run", str(plan)], capture_output=True, text=True,
-                         env=env, cwd=tmp_path, timeout=120)
+    out = subprocess.run(
+        [sys.executable, "-m", "pycram.cli", "run", str(plan)],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
+    )
     assert out.returncode == 0 and "recorded as run 1" in out.stderr, out.stderr
 
 

@@ -198,9 +198,27 @@ def test_with_timeout_on_a_manual_clock_is_exact():
 # `python -c "import pycram.language"`). Anything else — a third-party package, or heavy
 # standard modules such as ctypes, inspect, ast, asyncio, logging — is a regression.
 CORE_STDLIB_IMPORTS = {
-    "threading", "_weakrefset", "weakref", "heapq", "_heapq", "typing", "_typing", "typing.io",
-    "typing.re", "collections.abc", "enum", "itertools", "operator", "contextlib", "functools",
-    "types", "time", "os", "re", "collections", "abc",
+    "threading",
+    "_weakrefset",
+    "weakref",
+    "heapq",
+    "_heapq",
+    "typing",
+    "_typing",
+    "typing.io",
+    "typing.re",
+    "collections.abc",
+    "enum",
+    "itertools",
+    "operator",
+    "contextlib",
+    "functools",
+    "types",
+    "time",
+    "os",
+    "re",
+    "collections",
+    "abc",
 }
 
 
@@ -274,6 +292,7 @@ def test_asynchronous_evaporation_never_leaves_a_condition_lock_held():
     watched = Fluent(0, name="watched")
     never = watched < 0  # a network: pulsing `watched` takes its condition lock too
     for round_ in range(300):
+
         def busy() -> None:
             n = 0
             while True:
@@ -444,8 +463,11 @@ def test_a_seq_ends_after_the_detached_execution_of_one_of_its_steps(end_order, 
 
     _, release = routed_module
     handles = []
-    state = seq(lambda: handles.append(perform(MotionDesignator([("type", "moving"), ("wait", False)]))),
-                lambda: None, name="drive-and-go-on")
+    state = seq(
+        lambda: handles.append(perform(MotionDesignator([("type", "moving"), ("wait", False)]))),
+        lambda: None,
+        name="drive-and-go-on",
+    )
     assert state.get_value() is State.SUCCEEDED  # decided: the steps succeeded
     expression = current_task().children[-1]
     assert expression.status.get_value() is TaskStatus.RUNNING  # but a child still runs

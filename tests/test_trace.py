@@ -39,8 +39,7 @@ def postgres_url():
     """A fresh PostgreSQL database for this test session (dropped afterwards)."""
     if not PG_URL:
         pytest.skip(NO_PG)
-    admin = sa.create_engine(sa.make_url(PG_URL).set(drivername="postgresql+psycopg"),
-                             isolation_level="AUTOCOMMIT")
+    admin = sa.create_engine(sa.make_url(PG_URL).set(drivername="postgresql+psycopg"), isolation_level="AUTOCOMMIT")
     name = f"pycram_t_{uuid.uuid4().hex[:12]}"
     with admin.connect() as conn:
         conn.execute(sa.text(f"CREATE DATABASE {name}"))
@@ -123,8 +122,10 @@ def test_round_trip(db_url):
 
     assert len(query.durations("perform grasping", url=db_url, run_id=run_id)) == 1
     execs = query.executions(run_id, url=db_url)
-    assert [(x.module, x.outcome, x.duration) for x in execs] == [("navigation", "succeeded", 2.5),
-                                                                 ("gripper", "failed", 0.5)]
+    assert [(x.module, x.outcome, x.duration) for x in execs] == [
+        ("navigation", "succeeded", 2.5),
+        ("gripper", "failed", 0.5),
+    ]
     assert execs[1].error_type == "Boom"
     assert query.executions(outcome="failed", url=db_url)[-1].module == "gripper"
     desigs = query.designators(run_id, url=db_url)
@@ -295,8 +296,10 @@ def test_designators_and_process_modules_of_a_real_plan(tmp_path):
     assert "'target', 'table'" in desigs["looking"].designator
     assert desigs["gripping"].error_type == "ProcessModuleFailure" and "slipped" in desigs["gripping"].error_message
     execs = query.executions(run_id, url=url)
-    assert [(x.module, x.designator_type, x.outcome) for x in execs] == [("head", "looking", "succeeded"),
-                                                                         ("gripper", "gripping", "failed")]
+    assert [(x.module, x.designator_type, x.outcome) for x in execs] == [
+        ("head", "looking", "succeeded"),
+        ("gripper", "gripping", "failed"),
+    ]
     assert all(x.duration is not None and x.duration >= 0 for x in execs)
     assert "slipped" in execs[1].error_message
     action = next(r for r in query.tasks(run_id, url) if r.name == "perform looking-around")
@@ -350,7 +353,7 @@ def test_scope_records_only_tasks_below(tmp_path):
         seq(lambda: None, name="inside")
 
     def run_scoped() -> None:
-        from pycram.runtime import current_task, task_scope
+        from pycram.runtime import task_scope
 
         with task_scope("scope", "task") as scope:
             recorder.scope = scope.task
@@ -374,18 +377,25 @@ def test_schema_creation_is_idempotent(db_url):
         t.join()
     ensure_schema(engine)
     inspector = sa.inspect(engine)
-    assert {"pycram_runs", "pycram_tasks", "pycram_designators", "pycram_executions",
-            "pycram_fluent_samples"} <= set(inspector.get_table_names())
+    assert {"pycram_runs", "pycram_tasks", "pycram_designators", "pycram_executions", "pycram_fluent_samples"} <= set(
+        inspector.get_table_names()
+    )
     engine.dispose()
     recorder = start_recording(db_url, plan="after schema")
     assert recorder.finish() >= 1
 
 
-@pytest.mark.parametrize("url, fragment", [
-    ("not a url", "invalid database URL 'not a url'"),
-    ("nosuchdb://host/x", "unknown database kind 'nosuchdb'"),
-    ("postgresql+psycopg://someone:secret@127.0.0.1:1/x", "cannot use database postgresql+psycopg://someone:***@127.0.0.1:1/x"),
-])
+@pytest.mark.parametrize(
+    "url, fragment",
+    [
+        ("not a url", "invalid database URL 'not a url'"),
+        ("nosuchdb://host/x", "unknown database kind 'nosuchdb'"),
+        (
+            "postgresql+psycopg://someone:secret@127.0.0.1:1/x",
+            "cannot use database postgresql+psycopg://someone:***@127.0.0.1:1/x",
+        ),
+    ],
+)
 def test_bad_urls_get_a_clear_error(url, fragment):
     with pytest.raises(TraceDatabaseError) as info:
         start_recording(url, plan="bad")
@@ -424,9 +434,18 @@ def test_default_url_and_env(monkeypatch, tmp_path):
     assert resolve_url(str(tmp_path / "a.sqlite3")) == f"sqlite:///{tmp_path / 'a.sqlite3'}"
 
 
-@pytest.mark.parametrize("value, default, expected", [
-    (None, True, True), (None, False, False), ("0", True, False), ("1", False, True),
-    ("off", True, False), ("true", False, True), ("", True, True)])
+@pytest.mark.parametrize(
+    "value, default, expected",
+    [
+        (None, True, True),
+        (None, False, False),
+        ("0", True, False),
+        ("1", False, True),
+        ("off", True, False),
+        ("true", False, True),
+        ("", True, True),
+    ],
+)
 def test_recording_switch_from_environment(monkeypatch, value, default, expected):
     if value is None:
         monkeypatch.delenv("PYCRAM_RECORD", raising=False)
@@ -436,9 +455,11 @@ def test_recording_switch_from_environment(monkeypatch, value, default, expected
 
 
 def test_library_import_does_not_load_sqlalchemy():
-    code = ("import sys, pycram, pycram.trace, pycram.language, pycram.events; "
-            "assert 'sqlalchemy' not in sys.modules, 'sqlalchemy imported'; "
-            "assert 'matplotlib' not in sys.modules; print('ok')")
+    code = (
+        "import sys, pycram, pycram.trace, pycram.language, pycram.events; "
+        "assert 'sqlalchemy' not in sys.modules, 'sqlalchemy imported'; "
+        "assert 'matplotlib' not in sys.modules; print('ok')"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, timeout=60)
     assert out.returncode == 0 and "ok" in out.stdout, out.stderr
 
@@ -446,14 +467,17 @@ def test_library_import_does_not_load_sqlalchemy():
 def test_library_use_records_nothing_unless_asked(tmp_path):
     """Recording is off for library use: running plans writes no database and loads no
     recorder, whatever $PYCRAM_RECORD says (that switch is for `pycram run` / `pycram demo`)."""
-    code = ("import sys; from pycram.language import par, seq; "
-            "seq(lambda: None, lambda: par(lambda: None, lambda: None)); "
-            "assert 'pycram.trace.recorder' not in sys.modules; print('ok')")
+    code = (
+        "import sys; from pycram.language import par, seq; "
+        "seq(lambda: None, lambda: par(lambda: None, lambda: None)); "
+        "assert 'pycram.trace.recorder' not in sys.modules; print('ok')"
+    )
     for record in ("", "1"):
         env = dict(os.environ, PYCRAM_HOME=str(tmp_path / "home"), PYCRAM_RECORD=record)
         env.pop("PYCRAM_DB_URL", None)
-        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO,
-                             env=env, timeout=60)
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, env=env, timeout=60
+        )
         assert out.returncode == 0 and "ok" in out.stdout, out.stderr
     assert not (tmp_path / "home").exists()
 
@@ -489,8 +513,13 @@ _CHILD = textwrap.dedent("""
 
 
 def _child(url: str, plan: str, count: int) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-c", _CHILD, url, plan, str(count)], cwd=REPO,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-c", _CHILD, url, plan, str(count)],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def test_sigkilled_run_keeps_its_trace_up_to_the_last_second(db_url, tmp_path):
@@ -567,10 +596,25 @@ def test_two_recorders_in_one_process(tmp_path):
 
 # -- collapsing repeated siblings in displays ----------------------------------------------------
 
-def _record(task_id: int, parent: int | None, name: str, status: str = "succeeded", start: float = 0.0,
-            kind: str = "task") -> query.TaskRecord:
-    return query.TaskRecord(1, task_id, parent, name, kind, None, None, status, start, start + 0.1, 0.1,
-                            "Boom" if status == "failed" else None, None)
+
+def _record(
+    task_id: int, parent: int | None, name: str, status: str = "succeeded", start: float = 0.0, kind: str = "task"
+) -> query.TaskRecord:
+    return query.TaskRecord(
+        1,
+        task_id,
+        parent,
+        name,
+        kind,
+        None,
+        None,
+        status,
+        start,
+        start + 0.1,
+        0.1,
+        "Boom" if status == "failed" else None,
+        None,
+    )
 
 
 def test_collapse_merges_identical_successful_siblings_only():
@@ -597,9 +641,18 @@ def test_collapse_merges_identical_successful_siblings_only():
     add(2, "grasp")  # a run shorter than 3 stays as it is
     roots = collapse(query.build_tree(records))
     shown = [(node.record.name, node.count, depth) for node, depth in roots[0].walk()]
-    assert shown == [("MainThread", 1, 0), ("loop", 1, 1), ("look", 4, 2), ("move head", 4, 3),
-                     ("look", 1, 2), ("move eyes", 1, 3), ("look", 1, 2), ("look", 1, 2),
-                     ("grasp", 1, 2), ("grasp", 1, 2)]
+    assert shown == [
+        ("MainThread", 1, 0),
+        ("loop", 1, 1),
+        ("look", 4, 2),
+        ("move head", 4, 3),
+        ("look", 1, 2),
+        ("move eyes", 1, 3),
+        ("look", 1, 2),
+        ("look", 1, 2),
+        ("grasp", 1, 2),
+        ("grasp", 1, 2),
+    ]
     every = sorted(r.task_id for node, _ in roots[0].walk() for r in node.records)
     assert every == sorted(r.task_id for r in records)  # nothing dropped, nothing twice
     assert [n.count for n, _ in collapse(query.build_tree(records), min_run=0)[0].walk()] == [1] * len(records)

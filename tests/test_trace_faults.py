@@ -65,12 +65,16 @@ def _recording_then(url: str, plan: str, damage, steps: int = 2):
 
 # -- URLs and missing databases --------------------------------------------------------------------
 
-@pytest.mark.parametrize("url, fragments", [
-    ("postgresql://someone:secret@dbhost:notaport/runs", ["the port 'notaport' is not a number"]),
-    ("sqlite:/relative.db", ["needs '://' after its kind 'sqlite'", "sqlite:///relative/path.sqlite3"]),
-    ("mysql://someone@dbhost/runs", ["database kind 'mysql'", "not supported", "SQLite", "PostgreSQL"]),
-    ("mysql+pymysql://someone@dbhost/runs", ["database kind 'mysql'", "not supported"]),
-])
+
+@pytest.mark.parametrize(
+    "url, fragments",
+    [
+        ("postgresql://someone:secret@dbhost:notaport/runs", ["the port 'notaport' is not a number"]),
+        ("sqlite:/relative.db", ["needs '://' after its kind 'sqlite'", "sqlite:///relative/path.sqlite3"]),
+        ("mysql://someone@dbhost/runs", ["database kind 'mysql'", "not supported", "SQLite", "PostgreSQL"]),
+        ("mysql+pymysql://someone@dbhost/runs", ["database kind 'mysql'", "not supported"]),
+    ],
+)
 def test_malformed_and_unsupported_urls_get_a_clear_error(url, fragments, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(TraceDatabaseError) as info:
@@ -92,8 +96,11 @@ def test_malformed_and_unsupported_urls_get_a_clear_error(url, fragments, tmp_pa
 def test_inspecting_a_database_that_does_not_exist_says_so(tmp_path):
     no_folder = tmp_path / "no" / "such" / "runs.sqlite3"
     for command in (["runs"], ["show"], ["graph", "-o", str(tmp_path / "x.svg")]):
-        _one_line_error(_invoke(*command, "--db", str(no_folder)), "no such database",
-                        f"the folder {no_folder.parent} does not exist")
+        _one_line_error(
+            _invoke(*command, "--db", str(no_folder)),
+            "no such database",
+            f"the folder {no_folder.parent} does not exist",
+        )
     no_file = tmp_path / "runs.sqlite3"
     _one_line_error(_invoke("runs", "--db", f"sqlite:///{no_file}"), "no such database", f"{no_file} does not exist")
     assert not (tmp_path / "no").exists() and not no_file.exists()  # reading created nothing
@@ -109,6 +116,7 @@ def test_a_read_only_database_is_refused_before_the_plan_runs(tmp_path):
 
 
 # -- inspecting broken databases -------------------------------------------------------------------
+
 
 def _recorded(path: Path, runs: int = 3) -> None:
     for _ in range(runs):
@@ -139,14 +147,20 @@ def _directory(path: Path) -> None:
 def test_inspecting_a_broken_database_is_a_one_line_error(tmp_path, damage):
     path = tmp_path / "runs.sqlite3"
     damage(path)
-    for command in (["runs"], ["show"], ["show", "1"], ["graph", "-o", str(tmp_path / "x.svg")],
-                    ["timeline", "-o", str(tmp_path / "x.png")]):
+    for command in (
+        ["runs"],
+        ["show"],
+        ["show", "1"],
+        ["graph", "-o", str(tmp_path / "x.svg")],
+        ["timeline", "-o", str(tmp_path / "x.png")],
+    ):
         _one_line_error(_invoke(*command, "--db", str(path)), "database", str(path))
     with pytest.raises(TraceDatabaseError):
         query.failed_tasks(url=str(path))
 
 
 # -- a database that fails while a run is recorded ----------------------------------------------
+
 
 def _drop(path: Path, table: str) -> None:
     with sqlite3.connect(path) as conn:
@@ -181,8 +195,9 @@ def test_a_table_dropped_under_the_writer_loses_records_not_the_plan(tmp_path, c
 def test_a_database_that_recovers_loses_nothing(tmp_path):
     """Batches that fail are kept and written with the next batch that succeeds."""
     path = tmp_path / "runs.sqlite3"
-    recorder = _recording_then(f"sqlite:///{path}", "recovers",
-                               lambda _: _rename(path, "pycram_tasks", "pycram_tasks_away"))
+    recorder = _recording_then(
+        f"sqlite:///{path}", "recovers", lambda _: _rename(path, "pycram_tasks", "pycram_tasks_away")
+    )
     _steps("during", 3)
     events.process_module_executed("base", "go", "succeeded", 1.0, 2.0)
     assert recorder.flush()
@@ -203,8 +218,9 @@ def test_rows_beyond_the_backlog_limit_are_dropped_and_counted(tmp_path, monkeyp
 
     monkeypatch.setattr(recorder_module, "BACKLOG_LIMIT", 5)
     path = tmp_path / "runs.sqlite3"
-    recorder = _recording_then(f"sqlite:///{path}", "backlog",
-                               lambda _: _rename(path, "pycram_executions", "pycram_executions_away"))
+    recorder = _recording_then(
+        f"sqlite:///{path}", "backlog", lambda _: _rename(path, "pycram_executions", "pycram_executions_away")
+    )
     for i in range(20):
         events.process_module_executed("base", f"go {i}", "succeeded", float(i), i + 0.5)
     assert recorder.flush()
@@ -284,6 +300,7 @@ def test_the_demo_succeeds_and_tells_how_many_records_were_lost(tmp_path, capsys
 
 # -- PostgreSQL --------------------------------------------------------------------------------------
 
+
 @pytest.fixture
 def postgres_db():
     """A fresh PostgreSQL database of its own (the test may drop it); yields (url, admin engine)."""
@@ -311,9 +328,15 @@ def test_postgres_connections_killed_mid_run_lose_nothing(postgres_db):
 
     def terminate_connections(_) -> None:
         with admin.connect() as conn:
-            killed.append(conn.execute(sa.text(
-                "SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
-                "WHERE datname = :name AND pid <> pg_backend_pid()"), {"name": name}).scalar())
+            killed.append(
+                conn.execute(
+                    sa.text(
+                        "SELECT count(pg_terminate_backend(pid)) FROM pg_stat_activity "
+                        "WHERE datname = :name AND pid <> pg_backend_pid()"
+                    ),
+                    {"name": name},
+                ).scalar()
+            )
 
     recorder = _recording_then(url, "reconnects", terminate_connections, steps=3)
     assert killed[0] >= 1
@@ -346,6 +369,7 @@ def test_postgres_database_dropped_mid_run(postgres_db):
 
 # -- migrating a database of schema 1, on both kinds ----------------------------------------------
 
+
 @pytest.fixture(params=["sqlite", "postgresql"])
 def any_db(request, tmp_path):
     if request.param == "sqlite":
@@ -365,13 +389,16 @@ def test_schema_1_is_migrated_concurrently_and_read(any_db):
         conn.exec_driver_sql("ALTER TABLE pycram_tasks DROP COLUMN error_origin")
         conn.exec_driver_sql("ALTER TABLE pycram_runs DROP COLUMN clock")
         conn.exec_driver_sql("ALTER TABLE pycram_runs DROP COLUMN lost_records")
-        conn.exec_driver_sql("INSERT INTO pycram_runs (uuid, plan, started_at, outcome) "
-                             "VALUES ('old', 'old run', '2026-01-01 10:00:00', 'failed')")
+        conn.exec_driver_sql(
+            "INSERT INTO pycram_runs (uuid, plan, started_at, outcome) "
+            "VALUES ('old', 'old run', '2026-01-01 10:00:00', 'failed')"
+        )
         run_id = conn.exec_driver_sql("SELECT id FROM pycram_runs").scalar()
         conn.exec_driver_sql(
             "INSERT INTO pycram_tasks (run_id, task_id, parent_id, name, kind, status, error_type, error_message) "
             f"VALUES ({run_id}, 1, NULL, 'seq', 'seq', 'failed', 'Boom', 'x'), "
-            f"({run_id}, 2, 1, 'grab', 'step', 'failed', 'Boom', 'x')")
+            f"({run_id}, 2, 1, 'grab', 'step', 'failed', 'Boom', 'x')"
+        )
     engine.dispose()
     errors: list = []
 

@@ -37,6 +37,7 @@ def _invoke(*args: str):
 
 # -- every process-module execution is in the tree ---------------------------------------------
 
+
 def _robot_with_modules():
     from pycram.robot import Robot
     from pycram.testing import ScriptedProcessModule
@@ -79,14 +80,17 @@ def test_blocking_and_non_blocking_executions_are_in_the_task_tree(tmp_path, wid
     lines = out.splitlines()
     assert sum("base: moving [process-module]" in line for line in lines) == 1, out
     assert sum("arm: reaching [process-module] succeeded" in line for line in lines) == 1, out
-    assert sum("arm: gripping [process-module] failed" in line and "RuntimeError: joint limit" in line
-               for line in lines) == 1, out
+    assert (
+        sum("arm: gripping [process-module] failed" in line and "RuntimeError: joint limit" in line for line in lines)
+        == 1
+    ), out
     assert "3 process-module executions" in out
 
     tasks, executions = query.tree_records(run_id, url)
     assert [x.name for x in executions] == ["arm: reaching", "arm: gripping"]
-    fetch_node = next(n for root in query.build_tree(tasks + executions) for n, _ in root.walk()
-                      if n.record.name == "fetch")
+    fetch_node = next(
+        n for root in query.build_tree(tasks + executions) for n, _ in root.walk() if n.record.name == "fetch"
+    )
     assert [c.record.name for c in fetch_node.children] == ["base: moving", "look", "arm: reaching", "arm: gripping"]
 
     svg = tmp_path / "tree.svg"
@@ -95,6 +99,7 @@ def test_blocking_and_non_blocking_executions_are_in_the_task_tree(tmp_path, wid
 
 
 # -- each failure counted once ------------------------------------------------------------------
+
 
 class GraspFailed(Exception):
     pass
@@ -163,11 +168,14 @@ def test_the_demo_database_counts_each_failed_grasp_once_and_shows_every_executi
     out = _invoke("show", "--expand", "--db", url).output
     assert sum("[process-module]" in line for line in out.splitlines()) >= len(executions)
     reaching = sum(x.designator_type == "reaching" for x in executions)
-    assert reaching >= 3 and sum("arm_right: reaching [process-module]" in line for line in out.splitlines()) == reaching
+    assert (
+        reaching >= 3 and sum("arm_right: reaching [process-module]" in line for line in out.splitlines()) == reaching
+    )
     assert "times in the tree: simulated clock" in out and "(wall-clock)" in out
 
 
 # -- runs, clocks --------------------------------------------------------------------------------
+
 
 def test_runs_has_a_header_and_the_failure_reason(tmp_path, wide):
     url = f"sqlite:///{tmp_path / 'r.sqlite3'}"
@@ -189,6 +197,7 @@ def test_show_says_which_times_are_simulated_and_which_wall_clock(tmp_path, wide
     recorder = start_recording(url, plan="simulated")  # started on the wall clock
     clock = ManualClock(100.0)
     with use_clock(clock):
+
         def step() -> None:
             clock.advance(2.5)
 
@@ -202,7 +211,10 @@ def test_show_says_which_times_are_simulated_and_which_wall_clock(tmp_path, wide
     mixed = recorder.finish("succeeded")
 
     assert [query.get_run(r, url).clock for r in (wall, simulated, mixed)] == [
-        "wall-clock", "simulated", "wall-clock+simulated"]
+        "wall-clock",
+        "simulated",
+        "wall-clock+simulated",
+    ]
     out = _invoke("show", str(simulated), "--db", url).output
     assert "times in the tree: simulated clock" in out and "(wall-clock)" in out
     assert "on the simulated clock [task] succeeded 2.50 s" in out

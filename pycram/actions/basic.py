@@ -33,13 +33,21 @@ from pycram.designators.perform import perform
 from pycram.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
 from pycram.language import State, par
 
-from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, arms, attempt, make_action,
-                   motion, unwrap)
+from .core import RECOVERABLE, ActionParameterError, action_plan, arm_name, arms, attempt, make_action, motion, unwrap
 from .core import solutions as location_solutions
 from .search import search_for
 
-__all__ = ["Navigate", "LookAt", "ParkArms", "MoveTorso", "SetGripper", "Detect", "Search",
-           "NAVIGATION_ATTEMPTS", "point_of"]
+__all__ = [
+    "Navigate",
+    "LookAt",
+    "ParkArms",
+    "MoveTorso",
+    "SetGripper",
+    "Detect",
+    "Search",
+    "NAVIGATION_ATTEMPTS",
+    "point_of",
+]
 
 #: Standing poses (solutions of a location designator) tried before navigating gives up.
 NAVIGATION_ATTEMPTS = 3
@@ -136,6 +144,7 @@ def navigating(designator: ActionDesignator) -> Any:
 
 def _is_motion_failure(error: BaseException) -> bool:
     from pycram.failures import MotionFailure
+
     return isinstance(unwrap(error), MotionFailure)
 
 
@@ -155,6 +164,7 @@ def point_of(target: Any) -> tuple[float, float, float]:
     if isinstance(target, str):
         from pycram.locations.targets import as_target
         from pycram.robot import current_robot
+
         belief = getattr(current_robot(), "belief", None)
         environment = getattr(belief, "environment", None)
         return tuple(as_target(target, environment).position)  # type: ignore[return-value]
@@ -181,8 +191,7 @@ def looking_at(designator: ActionDesignator) -> Any:
 @action_plan("parking_arms")
 def parking_arms(designator: ActionDesignator) -> None:
     errors: list = []
-    branches = [lambda a=a: motion(type="setting_arm_configuration", arm=a, configuration="park")
-                for a in arms()]
+    branches = [lambda a=a: motion(type="setting_arm_configuration", arm=a, configuration="park") for a in arms()]
     state = par(*branches, errors=errors, name="park every arm")
     if state.get_value() is not State.SUCCEEDED:
         raise errors[0] if errors else PlanFailure("parking the arms failed", designator)
@@ -224,4 +233,5 @@ def searching(designator: ActionDesignator) -> Any:
     if not isinstance(wanted, ObjectDesignator):
         raise ActionParameterError("searching", "object", f"needs an object designator or a type name, got {wanted!r}")
     from .containers import Open
+
     return search_for(wanted, open_container=lambda name: perform(Open(name)))

@@ -31,8 +31,19 @@ from pycram.designators.location import LocationDesignator
 from pycram.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
 from pycram.robot import current_robot
 
-from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, attempt, base_pose_fluent,
-                   gripper_of, make_action, motion, solutions, unwrap)
+from .core import (
+    RECOVERABLE,
+    ActionParameterError,
+    action_plan,
+    arm_name,
+    attempt,
+    base_pose_fluent,
+    gripper_of,
+    make_action,
+    motion,
+    solutions,
+    unwrap,
+)
 
 __all__ = ["Open", "Close", "DRAWER_OPENING", "CONTAINER_ATTEMPTS", "PULL_STEPS", "HANDLE_OPENING"]
 
@@ -84,9 +95,13 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
         raise ActionParameterError(action, "container", f"the environment has no container {name!r}", names)
     container = environment.container(name)
     if container.kind != "drawer":
-        raise ContainerFailure(f"{action} {name!r}: robots open and close drawers only so far (a door's "
-                               f"handle swings on an arc the reaching motion cannot follow)",
-                               name, designator, "door_not_supported")
+        raise ContainerFailure(
+            f"{action} {name!r}: robots open and close drawers only so far (a door's "
+            f"handle swings on an arc the reaching motion cannot follow)",
+            name,
+            designator,
+            "door_not_supported",
+        )
     return belief, environment, container
 
 
@@ -108,8 +123,11 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     except RECOVERABLE as error:  # e.g. close to the furniture after a failed attempt
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
     here = base_pose_fluent().get_value()
-    if here is None or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE \
-            or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE:
+    if (
+        here is None
+        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
+        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
+    ):
         motion(type="moving", pose=location)
     start = _measure(belief, container)
     start = 0.0 if start is None else start
@@ -121,8 +139,10 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
     if opening < HANDLE_OPENING:
         _release(arm, gripper, handle, grasp)
-        raise HandleMissed(f"the {gripper} gripper closed beside the handle of {container.name!r} "
-                           f"(opening {opening * 1000:.1f} mm)", container.name)
+        raise HandleMissed(
+            f"the {gripper} gripper closed beside the handle of {container.name!r} (opening {opening * 1000:.1f} mm)",
+            container.name,
+        )
     reached = handle
     try:
         for k in range(1, PULL_STEPS + 1):
@@ -145,16 +165,21 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
         raise ContainerFailure(f"could not see the handle of {container.name!r} after moving it", container.name)
     done = measured < CLOSED if goal == 0.0 else measured >= min(goal - OPEN_TOLERANCE, USEFUL_OPENING)
     if not done:
-        raise ContainerStuck(f"{container.name!r} is at {measured:.2f} m after moving its handle from "
-                             f"{start:.2f} m towards {goal:.2f} m", container.name)
+        raise ContainerStuck(
+            f"{container.name!r} is at {measured:.2f} m after moving its handle from "
+            f"{start:.2f} m towards {goal:.2f} m",
+            container.name,
+        )
     return measured
 
 
 def _release(arm: str, gripper: str, handle: list[float], grasp: str) -> None:
     """Let go of the handle and back off (best effort), the arm up for driving."""
-    for step in (lambda: motion(type="setting_gripper", gripper=gripper, position=1),
-                 lambda: motion(type="reaching", arm=arm, target=handle, phase="retreat", grasp=grasp),
-                 lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry")):
+    for step in (
+        lambda: motion(type="setting_gripper", gripper=gripper, position=1),
+        lambda: motion(type="reaching", arm=arm, target=handle, phase="retreat", grasp=grasp),
+        lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
+    ):
         try:
             step()
         except RECOVERABLE as error:
@@ -195,6 +220,7 @@ def _stepped_in(location: Any, distance: float) -> Any:
     from dataclasses import replace
 
     from pycram.robot import current_prospection
+
     x = location.x + distance * math.cos(location.yaw)
     y = location.y + distance * math.sin(location.yaw)
     prospection = current_prospection()
@@ -216,8 +242,10 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
             if number > CONTAINER_ATTEMPTS:
                 break
             try:
-                measured = attempt(f"{action} {container.name} from ({location.x:.2f}, {location.y:.2f}) with "
-                                   f"the {location.arm} arm", lambda: _move_handle(location, belief, container, goal))
+                measured = attempt(
+                    f"{action} {container.name} from ({location.x:.2f}, {location.y:.2f}) with the {location.arm} arm",
+                    lambda: _move_handle(location, belief, container, goal),
+                )
                 if action == "opening":
                     _opened_from.setdefault(current_robot(), {})[container.name] = location
                 return measured
@@ -226,8 +254,9 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
                 attempts.append(f"from ({location.x:.2f}, {location.y:.2f}): {last}")
     except RECOVERABLE as error:
         if not attempts:
-            raise ObjectOutOfReach(f"{action} {container.name!r}: no standing pose: {error}", designator,
-                                   attempts=[str(error)]) from error
+            raise ObjectOutOfReach(
+                f"{action} {container.name!r}: no standing pose: {error}", designator, attempts=[str(error)]
+            ) from error
         attempts.append(f"no further standing pose: {error}")
     message = f"{action} {container.name!r} failed: " + "; ".join(attempts)
     if isinstance(last, ContainerFailure):
@@ -243,8 +272,9 @@ def opening(designator: ActionDesignator) -> float:
         low, high = container.limits
         goal = DRAWER_OPENING if wanted is None else float(wanted)
         if not low < goal <= high:
-            raise ActionParameterError("opening", "opening", f"{goal} m is outside the slide of "
-                                       f"{container.name!r} ({low}..{high} m)")
+            raise ActionParameterError(
+                "opening", "opening", f"{goal} m is outside the slide of {container.name!r} ({low}..{high} m)"
+            )
         return goal
 
     return _operate("opening", designator, goal_of)

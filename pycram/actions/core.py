@@ -108,8 +108,9 @@ def _description() -> Any:
     robot = current_robot()
     description = getattr(robot, "description", None)
     if description is None:
-        raise PlanFailure(f"the action library needs an active robot with a description "
-                          f"(arms, grippers); active robot: {robot!r}")
+        raise PlanFailure(
+            f"the action library needs an active robot with a description (arms, grippers); active robot: {robot!r}"
+        )
     return description
 
 
@@ -128,8 +129,9 @@ def arm_name(action: str, requested: Any) -> str | None:
     d = _description()
     aliases = getattr(d, "ARM_ALIASES", {a: a for a in d.ARMS})
     if requested not in aliases:
-        raise ActionParameterError(action, "arm", f"the robot has no arm {requested!r}",
-                                   sorted(str(a) for a in aliases))
+        raise ActionParameterError(
+            action, "arm", f"the robot has no arm {requested!r}", sorted(str(a) for a in aliases)
+        )
     return str(aliases[requested])
 
 
@@ -202,4 +204,5 @@ def solutions(designator: Any) -> Iterator[Any]:
 def attempt(name: str, body: Callable[[], Any]) -> Any:
     """Run `body` as a task called `name` (so the task tree shows each attempt of an action)."""
     from pycram.runtime import run_subtask
+
     return run_subtask(name, body, kind="attempt")

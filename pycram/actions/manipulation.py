@@ -38,20 +38,51 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.failures import (GraspFailed, GripperEmpty, NavigationFailure, ObjectNotVisible, ObjectOutOfReach,
-                             ObjectSlipped, PlacingFailed, PlanFailure)
+from pycram.failures import (
+    GraspFailed,
+    GripperEmpty,
+    NavigationFailure,
+    ObjectNotVisible,
+    ObjectOutOfReach,
+    ObjectSlipped,
+    PlacingFailed,
+    PlanFailure,
+)
 from pycram.language import State, pursue
 from pycram.robot import current_robot
 from pycram.world.belief import PerceivedObject
 from pycram.world.objects import Grasp, object_type
 
-from .core import (RECOVERABLE, ActionParameterError, action_plan, arm_name, attempt, gripper_of,
-                   base_pose_fluent, gripper_opening, make_action, motion, opening_fluent, solutions,
-                   unwrap)
+from .core import (
+    RECOVERABLE,
+    ActionParameterError,
+    action_plan,
+    arm_name,
+    attempt,
+    base_pose_fluent,
+    gripper_of,
+    gripper_opening,
+    make_action,
+    motion,
+    opening_fluent,
+    solutions,
+    unwrap,
+)
 from .search import search_for
 
-__all__ = ["PickUp", "Place", "Held", "held_objects", "PICK_ROUNDS", "STANDING_POSES", "MOVED",
-           "PLACE_SPOTS", "PLACE_TOLERANCE", "HELD_FRACTION", "executable_grasps"]
+__all__ = [
+    "PickUp",
+    "Place",
+    "Held",
+    "held_objects",
+    "PICK_ROUNDS",
+    "STANDING_POSES",
+    "MOVED",
+    "PLACE_SPOTS",
+    "PLACE_TOLERANCE",
+    "HELD_FRACTION",
+    "executable_grasps",
+]
 
 log = logging.getLogger("pycram.actions")
 
@@ -137,8 +168,9 @@ def believed_object(action: str, wanted: Any) -> PerceivedObject:
     if isinstance(wanted, str):
         wanted = ObjectDesignator(type=wanted)
     if not isinstance(wanted, ObjectDesignator):
-        raise ActionParameterError(action, "object", f"needs an object designator, a believed object or a "
-                                   f"type name, got {wanted!r}")
+        raise ActionParameterError(
+            action, "object", f"needs an object designator, a believed object or a type name, got {wanted!r}"
+        )
     return _search(wanted)
 
 
@@ -147,6 +179,7 @@ def _search(description: ObjectDesignator) -> PerceivedObject:
     from pycram.designators.perform import perform
 
     from .containers import Open
+
     return search_for(description, open_container=lambda name: perform(Open(name)))
 
 
@@ -173,9 +206,11 @@ class _ObjectMoved(PlanFailure):
 
 def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None) -> None:
     """Best effort after a failed grasp: open the gripper, back off, arm up for driving."""
-    for step in (lambda: motion(type="setting_gripper", gripper=gripper, position=1),
-                 lambda: point and motion(type="reaching", arm=arm, target=point, phase="retreat"),
-                 lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry")):
+    for step in (
+        lambda: motion(type="setting_gripper", gripper=gripper, position=1),
+        lambda: point and motion(type="reaching", arm=arm, target=point, phase="retreat"),
+        lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
+    ):
         try:
             step()
         except RECOVERABLE as error:
@@ -220,10 +255,12 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         _let_go_and_retract(arm, gripper, point)
         _look_again(obj)
         if obj.gone:
-            raise ObjectNotVisible(f"the {gripper} gripper closed on nothing: {obj.name} is no longer at "
-                                   f"{_xyz(planned)}", obj, "lost")
-        raise GraspFailed(f"the {gripper} gripper closed on nothing at {_xyz(point)} "
-                          f"(opening {opening * 1000:.1f} mm)", obj)
+            raise ObjectNotVisible(
+                f"the {gripper} gripper closed on nothing: {obj.name} is no longer at {_xyz(planned)}", obj, "lost"
+            )
+        raise GraspFailed(
+            f"the {gripper} gripper closed on nothing at {_xyz(point)} (opening {opening * 1000:.1f} mm)", obj
+        )
     motion(type="reaching", arm=arm, target=point, phase="lift")
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     opening = gripper_opening(gripper)
@@ -250,9 +287,13 @@ def picking_up(designator: ActionDesignator) -> Held:
     grasps = executable_grasps(obj.type, requested_grasp)
     if not grasps:
         available = [g.approach for g in object_type(obj.type).grasps]
-        raise GraspFailed(f"the robot cannot execute a grasp {requested_grasp or ''} of a {obj.type} "
-                          f"(its grasps: {', '.join(available)}; the reaching motion approaches "
-                          f"horizontally only)", designator, "no_executable_grasp")
+        raise GraspFailed(
+            f"the robot cannot execute a grasp {requested_grasp or ''} of a {obj.type} "
+            f"(its grasps: {', '.join(available)}; the reaching motion approaches "
+            f"horizontally only)",
+            designator,
+            "no_executable_grasp",
+        )
     by_approach = {g.approach: g for g in grasps}
     attempts: list[str] = []
     last: BaseException | None = None
@@ -271,8 +312,11 @@ def picking_up(designator: ActionDesignator) -> Held:
                     continue
                 tried += 1
                 try:
-                    held = attempt(f"grasp {obj.name} from {_pose_text(location)} with the {location.arm} arm "
-                                   f"({location.grasp} grasp)", lambda: _grasp_from(location, obj, grasp))
+                    held = attempt(
+                        f"grasp {obj.name} from {_pose_text(location)} with the {location.arm} arm "
+                        f"({location.grasp} grasp)",
+                        lambda: _grasp_from(location, obj, grasp),
+                    )
                 except RECOVERABLE as error:
                     cause = last = unwrap(error)
                     attempts.append(f"from {_pose_text(location)}: {cause}")
@@ -291,13 +335,15 @@ def picking_up(designator: ActionDesignator) -> Held:
                 return held
         except NoSolutionError as error:
             if not attempts:
-                raise ObjectOutOfReach(f"no standing pose from which the robot can grasp {obj!r}: {error}",
-                                       designator, attempts=[str(error)]) from error
+                raise ObjectOutOfReach(
+                    f"no standing pose from which the robot can grasp {obj!r}: {error}",
+                    designator,
+                    attempts=[str(error)],
+                ) from error
             attempts.append(str(error))
             last = error
         if not perceive_again and tried == 0 and not attempts:
-            raise ObjectOutOfReach(f"no standing pose with a grasp the robot can execute for {obj!r}",
-                                   designator)
+            raise ObjectOutOfReach(f"no standing pose with a grasp the robot can execute for {obj!r}", designator)
         if not perceive_again:
             break
     message = f"could not pick up {obj!r} after {len(attempts)} attempts: " + "; ".join(attempts)
@@ -323,9 +369,11 @@ def _held_for(designator: ActionDesignator) -> Held:
     elif isinstance(wanted, str):
         candidates = [h for h in candidates if wanted in (h.object.type, h.object.name)]
     if not candidates:
-        raise GripperEmpty(f"placing: no gripper holds {wanted!r} (holding: "
-                           f"{', '.join(f'{a}: {h.object.name}' for a, h in holding.items()) or 'nothing'})",
-                           designator)
+        raise GripperEmpty(
+            f"placing: no gripper holds {wanted!r} (holding: "
+            f"{', '.join(f'{a}: {h.object.name}' for a, h in holding.items()) or 'nothing'})",
+            designator,
+        )
     return candidates[0]
 
 
@@ -357,8 +405,9 @@ def _spots(target: Any, held: Held) -> Any:
     its side facing the robot (within easy reach of every arm)."""
     if isinstance(target, str):
         near = _near_side(target)
-        target = LocationDesignator([("on", target), ("for", held.object.type)]
-                                    + ([("near", near)] if near is not None else []))
+        target = LocationDesignator(
+            [("on", target), ("for", held.object.type)] + ([("near", near)] if near is not None else [])
+        )
     if isinstance(target, LocationDesignator):
         return solutions(target)
     if hasattr(target, "position"):
@@ -374,8 +423,7 @@ def _drive_watching(location: Any, held: Held) -> None:
 
     def watch() -> None:
         dropped.wait_for()
-        raise ObjectSlipped(f"{held.object.name} fell out of the {held.gripper} gripper while driving",
-                            held.object)
+        raise ObjectSlipped(f"{held.object.name} fell out of the {held.gripper} gripper while driving", held.object)
 
     state = pursue(lambda: motion(type="moving", pose=location), watch, errors=errors, name="drive, holding")
     if state.get_value() is not State.SUCCEEDED:
@@ -437,22 +485,28 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                     if pose_number > PLACE_STANDING_POSES:
                         break
                     try:
-                        return attempt(f"place {held.object.name} at {_xyz(spot)} from {_pose_text(location)}",
-                                       lambda: _place_at(location, held, spot, point))
+                        return attempt(
+                            f"place {held.object.name} at {_xyz(spot)} from {_pose_text(location)}",
+                            lambda: _place_at(location, held, spot, point),
+                        )
                     except RECOVERABLE as error:
                         cause = last = unwrap(error)
                         attempts.append(f"at {_xyz(spot)} from {_pose_text(location)}: {cause}")
                         if isinstance(cause, (ObjectSlipped, PlacingFailed)):
                             raise cause from error
                         if held.arm not in held_objects():  # let go already: nothing to retry with
-                            raise PlacingFailed(f"{held.object.name} was let go at {_xyz(spot)}, then: {cause}",
-                                                designator, attempts=attempts) from error
+                            raise PlacingFailed(
+                                f"{held.object.name} was let go at {_xyz(spot)}, then: {cause}",
+                                designator,
+                                attempts=attempts,
+                            ) from error
             except NoSolutionError as error:
                 attempts.append(f"at {_xyz(spot)}: {error}")
                 last = error
     except NoSolutionError as error:
-        raise ObjectOutOfReach(f"no spot at {target!r} for {held.object.name}: {error}", designator,
-                               attempts=attempts) from error
+        raise ObjectOutOfReach(
+            f"no spot at {target!r} for {held.object.name}: {error}", designator, attempts=attempts
+        ) from error
     message = f"could not place {held.object.name} at {target!r}: " + "; ".join(attempts)
     if last is None or isinstance(last, NoSolutionError):
         raise ObjectOutOfReach(message, designator, attempts=attempts) from last

@@ -83,8 +83,13 @@ def _free(environment: Environment, x: float, y: float) -> bool:
     return environment.is_free_floor(x, y, margin=STAND_CLEARANCE)
 
 
-def _stand_along(environment: Environment, point: tuple[float, float], towards: tuple[float, float],
-                 n: tuple[float, float], standoff: float) -> tuple[float, float] | None:
+def _stand_along(
+    environment: Environment,
+    point: tuple[float, float],
+    towards: tuple[float, float],
+    n: tuple[float, float],
+    standoff: float,
+) -> tuple[float, float] | None:
     """A free standing spot `standoff` [m] out from `point` on an edge (outward normal `n`),
     moved along the edge towards `towards` (in 0.1 m steps, at most to it) when `point` is not
     free; None when there is none."""
@@ -99,8 +104,9 @@ def _stand_along(environment: Environment, point: tuple[float, float], towards: 
     return None
 
 
-def _surface_lookouts(environment: Environment, surface: Surface, near: tuple[float, float],
-                      standoff: float) -> list[Lookout]:
+def _surface_lookouts(
+    environment: Environment, surface: Surface, near: tuple[float, float], standoff: float
+) -> list[Lookout]:
     """Lookouts along the free edge of an open surface nearest to `near`."""
     options = []
     for a, b, n in surface.edges():
@@ -124,13 +130,23 @@ def _surface_lookouts(environment: Environment, surface: Surface, near: tuple[fl
         if stand is None:
             continue
         name = surface.name if pieces == 1 else f"{surface.name} ({k + 1}/{pieces})"
-        out.append(Lookout(name, surface.name, (px - inward * n[0], py - inward * n[1], surface.height + 0.05),
-                           (*stand, math.atan2(-n[1], -n[0]))))
+        out.append(
+            Lookout(
+                name,
+                surface.name,
+                (px - inward * n[0], py - inward * n[1], surface.height + 0.05),
+                (*stand, math.atan2(-n[1], -n[0])),
+            )
+        )
     return out
 
 
-def lookouts(environment: Environment, type_name: str | None = None, near: tuple[float, float] = (0.0, 0.0),
-             standoff: float = STANDOFF) -> list[Lookout]:
+def lookouts(
+    environment: Environment,
+    type_name: str | None = None,
+    near: tuple[float, float] = (0.0, 0.0),
+    standoff: float = STANDOFF,
+) -> list[Lookout]:
     """The places of `environment` where an object of `type_name` is likely (all surfaces when
     the type is None or unknown), with where to stand for each, nearest to `near` [m] first."""
     kinds = OBJECT_TYPES[type_name].found_on if type_name in OBJECT_TYPES else None
@@ -154,11 +170,11 @@ def lookouts(environment: Environment, type_name: str | None = None, near: tuple
 
 def _robot_belief() -> BeliefState:
     from pycram.robot import current_robot
+
     robot = current_robot()
     belief = getattr(robot, "belief", None)
     if not isinstance(belief, BeliefState):
-        raise ValueError(f"search_for needs a belief state: the active robot {robot!r} has none "
-                         f"(pass belief=...)")
+        raise ValueError(f"search_for needs a belief state: the active robot {robot!r} has none (pass belief=...)")
     return belief
 
 
@@ -189,8 +205,15 @@ def _look(description: ObjectDesignator, target: tuple[float, float, float]) -> 
     return seen[0] if seen else None
 
 
-def _look_around(description: ObjectDesignator | None, places: list[Lookout], here: tuple[float, float],
-                 belief: BeliefState, look_range: float, looked: list[str], close: set[str]) -> list[PerceivedObject]:
+def _look_around(
+    description: ObjectDesignator | None,
+    places: list[Lookout],
+    here: tuple[float, float],
+    belief: BeliefState,
+    look_range: float,
+    looked: list[str],
+    close: set[str],
+) -> list[PerceivedObject]:
     """Look at each place within `look_range` of `here`; stop at the first match of a
     `description` (None: look at every place and return everything seen)."""
     environment = belief.environment
@@ -218,8 +241,9 @@ def _look_around(description: ObjectDesignator | None, places: list[Lookout], he
 
 
 @as_task(name="look_around")
-def look_around(description: ObjectDesignator | None = None, *, belief: BeliefState | None = None,
-                look_range: float = LOOK_RANGE) -> list[PerceivedObject]:
+def look_around(
+    description: ObjectDesignator | None = None, *, belief: BeliefState | None = None, look_range: float = LOOK_RANGE
+) -> list[PerceivedObject]:
     """Look at every likely place within `look_range` [m] from where the robot stands (for the
     type of `description`, all places without one), detecting at each, without driving; stops
     at the first object matching `description`. Returns the believed objects seen (matching
@@ -234,9 +258,14 @@ def look_around(description: ObjectDesignator | None = None, *, belief: BeliefSt
 
 
 @as_task(name="search_for")
-def search_for(description: ObjectDesignator, *, belief: BeliefState | None = None,
-               open_container: Callable[[str], Any] | None = None, look_range: float = LOOK_RANGE,
-               standoff: float = STANDOFF) -> PerceivedObject:
+def search_for(
+    description: ObjectDesignator,
+    *,
+    belief: BeliefState | None = None,
+    open_container: Callable[[str], Any] | None = None,
+    look_range: float = LOOK_RANGE,
+    standoff: float = STANDOFF,
+) -> PerceivedObject:
     """Find an object matching `description` (see the module's description); returns the believed
     object found, to which `description` is then equated (``description.current()``).
 
@@ -262,6 +291,7 @@ def search_for(description: ObjectDesignator, *, belief: BeliefState | None = No
     found = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
     if found:
         return found[0]
+
     # 2. visit the likely places, nearest first -- those behind a closed door or drawer last
     #    (opening is slow, and an opened drawer stands in the way)
     def closed_first_last(lookout: Lookout) -> bool:
@@ -276,9 +306,15 @@ def search_for(description: ObjectDesignator, *, belief: BeliefState | None = No
     raise ObjectNotFound(description, looked, sorted(skipped.items()))
 
 
-def _visit(description: ObjectDesignator, lookout: Lookout, environment: Environment, belief: BeliefState,
-           open_container: Callable[[str], Any] | None, looked: list[str],
-           skipped: dict[str, str]) -> PerceivedObject | None:
+def _visit(
+    description: ObjectDesignator,
+    lookout: Lookout,
+    environment: Environment,
+    belief: BeliefState,
+    open_container: Callable[[str], Any] | None,
+    looked: list[str],
+    skipped: dict[str, str],
+) -> PerceivedObject | None:
     container = lookout.container
     if container is not None and belief.container_open(container) is False and open_container is None:
         skipped[lookout.name] = f"{container} is closed"

@@ -18,8 +18,17 @@ from pycram.demos.scene_picture import _BOX, _OBJECT_COLOR, VIEW_SIZE, _Labels, 
 __all__ = ["write_belief_picture"]
 
 #: Matplotlib colours of the perceived colour names.
-_COLORS = {"red": "#d32f2f", "orange": "#f57c00", "yellow": "#fbc02d", "green": "#388e3c", "blue": "#1976d2",
-           "purple": "#7b1fa2", "white": "#fafafa", "grey": "#9e9e9e", "black": "#212121"}
+_COLORS = {
+    "red": "#d32f2f",
+    "orange": "#f57c00",
+    "yellow": "#fbc02d",
+    "green": "#388e3c",
+    "blue": "#1976d2",
+    "purple": "#7b1fa2",
+    "white": "#fafafa",
+    "grey": "#9e9e9e",
+    "black": "#212121",
+}
 _LOOK_COLOR = "#29b6f6"
 
 
@@ -34,10 +43,22 @@ def _plan_axes(ax: Any, image: Any, extent: tuple[float, float, float, float], t
 
 def _robot(ax: Any, world: Any) -> None:
     base = world.base_pose.get_value()
-    ax.annotate("", xy=(base.x + 0.35 * math.cos(base.yaw), base.y + 0.35 * math.sin(base.yaw)),
-                xytext=(base.x, base.y), arrowprops={"arrowstyle": "-|>", "color": "#1b5e20", "lw": 2})
-    ax.text(base.x, base.y - 0.3, world.robot.upper(), ha="center", va="top", fontsize=10, fontweight="bold",
-            color="#1b5e20")
+    ax.annotate(
+        "",
+        xy=(base.x + 0.35 * math.cos(base.yaw), base.y + 0.35 * math.sin(base.yaw)),
+        xytext=(base.x, base.y),
+        arrowprops={"arrowstyle": "-|>", "color": "#1b5e20", "lw": 2},
+    )
+    ax.text(
+        base.x,
+        base.y - 0.3,
+        world.robot.upper(),
+        ha="center",
+        va="top",
+        fontsize=10,
+        fontweight="bold",
+        color="#1b5e20",
+    )
 
 
 def write_belief_picture(world: Any, belief: Any, path: str | Path, title: str | None = None) -> Path:
@@ -76,19 +97,31 @@ def write_belief_picture(world: Any, belief: Any, path: str | Path, title: str |
         inside = placement.container if placement is not None else None
         hidden = inside is not None and abs(states.get(inside, 0.0)) < 0.05
         radius = math.hypot(item.size[0], item.size[1]) if item.shape == "box" else item.size[0]
-        truth_ax.add_patch(Circle((x, y), max(radius, 0.04), fill=False, lw=1.5, ls="--" if hidden else "-",
-                                  edgecolor=_OBJECT_COLOR))
+        truth_ax.add_patch(
+            Circle((x, y), max(radius, 0.04), fill=False, lw=1.5, ls="--" if hidden else "-", edgecolor=_OBJECT_COLOR)
+        )
         text = f"{item.type}" + (f" (in closed {inside})" if hidden else "")
-        truth_ax.annotate(text, xy=(x, y), xytext=truth_labels.spot(x, y, text), ha="center", va="center",
-                          fontsize=9, color=_OBJECT_COLOR, bbox={**_BOX, "facecolor": "white"},
-                          arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8})
+        truth_ax.annotate(
+            text,
+            xy=(x, y),
+            xytext=truth_labels.spot(x, y, text),
+            ha="center",
+            va="center",
+            fontsize=9,
+            color=_OBJECT_COLOR,
+            bbox={**_BOX, "facecolor": "white"},
+            arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8},
+        )
     _robot(truth_ax, world)
     # the belief: looks, then objects
     for look in belief.looks:
         heading = math.degrees(math.atan2(look.direction[1], look.direction[0]))
         half = math.degrees(math.atan(math.tan(math.radians(look.fovy) / 2) * 4 / 3))  # 4:3 images
-        belief_ax.add_patch(Wedge(look.position[:2], look.max_range, heading - half, heading + half,
-                                  alpha=0.08, color=_LOOK_COLOR, lw=0))
+        belief_ax.add_patch(
+            Wedge(
+                look.position[:2], look.max_range, heading - half, heading + half, alpha=0.08, color=_LOOK_COLOR, lw=0
+            )
+        )
     belief_labels = labels()
     rows = []
     for obj in belief.objects():
@@ -97,26 +130,61 @@ def write_belief_picture(world: Any, belief: Any, path: str | Path, title: str |
         x, y, _ = obj.pose
         size = obj.properties.get("size") or (0.08, 0.08, 0.0)
         colour = obj.properties.get("color") or "grey"
-        belief_ax.add_patch(Circle((x, y), max(size[0], size[1], 0.08) / 2, lw=1.5,
-                                   facecolor=_COLORS.get(colour, "#9e9e9e"), edgecolor="#212121",
-                                   alpha=0.35 if obj.gone else 0.95, ls="--" if obj.gone else "-"))
+        belief_ax.add_patch(
+            Circle(
+                (x, y),
+                max(size[0], size[1], 0.08) / 2,
+                lw=1.5,
+                facecolor=_COLORS.get(colour, "#9e9e9e"),
+                edgecolor="#212121",
+                alpha=0.35 if obj.gone else 0.95,
+                ls="--" if obj.gone else "-",
+            )
+        )
         if obj.gone:
             belief_ax.plot([x - 0.08, x + 0.08], [y - 0.08, y + 0.08], color="#b71c1c", lw=2)
             belief_ax.plot([x - 0.08, x + 0.08], [y + 0.08, y - 0.08], color="#b71c1c", lw=2)
         seen = obj.properties.get("last_seen")
         text = f"{obj.name}" + (" (gone)" if obj.gone else "")
-        belief_ax.annotate(text, xy=(x, y), xytext=belief_labels.spot(x, y, text), ha="center", va="center",
-                           fontsize=9, color=_OBJECT_COLOR, bbox={**_BOX, "facecolor": "white"},
-                           arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8})
+        belief_ax.annotate(
+            text,
+            xy=(x, y),
+            xytext=belief_labels.spot(x, y, text),
+            ha="center",
+            va="center",
+            fontsize=9,
+            color=_OBJECT_COLOR,
+            bbox={**_BOX, "facecolor": "white"},
+            arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8},
+        )
         where = obj.properties.get("on") or "?"
         inside = obj.properties.get("in")
-        rows.append(f"{obj.name:<9} {colour:<6} {where}{' (in ' + inside + ')' if inside else ''}"
-                    f"  seen {seen:.1f} s{'  GONE' if obj.gone else ''}")
+        rows.append(
+            f"{obj.name:<9} {colour:<6} {where}{' (in ' + inside + ')' if inside else ''}"
+            f"  seen {seen:.1f} s{'  GONE' if obj.gone else ''}"
+        )
     _robot(belief_ax, world)
     text = "believed objects\n" + ("\n".join(rows) if rows else "(none perceived)")
-    belief_ax.text(x1 - 0.1, y0 + 0.1, text, ha="right", va="bottom", family="monospace", fontsize=8,
-                   color="#1a1a1a", bbox={**_BOX, "facecolor": "white", "alpha": 0.9})
-    belief_ax.text(x0 + 0.1, y1 - 0.1, f"blue wedges: the camera's {len(belief.looks)} looks\n"
-                   "disc: believed object, perceived colour and measured size\ncrossed: believed gone",
-                   ha="left", va="top", fontsize=8, color="#263238", bbox={**_BOX, "facecolor": "white"})
+    belief_ax.text(
+        x1 - 0.1,
+        y0 + 0.1,
+        text,
+        ha="right",
+        va="bottom",
+        family="monospace",
+        fontsize=8,
+        color="#1a1a1a",
+        bbox={**_BOX, "facecolor": "white", "alpha": 0.9},
+    )
+    belief_ax.text(
+        x0 + 0.1,
+        y1 - 0.1,
+        f"blue wedges: the camera's {len(belief.looks)} looks\n"
+        "disc: believed object, perceived colour and measured size\ncrossed: believed gone",
+        ha="left",
+        va="top",
+        fontsize=8,
+        color="#263238",
+        bbox={**_BOX, "facecolor": "white"},
+    )
     return _save(fig, path, title or f"{env.name}: belief and ground truth")

@@ -38,8 +38,14 @@ def parse_location(text: str) -> list[tuple[str, Any]]:
     return out
 
 
-def write_costmap_picture(world: Any, robot: Any, properties: Sequence[tuple[str, Any]], path: str | Path,
-                          count: int = 5, title: str | None = None) -> tuple[Path, list[Any], str | None]:
+def write_costmap_picture(
+    world: Any,
+    robot: Any,
+    properties: Sequence[tuple[str, Any]],
+    path: str | Path,
+    count: int = 5,
+    title: str | None = None,
+) -> tuple[Path, list[Any], str | None]:
     """Resolve ``LocationDesignator(properties)`` with `robot` active and draw it (see the module
     docstring). Returns (path, solutions found, error message or None)."""
     import matplotlib
@@ -76,7 +82,7 @@ def write_costmap_picture(world: Any, robot: Any, properties: Sequence[tuple[str
     columns = min(4, len(panels))
     rows = (len(panels) + columns - 1) // columns
     fig, axes = plt.subplots(rows, columns, figsize=(5.5 * columns, 4.4 * rows + 0.8), squeeze=False)
-    for ax in axes.ravel()[len(panels):]:
+    for ax in axes.ravel()[len(panels) :]:
         ax.set_axis_off()
     for ax, (label, values, grid) in zip(axes.ravel(), panels):
         ax.imshow(plan, extent=(x0, x1, y0, y1))
@@ -85,8 +91,15 @@ def write_costmap_picture(world: Any, robot: Any, properties: Sequence[tuple[str
             gx0, gy0, gx1, gy1 = grid.bounds
             finite = shown[np.isfinite(shown)]
             vmax = float(np.percentile(finite, 95)) if finite.size else 1.0
-            ax.imshow(shown, extent=(gx0, gx1, gy0, gy1), origin="lower", cmap="viridis_r", alpha=0.6,
-                      vmin=0.0, vmax=max(vmax, 1e-6))
+            ax.imshow(
+                shown,
+                extent=(gx0, gx1, gy0, gy1),
+                origin="lower",
+                cmap="viridis_r",
+                alpha=0.6,
+                vmin=0.0,
+                vmax=max(vmax, 1e-6),
+            )
             blocked = np.where(np.isinf(values), 1.0, np.nan)
             ax.imshow(blocked, extent=(gx0, gx1, gy0, gy1), origin="lower", cmap="Reds", alpha=0.35, vmin=0, vmax=1)
         _draw_solutions(ax, solutions)
@@ -110,8 +123,12 @@ def _draw_solutions(ax: Any, solutions: Sequence[Any]) -> None:
     for i, s in enumerate(solutions):
         color = "#d50000" if i == 0 else "#ff6d00"
         if hasattr(s, "yaw"):
-            ax.annotate("", xy=(s.x + 0.35 * math.cos(s.yaw), s.y + 0.35 * math.sin(s.yaw)), xytext=(s.x, s.y),
-                        arrowprops={"arrowstyle": "-|>", "color": color, "lw": 2})
+            ax.annotate(
+                "",
+                xy=(s.x + 0.35 * math.cos(s.yaw), s.y + 0.35 * math.sin(s.yaw)),
+                xytext=(s.x, s.y),
+                arrowprops={"arrowstyle": "-|>", "color": color, "lw": 2},
+            )
             ax.plot([s.x], [s.y], "o", ms=5, color=color)
             ax.text(s.x + 0.08, s.y - 0.15, str(i + 1), fontsize=8, color=color, fontweight="bold")
         else:

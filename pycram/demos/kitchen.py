@@ -222,8 +222,9 @@ def _mark_interrupted(result: DemoResult, stop: Any) -> None:
     elif result.plan_task is None:
         result.message = f"{stop.reason} before the plan started"
     else:
-        result.message = (f"{stop.reason} after {result.sim_time:.1f} s of simulated time; "
-                          f"the plan and the robot were stopped")
+        result.message = (
+            f"{stop.reason} after {result.sim_time:.1f} s of simulated time; the plan and the robot were stopped"
+        )
 
 
 def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop: Any) -> None:
@@ -259,8 +260,14 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
         robot = None
         counter_height = world.environment.surface("cooker #1").height
-        camera = FollowView((world.description.ROOT_LINK, *(item.name for item in items)), region=KITCHEN_REGION,
-                            side_of=ROOM_MIDDLE, elevation=-50.0, min_distance=2.8, margin=2.2)
+        camera = FollowView(
+            (world.description.ROOT_LINK, *(item.name for item in items)),
+            region=KITCHEN_REGION,
+            side_of=ROOM_MIDDLE,
+            elevation=-50.0,
+            min_distance=2.8,
+            margin=2.2,
+        )
     thief = None
     story = None
     frames: list = []
@@ -283,8 +290,9 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         story = _Story(plan, thief, stop)
         add_task_listener(story)
         if options.animation:
-            world.start_recording(camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1],
-                                  caption=story.caption)
+            world.start_recording(
+                camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1], caption=story.caption
+            )
         run = PlanRun(plan, robot, facts)
         thief.start()
         run.start(world.sim_time.get_value())
@@ -341,8 +349,15 @@ def _item_on_cooker_1(world: Any, item: str, counter_height: float) -> bool:
     on_top = counter_height < z < counter_height + 0.15
     near = math.hypot(x - PLACE_XY[0], y - PLACE_XY[1]) < 0.15
     tilt = _tilt(pose.orientation)
-    log.info("the %s ends at (%.2f, %.2f, %.2f), tilted %.0f deg%s", item, x, y, z,
-             math.degrees(tilt), ", held" if held else "")
+    log.info(
+        "the %s ends at (%.2f, %.2f, %.2f), tilted %.0f deg%s",
+        item,
+        x,
+        y,
+        z,
+        math.degrees(tilt),
+        ", held" if held else "",
+    )
     return not held and on_top and near and tilt < math.radians(20)
 
 
@@ -405,8 +420,11 @@ def _write_run_pictures(result: DemoResult, recorder: Any) -> list[Path]:
     try:
         return list(write_run_pictures(result.run_id, result.output, url=recorder.url))
     except (TraceDatabaseError, RunNotFound) as error:
-        log.warning("cannot read run %s back from the trace database (%s); drawing the pictures "
-                    "from memory", result.run_id, error)
+        log.warning(
+            "cannot read run %s back from the trace database (%s); drawing the pictures from memory",
+            result.run_id,
+            error,
+        )
     if result.plan_task is None:
         return []
     return list(write_task_pictures(result.plan_task, result.output))
@@ -501,10 +519,12 @@ class _ProgressLine:
 
     def _text(self) -> str:
         task = self.run.task
-        return (f"step: {self.plan.phase.get_value():<13} failed grasps: {failed_grasps(task)}  "
-                f"recoveries: {recoveries(task)}  "
-                f"thefts: {self.thief.stolen}  sim {self.world.sim_time.get_value():6.1f} s  "
-                f"wall {time.monotonic() - self._started:5.1f} s")
+        return (
+            f"step: {self.plan.phase.get_value():<13} failed grasps: {failed_grasps(task)}  "
+            f"recoveries: {recoveries(task)}  "
+            f"thefts: {self.thief.stolen}  sim {self.world.sim_time.get_value():6.1f} s  "
+            f"wall {time.monotonic() - self._started:5.1f} s"
+        )
 
     def __enter__(self) -> _ProgressLine:
         self._live.__enter__()
@@ -576,9 +596,20 @@ def _log_to_terminal() -> None:
         demo_log.propagate = False
 
 
-def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal: int = 0, seed: int = 0,
-         realtime: bool = False, interactive: bool = False, db: str | None = None, record: bool = True,
-         quiet: bool = False, animation: bool = True, backend: str = "sim") -> int:
+def main(
+    robot: str = "pr2",
+    output: str | None = None,
+    item_at: int = 1,
+    steal: int = 0,
+    seed: int = 0,
+    realtime: bool = False,
+    interactive: bool = False,
+    db: str | None = None,
+    record: bool = True,
+    quiet: bool = False,
+    animation: bool = True,
+    backend: str = "sim",
+) -> int:
     """Run the demo, print the task tree and a summary; return the process exit code (0: the item
     rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
     from rich.console import Console
@@ -589,9 +620,20 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
         _log_to_terminal()
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
-    options = DemoOptions(robot=robot, output=Path(output) if output else None, item_at=item_at, steal=steal,
-                          seed=seed, realtime=realtime, interactive=interactive, db=db, record=record,
-                          quiet=quiet, animation=animation, backend=backend)
+    options = DemoOptions(
+        robot=robot,
+        output=Path(output) if output else None,
+        item_at=item_at,
+        steal=steal,
+        seed=seed,
+        realtime=realtime,
+        interactive=interactive,
+        db=db,
+        record=record,
+        quiet=quiet,
+        animation=animation,
+        backend=backend,
+    )
     try:
         with StopSignals(on_second=lambda: _stderr_console().show_cursor(True)) as stop:
             result = run_demo(options, stop)
@@ -600,15 +642,16 @@ def main(robot: str = "pr2", output: str | None = None, item_at: int = 1, steal:
         return 2
     console.print()
     console.print(_task_tree_display(result, options.db))
-    console.print(f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
-                  f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s")
+    console.print(
+        f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
+        f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s"
+    )
     console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")
     console.print(f"pictures in {result.output.resolve()}: " + ", ".join(p.name for p in result.files))
     if result.run_id is not None:
         console.print(f"recorded as run {result.run_id} (see `pycram show {result.run_id}`)")
     if result.trace_loss:
-        console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]",
-                      highlight=False)
+        console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]", highlight=False)
     colour = "green" if result.exit_code == 0 else "yellow" if result.interrupted else "red"
     verdict = "SUCCESS" if result.exit_code == 0 else "INTERRUPTED" if result.interrupted else "FAILURE"
     console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")

@@ -16,8 +16,9 @@ from __future__ import annotations
 import logging
 import random
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule
@@ -153,8 +154,9 @@ class Thief:
     ends it.
     """
 
-    def __init__(self, world: Any, helper: Helper, phase: Fluent, goal: Fluent, gripper: str,
-                 count: int, rng: random.Random) -> None:
+    def __init__(
+        self, world: Any, helper: Helper, phase: Fluent, goal: Fluent, gripper: str, count: int, rng: random.Random
+    ) -> None:
         self.world, self.helper, self.phase, self.goal = world, helper, phase, goal
         self.gripper, self.count, self.rng = gripper, count, rng
         self.stolen = 0

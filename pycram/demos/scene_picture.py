@@ -31,8 +31,20 @@ def _hex(rgba: Any) -> tuple[float, float, float]:
 class _Labels:
     """Places object labels next to their objects without overlapping each other (greedy)."""
 
-    OFFSETS = [(0.35, 0.25), (-0.35, 0.25), (0.35, -0.25), (-0.35, -0.25), (0.0, 0.4), (0.0, -0.4),
-               (0.55, 0.0), (-0.55, 0.0), (0.5, 0.55), (-0.5, 0.55), (0.5, -0.55), (-0.5, -0.55)]
+    OFFSETS = [
+        (0.35, 0.25),
+        (-0.35, 0.25),
+        (0.35, -0.25),
+        (-0.35, -0.25),
+        (0.0, 0.4),
+        (0.0, -0.4),
+        (0.55, 0.0),
+        (-0.55, 0.0),
+        (0.5, 0.55),
+        (-0.5, 0.55),
+        (0.5, -0.55),
+        (-0.5, -0.55),
+    ]
 
     def __init__(self, char_width: float, line_height: float, unit: float = 1.0) -> None:
         """`char_width` and `line_height` of the text and `unit` (the length of 1 m of offset)
@@ -102,8 +114,9 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
         cx, cy, cz = surface.centroid
         small = surface.kind == "cooker"
         style = {**_SURFACE_STYLE, "fontsize": 8 if small else 10}
-        ax.text(cx, cy + ((0.22 if i % 2 else -0.22) if small else 0.0), surface.name, ha="center",
-                va="center", **style)
+        ax.text(
+            cx, cy + ((0.22 if i % 2 else -0.22) if small else 0.0), surface.name, ha="center", va="center", **style
+        )
         if not small:
             uv = _project(env.camera, (cx, cy, cz), width, height)
             if uv is not None:
@@ -115,12 +128,22 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
     for (hx, hy), members in groups.items():
         c = members[0]
         dx, dy = c.opening_direction
-        ax.annotate("", xy=(hx + 0.3 * dx, hy + 0.3 * dy), xytext=(hx, hy),
-                    arrowprops={"arrowstyle": "-|>", "color": "#5d4037", "lw": 2})
+        ax.annotate(
+            "",
+            xy=(hx + 0.3 * dx, hy + 0.3 * dy),
+            xytext=(hx, hy),
+            arrowprops={"arrowstyle": "-|>", "color": "#5d4037", "lw": 2},
+        )
         names = [m.name for m in sorted(members, key=lambda m: -m.handle[2])]  # the top one first
         label = "\n".join(names) if c.kind == "drawer" else f"{c.name} (door)"
-        ax.text(hx + 0.38 * dx + 0.3 * abs(dy), hy + 0.38 * dy, label, ha="left" if dx >= 0 else "right",
-                va="center", **{**_CONTAINER_STYLE, "fontsize": 9})
+        ax.text(
+            hx + 0.38 * dx + 0.3 * abs(dy),
+            hy + 0.38 * dy,
+            label,
+            ha="left" if dx >= 0 else "right",
+            va="center",
+            **{**_CONTAINER_STYLE, "fontsize": 9},
+        )
         if c.kind == "door":
             _door_swing(ax, Arc, c)
         for m in members:
@@ -130,14 +153,26 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
     # named places (robot-independent base poses)
     for place in env.places:
         px, py, yaw = place.pose
-        ax.annotate("", xy=(px + 0.25 * math.cos(yaw), py + 0.25 * math.sin(yaw)), xytext=(px, py),
-                    arrowprops={"arrowstyle": "->", "color": "#455a64", "lw": 1.2})
+        ax.annotate(
+            "",
+            xy=(px + 0.25 * math.cos(yaw), py + 0.25 * math.sin(yaw)),
+            xytext=(px, py),
+            arrowprops={"arrowstyle": "->", "color": "#455a64", "lw": 1.2},
+        )
         ax.plot([px], [py], "o", ms=4, color="#455a64")
         ax.text(px + 0.08, py - 0.1, place.name, ha="left", va="top", **_PLACE_STYLE)
     # the robot
     base = world.base_pose.get_value()
-    ax.text(base.x, base.y + 0.45, world.robot.upper(), ha="center", va="bottom", fontsize=10,
-            fontweight="bold", color="#1b5e20")
+    ax.text(
+        base.x,
+        base.y + 0.45,
+        world.robot.upper(),
+        ha="center",
+        va="bottom",
+        fontsize=10,
+        fontweight="bold",
+        color="#1b5e20",
+    )
     # objects
     labels = _Labels(char_width=0.075 * (x1 - x0) / 8.0, line_height=0.16 * (y1 - y0) / 6.0)
     for box in ax.texts:  # keep object labels off the other labels
@@ -153,26 +188,56 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
         inside = placement.container if placement is not None else None
         where = placement.support if placement is not None else "—"
         radius = math.hypot(item.size[0], item.size[1]) if item.shape == "box" else item.size[0]
-        ax.add_patch(Circle((x, y), max(radius, 0.04), fill=False, lw=1.5, ls="--" if inside else "-",
-                            edgecolor=_OBJECT_COLOR))
+        ax.add_patch(
+            Circle((x, y), max(radius, 0.04), fill=False, lw=1.5, ls="--" if inside else "-", edgecolor=_OBJECT_COLOR)
+        )
         text = item.name + (f" (in {inside})" if inside else "")
         lx, ly = labels.spot(x, y, text)
-        ax.annotate(text, xy=(x, y), xytext=(lx, ly), ha="center", va="center", fontsize=9,
-                    color=_OBJECT_COLOR, fontstyle="italic" if inside else "normal",
-                    bbox={**_BOX, "facecolor": "white"},
-                    arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8})
+        ax.annotate(
+            text,
+            xy=(x, y),
+            xytext=(lx, ly),
+            ha="center",
+            va="center",
+            fontsize=9,
+            color=_OBJECT_COLOR,
+            fontstyle="italic" if inside else "normal",
+            bbox={**_BOX, "facecolor": "white"},
+            arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR, "lw": 0.8},
+        )
         uv = _project(env.camera, (x, y, z + item.half_height), width, height)
         if uv is not None and not inside:
-            view.annotate(item.name, xy=uv, xytext=view_labels.spot(*uv, item.name), ha="center", va="center",
-                          fontsize=8, color=_OBJECT_COLOR, bbox={**_BOX, "facecolor": "white"},
-                          arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR})
+            view.annotate(
+                item.name,
+                xy=uv,
+                xytext=view_labels.spot(*uv, item.name),
+                ha="center",
+                va="center",
+                fontsize=8,
+                color=_OBJECT_COLOR,
+                bbox={**_BOX, "facecolor": "white"},
+                arrowprops={"arrowstyle": "-", "color": _OBJECT_COLOR},
+            )
         rows.append(f"{item.name:<9} {item.type:<7} {where}" + (f"  (in {inside})" if inside else ""))
     if rows:
-        view.text(12, height - 12, "objects\n" + "\n".join(rows), ha="left", va="bottom", family="monospace",
-                  fontsize=8.5, color="#1a1a1a", bbox={**_BOX, "facecolor": "white", "alpha": 0.9})
+        view.text(
+            12,
+            height - 12,
+            "objects\n" + "\n".join(rows),
+            ha="left",
+            va="bottom",
+            family="monospace",
+            fontsize=8.5,
+            color="#1a1a1a",
+            bbox={**_BOX, "facecolor": "white", "alpha": 0.9},
+        )
     legend_w, legend_h = 0.6 * (x1 - x0), 0.07 * (y1 - y0)  # roughly, in [m] of the plan
-    corners = [(x1 - 0.1, y0 + 0.1, "right", "bottom"), (x1 - 0.1, y1 - 0.1, "right", "top"),
-               (x0 + 0.1, y0 + 0.1, "left", "bottom"), (x0 + 0.1, y1 - 0.1, "left", "top")]
+    corners = [
+        (x1 - 0.1, y0 + 0.1, "right", "bottom"),
+        (x1 - 0.1, y1 - 0.1, "right", "top"),
+        (x0 + 0.1, y0 + 0.1, "left", "bottom"),
+        (x0 + 0.1, y1 - 0.1, "left", "top"),
+    ]
     footprints = [b.footprint for b in env.static] + [c.body.footprint for c in env.containers]
 
     def free(corner: tuple) -> bool:
@@ -182,9 +247,17 @@ def write_scene_picture(world: Any, path: str | Path, title: str | None = None) 
         return not any(f[0] < bx1 and bx0 < f[2] and f[1] < by1 and by0 < f[3] for f in footprints)
 
     lx, ly, ha, va = next((c for c in corners if free(c)), corners[0])
-    ax.text(lx, ly, "solid circle: object in view   dashed: inside a closed container\n"
-            "brown arrow: how a container opens   grey arrow: a named place (base pose)",
-            ha=ha, va=va, fontsize=8, color="#263238", bbox={**_BOX, "facecolor": "white"})
+    ax.text(
+        lx,
+        ly,
+        "solid circle: object in view   dashed: inside a closed container\n"
+        "brown arrow: how a container opens   grey arrow: a named place (base pose)",
+        ha=ha,
+        va=va,
+        fontsize=8,
+        color="#263238",
+        bbox={**_BOX, "facecolor": "white"},
+    )
     return _save(fig, path, title or f"{env.name}: {env.title}")
 
 
@@ -208,8 +281,18 @@ def _door_swing(ax: Any, arc_type: Any, door: Any) -> None:
     radius = math.hypot(far[0] - hx, far[1] - hy)
     closed = math.degrees(math.atan2(far[1] - hy, far[0] - hx))
     opened = closed + door.hinge_sign * 90.0
-    ax.add_patch(arc_type((hx, hy), 2 * radius, 2 * radius, theta1=min(closed, opened), theta2=max(closed, opened),
-                          ls="--", lw=1.2, color="#5d4037"))
+    ax.add_patch(
+        arc_type(
+            (hx, hy),
+            2 * radius,
+            2 * radius,
+            theta1=min(closed, opened),
+            theta2=max(closed, opened),
+            ls="--",
+            lw=1.2,
+            color="#5d4037",
+        )
+    )
     ax.plot([hx], [hy], "s", ms=5, color="#5d4037")
 
 

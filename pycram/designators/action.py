@@ -9,10 +9,17 @@ task tree and returns its result.
 
 from __future__ import annotations
 
-from typing import Any, Callable, ClassVar, Iterator
+from collections.abc import Callable, Iterator
+from typing import Any, ClassVar
 
-from pycram.designators.core import (LazyDesignator, ResolverError, _short, call_resolver,
-                                     callable_name, expand_solutions)
+from pycram.designators.core import (
+    LazyDesignator,
+    ResolverError,
+    _short,
+    call_resolver,
+    callable_name,
+    expand_solutions,
+)
 
 __all__ = ["ActionDesignator", "plan_for"]
 
@@ -20,11 +27,12 @@ __all__ = ["ActionDesignator", "plan_for"]
 class ActionDesignator(LazyDesignator):
     """An action such as fetching or placing; its solutions are plan functions."""
 
-    resolvers: ClassVar[list[Callable[["ActionDesignator"], Any]]] = []
+    resolvers: ClassVar[list[Callable[[ActionDesignator], Any]]] = []
     kind_name = "action designator"
 
     def _current_resolvers(self) -> list[Any]:
         from pycram.robot import gather
+
         return gather("action_resolvers", ActionDesignator.resolvers)
 
     def _resolvers_for_message(self) -> list[Any]:
@@ -40,16 +48,18 @@ class ActionDesignator(LazyDesignator):
                     raise ResolverError(
                         f"action resolver {callable_name(resolver)} produced {_short(plan)} for "
                         f"{self!r}; plans must be callables plan(designator)",
-                        designator=self, resolver=resolver)
+                        designator=self,
+                        resolver=resolver,
+                    )
                 yield plan
 
 
-def plan_for(action_type: str, plan: Callable[[ActionDesignator], Any]
-             ) -> Callable[[ActionDesignator], Any]:
+def plan_for(action_type: str, plan: Callable[[ActionDesignator], Any]) -> Callable[[ActionDesignator], Any]:
     """An action resolver returning ``plan`` for designators with ``('type', action_type)``.
 
     Example: ``robot.action_resolvers.append(plan_for('fetching', fetch))``.
     """
+
     def resolver(designator: ActionDesignator) -> Any:
         if designator.check_constraints([("type", action_type)]):
             return plan

@@ -29,9 +29,9 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from inspect import isgenerator, isgeneratorfunction
-from typing import Any, Callable, Iterable, Iterator, Optional, Sequence
+from typing import Any
 
 __all__ = [
     "Designator",
@@ -49,7 +49,6 @@ logger = logging.getLogger("pycram.designator")
 
 #: One designator property: a ``(key, value)`` pair.
 Property = tuple[Any, Any]
-
 
 
 # --------------------------------------------------------------------------- errors
@@ -73,8 +72,9 @@ class ResolverError(DesignatorError):
     Attributes: ``designator``, ``resolver`` and ``cause`` (also chained as ``__cause__``).
     """
 
-    def __init__(self, message: str, designator: Any = None, resolver: Any = None,
-                 cause: Optional[BaseException] = None) -> None:
+    def __init__(
+        self, message: str, designator: Any = None, resolver: Any = None, cause: BaseException | None = None
+    ) -> None:
         super().__init__(message)
         self.designator = designator
         self.resolver = resolver
@@ -84,8 +84,7 @@ class ResolverError(DesignatorError):
 class NoSolutionError(DesignatorError):
     """The designator has no (more) solutions. Attributes: ``designator``, ``resolvers``."""
 
-    def __init__(self, message: str, designator: Any = None,
-                 resolvers: Sequence[Any] = ()) -> None:
+    def __init__(self, message: str, designator: Any = None, resolvers: Sequence[Any] = ()) -> None:
         super().__init__(message)
         self.designator = designator
         self.resolvers = list(resolvers)
@@ -106,12 +105,14 @@ def callable_name(f: Any) -> str:
 def _now() -> float:
     """Current time [s] of the active pycram clock."""
     from pycram.runtime import current_clock
+
     return current_clock().now()
 
 
 def _wait(condition: threading.Condition, predicate: Callable[[], bool]) -> None:
     """Block on ``condition`` until ``predicate()`` (evaluated with it held); evaporable."""
     from pycram.runtime import wait_until
+
     wait_until(condition, predicate)
 
 
@@ -127,14 +128,11 @@ def normalize_properties(properties: Any, kwargs: Mapping[str, Any], owner: str)
     elif isinstance(properties, Mapping):
         result.extend(properties.items())
     elif isinstance(properties, (str, bytes)) or not isinstance(properties, Iterable):
-        raise PropertyError(
-            f"{owner}: properties must be a list of (key, value) pairs, got {properties!r}")
+        raise PropertyError(f"{owner}: properties must be a list of (key, value) pairs, got {properties!r}")
     else:
         for index, prop in enumerate(properties):
             if not isinstance(prop, (tuple, list)) or len(prop) != 2:
-                raise PropertyError(
-                    f"{owner}: property #{index} {prop!r} is not a (key, value) pair "
-                    f"in {properties!r}")
+                raise PropertyError(f"{owner}: property #{index} {prop!r} is not a (key, value) pair in {properties!r}")
             if isinstance(prop[0], (list, dict, set)):
                 raise PropertyError(f"{owner}: property key {prop[0]!r} is not hashable")
             result.append((prop[0], prop[1]))
@@ -183,26 +181,23 @@ class Designator:
     :meth:`reference`) and ``next_solution``.
     """
 
-    def __init__(self, properties: Any = None, parent: Optional["Designator"] = None,
-                 **kwargs: Any) -> None:
+    def __init__(self, properties: Any = None, parent: Designator | None = None, **kwargs: Any) -> None:
         self._mutex = threading.Condition(threading.RLock())
-        self._resolving: Optional[int] = None  # ident of the thread running _reference
-        self._parent: Optional[Designator] = None
-        self._successor: Optional[Designator] = None
+        self._resolving: int | None = None  # ident of the thread running _reference
+        self._parent: Designator | None = None
+        self._successor: Designator | None = None
         self._effective = False
         self._data: Any = None
-        self.timestamp: Optional[float] = None
-        self._properties: list[Property] = normalize_properties(
-            properties, kwargs, type(self).__name__)
+        self.timestamp: float | None = None
+        self._properties: list[Property] = normalize_properties(properties, kwargs, type(self).__name__)
         if parent is not None:
             if not isinstance(parent, Designator):
-                raise UnknownKindError(
-                    f"{type(self).__name__}: parent must be a Designator, got {parent!r}")
+                raise UnknownKindError(f"{type(self).__name__}: parent must be a Designator, got {parent!r}")
             self.equate(parent)
 
     # -- chain ----------------------------------------------------------------------------
 
-    def equate(self, parent: "Designator") -> None:
+    def equate(self, parent: Designator) -> None:
         """Equate this designator with ``parent``: both describe the same entity afterwards.
 
         This designator (with any ancestors it already has) is appended after the most recent
@@ -222,27 +217,27 @@ class Designator:
             self._parent = youngest_parent
             youngest_parent._successor = self
 
-    def equal(self, other: "Designator") -> bool:
+    def equal(self, other: Designator) -> bool:
         """``True`` iff both designators are in the same chain (same first ancestor)."""
         return other.first() is self.first()
 
-    def first(self) -> "Designator":
+    def first(self) -> Designator:
         """The first ancestor of the chain of equated designators."""
         desig = self
         while desig._parent is not None:
             desig = desig._parent
         return desig
 
-    def current(self) -> "Designator":
+    def current(self) -> Designator:
         """The most recent designator of the chain of equated designators."""
         desig = self
         while desig._successor is not None:
             desig = desig._successor
         return desig
 
-    def newest_effective(self) -> Optional["Designator"]:
+    def newest_effective(self) -> Designator | None:
         """The most recent effective designator of the chain, or ``None`` if there is none."""
-        desig: Optional[Designator] = self.current()
+        desig: Designator | None = self.current()
         while desig is not None and not desig._effective:
             desig = desig._parent
         return desig
@@ -279,8 +274,7 @@ class Designator:
 
     def _constraint_pair(self, prop: tuple, caller: str) -> tuple[Any, Any]:
         if len(prop) != 2:
-            raise PropertyError(
-                f"{caller} on {self!r}: {_short(prop)} is neither a key nor a (key, value) pair")
+            raise PropertyError(f"{caller} on {self!r}: {_short(prop)} is neither a key nor a (key, value) pair")
         return prop
 
     def make_dictionary(self, properties: Iterable[Any]) -> dict[Any, Any]:
@@ -296,7 +290,7 @@ class Designator:
 
     # -- new designators ------------------------------------------------------------------
 
-    def copy(self, new_properties: Any = None, **kwargs: Any) -> "Designator":
+    def copy(self, new_properties: Any = None, **kwargs: Any) -> Designator:
         """A new, unequated designator of the same class with the same properties.
 
         ``new_properties`` (pairs) and keyword properties are dominant: an existing key is
@@ -307,8 +301,7 @@ class Designator:
             _merge(properties, key, value)
         return self.__class__(properties)
 
-    def make_effective(self, properties: Any = None, data: Any = None,
-                       timestamp: Optional[float] = None) -> "Designator":
+    def make_effective(self, properties: Any = None, data: Any = None, timestamp: float | None = None) -> Designator:
         """A new effective designator of the same class holding the low-level ``data``.
 
         Properties default to this designator's; the timestamp to the active clock's now.
@@ -328,8 +321,7 @@ class Designator:
         """Resolve; override in subclasses. Default: the data of an effective designator."""
         if self._effective:
             return self._data
-        raise DesignatorError(f"{self!r} is not effective and {type(self).__name__} "
-                              f"has no resolution")
+        raise DesignatorError(f"{self!r} is not effective and {type(self).__name__} has no resolution")
 
     def reference(self) -> Any:
         """Resolve this designator to its low-level solution (always the same one).
@@ -343,8 +335,8 @@ class Designator:
         with self._mutex:
             if self._resolving == me:
                 raise ResolverError(
-                    f"{self!r}: a resolver called reference() on the designator it is resolving",
-                    designator=self)
+                    f"{self!r}: a resolver called reference() on the designator it is resolving", designator=self
+                )
 
         def claim() -> bool:  # evaluated under self._mutex: atomic check-and-set
             if self._resolving is None:
@@ -364,7 +356,7 @@ class Designator:
             self.timestamp = _now()
         return ret
 
-    def next_solution(self) -> Optional["Designator"]:
+    def next_solution(self) -> Designator | None:
         """A new designator equated to this one for the next solution, or ``None``."""
         return None
 
@@ -375,9 +367,9 @@ class Designator:
         Designators that cannot be referenced are skipped (thesis); a broken resolver
         (:class:`ResolverError`) propagates.
         """
-        desig: Optional[Designator] = self.first() if from_root is not None else self
+        desig: Designator | None = self.first() if from_root is not None else self
 
-        def generator(desig: Optional[Designator]) -> Iterator[Any]:
+        def generator(desig: Designator | None) -> Iterator[Any]:
             while desig is not None:
                 try:
                     yield desig.reference()
@@ -420,7 +412,7 @@ class GeneratorList:
         self._generated: list[Any] = []
         self._lock = threading.RLock()
         self._done = False
-        self._error: Optional[BaseException] = None
+        self._error: BaseException | None = None
         self._advancing = False
         self.interrupted = False
 
@@ -490,7 +482,9 @@ def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[An
         raise ResolverError(
             f"resolver {name} returned {kind} {_short(result)} for {designator!r}; "
             f"resolvers must return a list of solutions (wrap a single solution in a list)",
-            designator=designator, resolver=resolver)
+            designator=designator,
+            resolver=resolver,
+        )
     iterator = iter(result)
     while True:
         try:
@@ -499,8 +493,12 @@ def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[An
             return
         except Exception as e:
             _reraise_own(designator, e)
-            raise ResolverError(f"resolver {name} failed while resolving {designator!r}: {e!r}",
-                                designator=designator, resolver=resolver, cause=e) from e
+            raise ResolverError(
+                f"resolver {name} failed while resolving {designator!r}: {e!r}",
+                designator=designator,
+                resolver=resolver,
+                cause=e,
+            ) from e
         if isgeneratorfunction(solution):
             solution = solution()
         if isgenerator(solution):
@@ -512,9 +510,11 @@ def expand_solutions(designator: Any, resolver: Any, result: Any) -> Iterator[An
                 except Exception as e:
                     _reraise_own(designator, e)
                     raise ResolverError(
-                        f"a solution generator of resolver {name} failed while resolving "
-                        f"{designator!r}: {e!r}", designator=designator, resolver=resolver,
-                        cause=e) from e
+                        f"a solution generator of resolver {name} failed while resolving {designator!r}: {e!r}",
+                        designator=designator,
+                        resolver=resolver,
+                        cause=e,
+                    ) from e
                 yield _not_none(designator, resolver, item)
         else:
             yield _not_none(designator, resolver, solution)
@@ -525,7 +525,9 @@ def _not_none(designator: Any, resolver: Any, solution: Any) -> Any:
         raise ResolverError(
             f"resolver {callable_name(resolver)} gave None as a solution of {designator!r}; "
             f"a resolver with nothing to offer returns None or an empty list",
-            designator=designator, resolver=resolver)
+            designator=designator,
+            resolver=resolver,
+        )
     return solution
 
 
@@ -548,7 +550,10 @@ def call_resolver(designator: Any, resolver: Any, *args: Any) -> Any:
         _reraise_own(designator, e)
         raise ResolverError(
             f"resolver {callable_name(resolver)} failed while resolving {designator!r}: {e!r}",
-            designator=designator, resolver=resolver, cause=e) from e
+            designator=designator,
+            resolver=resolver,
+            cause=e,
+        ) from e
 
 
 class LazyDesignator(Designator):
@@ -563,9 +568,8 @@ class LazyDesignator(Designator):
     #: Noun used in error messages, e.g. "motion designator".
     kind_name = "designator"
 
-    def __init__(self, properties: Any = None, parent: Optional[Designator] = None,
-                 **kwargs: Any) -> None:
-        self._solutions: Optional[GeneratorList] = None
+    def __init__(self, properties: Any = None, parent: Designator | None = None, **kwargs: Any) -> None:
+        self._solutions: GeneratorList | None = None
         self._index = 0
         super().__init__(properties, parent, **kwargs)
 
@@ -578,15 +582,17 @@ class LazyDesignator(Designator):
     def _no_solution_message(self) -> str:
         names = [callable_name(r) for r in self._resolvers_for_message()]
         from pycram.robot import describe_active_robot
+
         which = "no" if self._index == 0 else f"no solution #{self._index} (only {self._index})"
-        return (f"Cannot resolve {self.kind_name} {self!r}: {which} solutions "
-                f"from resolvers {names} ({describe_active_robot()})")
+        return (
+            f"Cannot resolve {self.kind_name} {self!r}: {which} solutions "
+            f"from resolvers {names} ({describe_active_robot()})"
+        )
 
     def _reference(self) -> Any:
         if self._effective and self._solutions is None:
             return self._data  # made effective by hand (make_effective)
-        if self._solutions is None or (self._solutions.interrupted
-                                       and not self._solutions.cached(self._index)):
+        if self._solutions is None or (self._solutions.interrupted and not self._solutions.cached(self._index)):
             # first resolution, or the previous one was evaporated midway: resolve afresh
             self._solutions = GeneratorList(self._generate)
         if self._effective:
@@ -594,11 +600,12 @@ class LazyDesignator(Designator):
         try:
             self._data = self._solutions.get(self._index)
         except StopIteration:
-            raise NoSolutionError(self._no_solution_message(), designator=self,
-                                  resolvers=self._resolvers_for_message()) from None
+            raise NoSolutionError(
+                self._no_solution_message(), designator=self, resolvers=self._resolvers_for_message()
+            ) from None
         return self._data
 
-    def next_solution(self) -> Optional["LazyDesignator"]:
+    def next_solution(self) -> LazyDesignator | None:
         """A new designator, equated to this one, for the next solution; ``None`` if none.
 
         Raises :class:`ResolverError` when a resolver fails while looking for the next solution.

@@ -20,10 +20,17 @@ resolution stops with ``NoSolutionError`` saying so.
 
 from __future__ import annotations
 
-from typing import Any, Callable, ClassVar, Iterator
+from collections.abc import Callable, Iterator
+from typing import Any, ClassVar
 
-from pycram.designators.core import (DesignatorError, LazyDesignator, NoSolutionError,
-                                     call_resolver, callable_name, expand_solutions)
+from pycram.designators.core import (
+    DesignatorError,
+    LazyDesignator,
+    NoSolutionError,
+    call_resolver,
+    callable_name,
+    expand_solutions,
+)
 
 __all__ = ["LocationDesignator"]
 
@@ -31,18 +38,20 @@ __all__ = ["LocationDesignator"]
 class LocationDesignator(LazyDesignator):
     """A location described by constraints, e.g. ``('on', counter)``, ``('to_see', obj)``."""
 
-    generators: ClassVar[list[Callable[["LocationDesignator"], Any]]] = []
-    validators: ClassVar[list[Callable[["LocationDesignator", Any], Any]]] = []
+    generators: ClassVar[list[Callable[[LocationDesignator], Any]]] = []
+    validators: ClassVar[list[Callable[[LocationDesignator, Any], Any]]] = []
     #: Consecutive rejected candidates after which resolution gives up.
     max_rejected: ClassVar[int] = 10_000
     kind_name = "location designator"
 
     def _current_generators(self) -> list[Any]:
         from pycram.robot import gather
+
         return gather("location_generators", LocationDesignator.generators)
 
     def _current_validators(self) -> list[Any]:
         from pycram.robot import gather
+
         return gather("location_validators", LocationDesignator.validators)
 
     def _resolvers_for_message(self) -> list[Any]:
@@ -76,10 +85,12 @@ class LocationDesignator(LazyDesignator):
                 affirmed = True
         if not affirmed:
             from pycram.robot import describe_active_robot
+
             raise DesignatorError(
                 f"Cannot tell whether {pose!r} is in {self!r}: no location validator applies "
                 f"(validators asked: {[callable_name(v) for v in validators]}; "
-                f"{describe_active_robot()})")
+                f"{describe_active_robot()})"
+            )
         return True
 
     def _generate(self) -> Iterator[Any]:
@@ -98,5 +109,7 @@ class LocationDesignator(LazyDesignator):
                         f"Cannot resolve {self!r}: gave up after {rejected} consecutive "
                         f"candidates rejected by validators "
                         f"{[callable_name(v) for v in validators]} (last generator "
-                        f"{callable_name(generator)})", designator=self,
-                        resolvers=[generator])
+                        f"{callable_name(generator)})",
+                        designator=self,
+                        resolvers=[generator],
+                    )

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any, Callable, ClassVar, Iterator
+from collections.abc import Callable, Iterator
+from typing import Any, ClassVar
 
 from pycram.designators.core import LazyDesignator, call_resolver, expand_solutions
-from pycram.designators.motion_types import (active_motion_types, check_motion,
-                                             describe_known_types)
+from pycram.designators.motion_types import active_motion_types, check_motion, describe_known_types
 
 __all__ = ["MotionDesignator"]
 
@@ -26,7 +26,7 @@ class MotionDesignator(LazyDesignator):
     invalid key raises :class:`~pycram.designators.motion_types.MotionPropertyError`.
     """
 
-    resolvers: ClassVar[list[Callable[["MotionDesignator"], Any]]] = []
+    resolvers: ClassVar[list[Callable[[MotionDesignator], Any]]] = []
     kind_name = "motion designator"
 
     def _resolvers_for_message(self) -> list[Any]:
@@ -34,6 +34,7 @@ class MotionDesignator(LazyDesignator):
 
     def _current_resolvers(self) -> list[Any]:
         from pycram.robot import gather
+
         return gather("motion_resolvers", MotionDesignator.resolvers)
 
     def _no_solution_message(self) -> str:

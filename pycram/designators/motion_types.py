@@ -30,9 +30,10 @@ from __future__ import annotations
 
 import difflib
 import math
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from numbers import Real
-from typing import Any, Callable, Iterable, Mapping, Optional
+from typing import Any
 
 from pycram.designators.core import PropertyError, _short
 
@@ -71,8 +72,14 @@ class MotionPropertyError(PropertyError):
     offending key or ``None``), ``valid_keys`` (of the type; empty if the type is unknown).
     """
 
-    def __init__(self, message: str, designator: Any = None, motion_type: Any = None,
-                 key: Any = None, valid_keys: Iterable[str] = ()) -> None:
+    def __init__(
+        self,
+        message: str,
+        designator: Any = None,
+        motion_type: Any = None,
+        key: Any = None,
+        valid_keys: Iterable[str] = (),
+    ) -> None:
         super().__init__(message)
         self.designator = designator
         self.motion_type = motion_type
@@ -99,12 +106,11 @@ class MotionKey:
     form: str = "any"
     required: bool = True
     choices: tuple[Any, ...] = ()
-    range: Optional[tuple[float, float]] = None
+    range: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.form not in FORMS:
-            raise ValueError(f"motion key {self.name!r}: unknown form {self.form!r}; "
-                             f"available: {sorted(FORMS)}")
+            raise ValueError(f"motion key {self.name!r}: unknown form {self.form!r}; available: {sorted(FORMS)}")
 
     def valid_values(self) -> str:
         """The valid values in words, for messages and docs."""
@@ -114,17 +120,19 @@ class MotionKey:
         if self.choices:
             parts.append(", ".join(repr(c) for c in sorted(self.choices, key=str)))
         if self.form == "number":
-            parts.append(FORMS["number"] if self.range is None
-                         else f"a number in [{self.range[0]:g}, {self.range[1]:g}]")
+            parts.append(
+                FORMS["number"] if self.range is None else f"a number in [{self.range[0]:g}, {self.range[1]:g}]"
+            )
         return " or ".join(parts) or FORMS["any"]
 
-    def problem(self, value: Any) -> Optional[str]:
+    def problem(self, value: Any) -> str | None:
         """Why ``value`` is not valid for this key, or ``None`` when it is."""
         if self.form == "name":
             ok = not self.choices or _among(value, self.choices)
         elif self.form == "number":
-            ok = _among(value, self.choices) or (_finite_number(value) and (
-                self.range is None or self.range[0] <= float(value) <= self.range[1]))
+            ok = _among(value, self.choices) or (
+                _finite_number(value) and (self.range is None or self.range[0] <= float(value) <= self.range[1])
+            )
         else:
             ok = _FORM_CHECKS[self.form](value)
         return None if ok else f"must be {self.valid_values()}"
@@ -134,8 +142,9 @@ class MotionKey:
 #: once instead of waiting; see ``ProcessModule.perform``).
 COMMON_KEYS: tuple[MotionKey, ...] = (
     MotionKey("type", "the motion type", form="text"),
-    MotionKey("wait", "False: return an execution handle at once; default: wait until done",
-              form="bool", required=False),
+    MotionKey(
+        "wait", "False: return an execution handle at once; default: wait until done", form="bool", required=False
+    ),
 )
 
 
@@ -148,14 +157,14 @@ class MotionType:
     name: str
     meaning: str
     keys: tuple[MotionKey, ...] = ()
-    checks: tuple[Callable[[Any, "MotionType"], None], ...] = field(default=(), compare=False)
+    checks: tuple[Callable[[Any, MotionType], None], ...] = field(default=(), compare=False)
 
     def all_keys(self) -> tuple[MotionKey, ...]:
         """The type's own keys followed by :data:`COMMON_KEYS`."""
         own = {k.name for k in self.keys}
         return self.keys + tuple(k for k in COMMON_KEYS if k.name not in own)
 
-    def key(self, name: Any) -> Optional[MotionKey]:
+    def key(self, name: Any) -> MotionKey | None:
         for key in self.all_keys():
             if key.name == name:
                 return key
@@ -163,17 +172,21 @@ class MotionType:
 
     def describe_keys(self) -> str:
         """The valid keys in one line: ``pose (required), frame, wait``."""
-        return ", ".join(f"{k.name} (required)" if k.required else k.name
-                         for k in self.all_keys() if k.name != "type")
+        return ", ".join(f"{k.name} (required)" if k.required else k.name for k in self.all_keys() if k.name != "type")
 
     def check(self, designator: Any) -> None:
         """Raise :class:`MotionPropertyError` unless ``designator`` fits this type."""
         valid = [k.name for k in self.all_keys()]
 
         def error(message: str, key: Any, cls: type = MotionPropertyError) -> Exception:
-            return cls(f"motion designator of type {self.name!r}: {message}; valid keys of "
-                       f"{self.name!r}: {self.describe_keys()} (in {designator!r})",
-                       designator=designator, motion_type=self.name, key=key, valid_keys=valid)
+            return cls(
+                f"motion designator of type {self.name!r}: {message}; valid keys of "
+                f"{self.name!r}: {self.describe_keys()} (in {designator!r})",
+                designator=designator,
+                motion_type=self.name,
+                key=key,
+                valid_keys=valid,
+            )
 
         for name, value in designator.properties:
             key = self.key(name)
@@ -226,8 +239,8 @@ def check_motion(designator: Any) -> None:
     type_name = designator.prop_value("type")
     if type_name is None:
         raise MotionPropertyError(
-            f"{designator!r} has no 'type'; {describe_known_types(types)}",
-            designator=designator, key="type")
+            f"{designator!r} has no 'type'; {describe_known_types(types)}", designator=designator, key="type"
+        )
     try:
         motion_type = types.get(type_name)
     except TypeError:  # an unhashable type value
@@ -239,12 +252,12 @@ def check_motion(designator: Any) -> None:
 def vocabulary_table(types: Mapping[Any, MotionType]) -> str:
     """The vocabulary as a Markdown table (docs): per type a row saying what it does, then one row
     per key; the keys every type has (:data:`COMMON_KEYS` but ``type``) at the end."""
-    rows = ["| type | key | required | meaning [unit] | valid values |",
-            "|---|---|---|---|---|"]
+    rows = ["| type | key | required | meaning [unit] | valid values |", "|---|---|---|---|---|"]
 
     def key_row(type_cell: str, key: MotionKey) -> str:
-        return (f"| {type_cell} | `{key.name}` | {'yes' if key.required else 'no'} | "
-                f"{key.meaning} | {key.valid_values()} |")
+        return (
+            f"| {type_cell} | `{key.name}` | {'yes' if key.required else 'no'} | {key.meaning} | {key.valid_values()} |"
+        )
 
     for name in sorted(types, key=str):
         rows.append(f"| `{name}` | | | {types[name].meaning} | |")
@@ -269,7 +282,7 @@ def _finite_number(value: Any) -> bool:
     return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _finite_numbers(value: Any) -> Optional[list[float]]:
+def _finite_numbers(value: Any) -> list[float] | None:
     if isinstance(value, (str, bytes)):
         return None
     try:

@@ -18,11 +18,11 @@ equated to the description.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, Callable, ClassVar, Iterable, Iterator, Optional
+from typing import Any, ClassVar
 
-from pycram.designators.core import (Designator, LazyDesignator, _now, call_resolver,
-                                     expand_solutions)
+from pycram.designators.core import Designator, LazyDesignator, _now, call_resolver, expand_solutions
 
 __all__ = ["ObjectDesignator", "BelievedObject", "Belief"]
 
@@ -72,7 +72,7 @@ class Belief:
         with self._lock:
             return list(self._objects.values())
 
-    def resolver(self, designator: "ObjectDesignator") -> list[BelievedObject]:
+    def resolver(self, designator: ObjectDesignator) -> list[BelievedObject]:
         """Object resolver: every believed object (the designator filters them)."""
         return self.objects()
 
@@ -116,11 +116,12 @@ class ObjectDesignator(LazyDesignator):
     perceived, best match first.
     """
 
-    resolvers: ClassVar[list[Callable[["ObjectDesignator"], Any]]] = []
+    resolvers: ClassVar[list[Callable[[ObjectDesignator], Any]]] = []
     kind_name = "object designator"
 
     def _current_resolvers(self) -> list[Any]:
         from pycram.robot import gather
+
         return gather("object_resolvers", ObjectDesignator.resolvers)
 
     def _resolvers_for_message(self) -> list[Any]:
@@ -129,6 +130,7 @@ class ObjectDesignator(LazyDesignator):
     def matches(self, obj: Any) -> bool:
         """``True`` iff the candidate ``obj`` satisfies every property of this designator."""
         from pycram.designators.location import LocationDesignator
+
         for key, value in self._properties:
             if isinstance(value, LocationDesignator):
                 pose = _object_value(obj, "pose")
@@ -160,8 +162,7 @@ class ObjectDesignator(LazyDesignator):
                 seen.add(id(obj))
                 yield obj
 
-    def perceived(self, data: Any, properties: Any = None,
-                  timestamp: Optional[float] = None) -> "ObjectDesignator":
+    def perceived(self, data: Any, properties: Any = None, timestamp: float | None = None) -> ObjectDesignator:
         """Record that ``data`` (a perceived object) is the object this describes.
 
         Returns a new effective designator holding ``data``, equated to this description (so

@@ -34,6 +34,7 @@ def perform(designator: Any) -> Any:
     """
     if isinstance(designator, MotionDesignator):
         from pycram.process_module import ProcessModule
+
         return ProcessModule.perform(designator)
     if isinstance(designator, ActionDesignator):
         plan = None
@@ -43,6 +44,7 @@ def perform(designator: Any) -> Any:
             name = f"perform {action_type}" if action_type is not None else "perform action"
             logger.debug("performing %r with plan %r", designator, plan)
             from pycram.runtime import run_subtask
+
             result = run_subtask(name, plan, designator, kind="action")
         except BaseException as e:
             events.designator_performed(designator, plan, e)
@@ -50,5 +52,5 @@ def perform(designator: Any) -> Any:
         events.designator_performed(designator, plan, None)
         return result
     raise UnknownKindError(
-        f"perform() accepts motion and action designators, got {designator!r} "
-        f"({type(designator).__name__})")
+        f"perform() accepts motion and action designators, got {designator!r} ({type(designator).__name__})"
+    )

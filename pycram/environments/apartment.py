@@ -60,12 +60,25 @@ def _drawer(number: int, bottom: float) -> Container:
     zc = bottom + height / 2
     inner_bottom = bottom + _DRAWER_WALL
     return Container(
-        name=f"drawer {number}", kind="drawer",
+        name=f"drawer {number}",
+        kind="drawer",
         body=Box(f"drawer {number}", (0.315, 2.9, zc), (0.285, 0.475, height / 2), _DRAWER),
-        handle=(0.64, 2.9, zc + 0.06), opening_direction=(1.0, 0.0), limits=(0.0, 0.42),
-        interior=(Surface.rectangle(f"drawer {number} inside", (0.045, 2.44, 0.585, 3.36), inner_bottom,
-                                    "drawer", clearance=height - _DRAWER_WALL - 0.01),),
-        damping=30.0, friction=4.0, wall=_DRAWER_WALL)
+        handle=(0.64, 2.9, zc + 0.06),
+        opening_direction=(1.0, 0.0),
+        limits=(0.0, 0.42),
+        interior=(
+            Surface.rectangle(
+                f"drawer {number} inside",
+                (0.045, 2.44, 0.585, 3.36),
+                inner_bottom,
+                "drawer",
+                clearance=height - _DRAWER_WALL - 0.01,
+            ),
+        ),
+        damping=30.0,
+        friction=4.0,
+        wall=_DRAWER_WALL,
+    )
 
 
 _DRAWERS = (_drawer(1, 0.09), _drawer(2, 0.35), _drawer(3, 0.61))
@@ -83,19 +96,37 @@ _FRIDGE_BOXES = (
 _SHELF_RECT = (2.74, 4.41, 3.36, 4.96)
 _FRIDGE_DOOR_BOX = Box("fridge door", (3.05, 4.35, 0.85), (0.35, 0.02, 0.84), _FRIDGE_DOOR)
 _FRIDGE_DOOR_CONTAINER = Container(
-    name="fridge", kind="door", body=_FRIDGE_DOOR_BOX, handle=(3.3, 4.29, 1.0), opening_direction=(0.0, -1.0),
-    limits=(0.0, 1.9), hinge=(2.70, 4.33), damping=8.0, friction=2.0,
-    interior=(Surface.rectangle("fridge bottom shelf", _SHELF_RECT, 0.12, "shelf", clearance=0.47),
-              Surface.rectangle("fridge middle shelf", _SHELF_RECT, 0.62, "shelf", clearance=0.47),
-              Surface.rectangle("fridge top shelf", _SHELF_RECT, 1.12, "shelf", clearance=0.53)))
+    name="fridge",
+    kind="door",
+    body=_FRIDGE_DOOR_BOX,
+    handle=(3.3, 4.29, 1.0),
+    opening_direction=(0.0, -1.0),
+    limits=(0.0, 1.9),
+    hinge=(2.70, 4.33),
+    damping=8.0,
+    friction=2.0,
+    interior=(
+        Surface.rectangle("fridge bottom shelf", _SHELF_RECT, 0.12, "shelf", clearance=0.47),
+        Surface.rectangle("fridge middle shelf", _SHELF_RECT, 0.62, "shelf", clearance=0.47),
+        Surface.rectangle("fridge top shelf", _SHELF_RECT, 1.12, "shelf", clearance=0.53),
+    ),
+)
 
 # --- the dining table in the middle of the room -------------------------------------------------
 _TABLE_CENTER, _TABLE_HALF = (4.3, 2.0), (0.7, 0.45)
 _TABLE_BOXES = (Box("table", (*_TABLE_CENTER, TABLE_HEIGHT - 0.02), (*_TABLE_HALF, 0.02), _TABLE),) + tuple(
-    Box(f"table leg {i + 1}", (_TABLE_CENTER[0] + sx * (_TABLE_HALF[0] - 0.06),
-                               _TABLE_CENTER[1] + sy * (_TABLE_HALF[1] - 0.06), (TABLE_HEIGHT - 0.04) / 2),
-        (0.025, 0.025, (TABLE_HEIGHT - 0.04) / 2), _TABLE)
-    for i, (sx, sy) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1))))
+    Box(
+        f"table leg {i + 1}",
+        (
+            _TABLE_CENTER[0] + sx * (_TABLE_HALF[0] - 0.06),
+            _TABLE_CENTER[1] + sy * (_TABLE_HALF[1] - 0.06),
+            (TABLE_HEIGHT - 0.04) / 2,
+        ),
+        (0.025, 0.025, (TABLE_HEIGHT - 0.04) / 2),
+        _TABLE,
+    )
+    for i, (sx, sy) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1)))
+)
 
 _WALLS = (
     Box("wall north", (3.2, 5.05, 1.1), (3.3, 0.05, 1.1), _WALL),
@@ -110,8 +141,10 @@ ENVIRONMENT = Environment(
         Surface.rectangle("counter", _COUNTER_RECT, COUNTER_HEIGHT, "counter"),
         Surface.rectangle("cabinet top", (0.0, _CABINET_Y[0], 0.6, _CABINET_Y[1]), COUNTER_HEIGHT, "counter"),
         Surface.rectangle("table", rect_around(_TABLE_CENTER, _TABLE_HALF), TABLE_HEIGHT, "table"),
-    ) + tuple(Surface.rectangle(name, rect_around(xy, (0.1, 0.1)), COUNTER_HEIGHT, "cooker")
-              for name, xy in _COOKERS.items()),
+    )
+    + tuple(
+        Surface.rectangle(name, rect_around(xy, (0.1, 0.1)), COUNTER_HEIGHT, "cooker") for name, xy in _COOKERS.items()
+    ),
     containers=_DRAWERS + (_FRIDGE_DOOR_CONTAINER,),
     floor=((0.0, 0.0, 6.5, 5.0),),
     places=(

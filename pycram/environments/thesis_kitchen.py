@@ -35,8 +35,10 @@ ENVIRONMENT = Environment(
     title="The thesis kitchen: two counters with a cooker each",
     static=_STATIC,
     surfaces=tuple(Surface.rectangle(b.name, b.footprint, COUNTER_HEIGHT, "counter") for b in _COUNTERS)
-    + tuple(Surface.rectangle(name, rect_around(xy, (_COOKER_RADIUS, _COOKER_RADIUS)), COUNTER_HEIGHT, "cooker")
-            for name, xy in _COOKERS.items()),
+    + tuple(
+        Surface.rectangle(name, rect_around(xy, (_COOKER_RADIUS, _COOKER_RADIUS)), COUNTER_HEIGHT, "cooker")
+        for name, xy in _COOKERS.items()
+    ),
     containers=(),
     floor=((-0.45, -0.9, 3.0, 3.5),),
     places=(Place("start", (0.8, 0.6, 0.0)),),

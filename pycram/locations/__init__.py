@@ -13,5 +13,16 @@ from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation, Spot
 from .targets import KnownObject, Target, as_target
 
-__all__ = ["LocationReasoner", "RobotGeometry", "BaseLocation", "Spot", "Target", "KnownObject", "as_target",
-           "Costmap", "FloorGrid", "VOCABULARY", "grasp_sequence"]
+__all__ = [
+    "LocationReasoner",
+    "RobotGeometry",
+    "BaseLocation",
+    "Spot",
+    "Target",
+    "KnownObject",
+    "as_target",
+    "Costmap",
+    "FloorGrid",
+    "VOCABULARY",
+    "grasp_sequence",
+]

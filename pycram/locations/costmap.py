@@ -23,8 +23,7 @@ import numpy as np
 
 from pycram.world.environment import Environment, Rect
 
-__all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer",
-           "rect_distance", "floor_obstacles"]
+__all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer", "rect_distance", "floor_obstacles"]
 
 #: Cell size [m] of the floor grids.
 RESOLUTION = 0.05
@@ -95,8 +94,7 @@ def rect_distance(grid: FloorGrid, rect: Rect) -> np.ndarray:
     return np.hypot(dx, dy)
 
 
-def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float,
-                    extra: Sequence[Rect] = ()) -> np.ndarray:
+def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float, extra: Sequence[Rect] = ()) -> np.ndarray:
     """0 where a circle of `radius` [m] around the cell centre lies on the environment's floor and
     off every obstacle (`floor_obstacles`, the boxes in `extra`), else ``inf``. Cached per
     environment and radius (without `extra`)."""
@@ -105,8 +103,9 @@ def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float,
     if base is None:
         inside = np.zeros(grid.shape, bool)
         for x0, y0, x1, y1 in environment.floor:
-            inside |= ((grid.x >= x0 + radius) & (grid.x <= x1 - radius)
-                       & (grid.y >= y0 + radius) & (grid.y <= y1 - radius))
+            inside |= (
+                (grid.x >= x0 + radius) & (grid.x <= x1 - radius) & (grid.y >= y0 + radius) & (grid.y <= y1 - radius)
+            )
         for rect in floor_obstacles(environment):
             inside &= rect_distance(grid, rect) >= radius
         base = _OCCUPANCY[key] = np.where(inside, 0.0, np.inf)
@@ -118,8 +117,9 @@ def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float,
     return layer
 
 
-def ring_layer(grid: FloorGrid, center: Sequence[float], preferred: float, sigma: float,
-               low: float, high: float) -> np.ndarray:
+def ring_layer(
+    grid: FloorGrid, center: Sequence[float], preferred: float, sigma: float, low: float, high: float
+) -> np.ndarray:
     """((d - preferred) / sigma)^2 for cells at distance d [m] from `center` (x, y) with
     low <= d <= high, ``inf`` elsewhere (a Gaussian ring's negative log, up to a constant)."""
     d = np.hypot(grid.x - center[0], grid.y - center[1])

@@ -60,8 +60,9 @@ __all__ = ["LocationReasoner", "VOCABULARY", "MAX_CANDIDATES", "SPACING", "grasp
 log = logging.getLogger(__name__)
 
 #: The keys location reasoning understands; a designator with any other key is left to others.
-VOCABULARY = frozenset({"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for",
-                        "action", "opening"})
+VOCABULARY = frozenset(
+    {"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for", "action", "opening"}
+)
 #: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
 #: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
 BASE_CLEARANCE = 0.1
@@ -113,8 +114,9 @@ def _quat_down(yaw: float) -> tuple[float, float, float, float]:
     return (cz * c, -sz * s, cz * s, sz * c)
 
 
-def grasp_sequence(geometry: RobotGeometry, point: Sequence[float], heading: float, approach: str,
-                   action: str = "grasp") -> list[tuple[tuple[float, float, float], tuple]]:
+def grasp_sequence(
+    geometry: RobotGeometry, point: Sequence[float], heading: float, approach: str, action: str = "grasp"
+) -> list[tuple[tuple[float, float, float], tuple]]:
     """Tool poses (position [m], orientation (w, x, y, z)) of the grasp or place sequence at
     `point`: the tool points along `heading` [rad] (horizontal approaches) or down (``'top'``),
     each phase offset by the robot's ``APPROACH_OFFSETS`` (back along the approach, up)."""
@@ -149,8 +151,11 @@ class _Tally:
             if not n:
                 continue
             detail = self.details.get(reason)
-            more = (f" ({', '.join(f'{k} {v}' for k, v in detail.most_common() if v)})"
-                    if detail and any(detail.values()) else "")
+            more = (
+                f" ({', '.join(f'{k} {v}' for k, v in detail.most_common() if v)})"
+                if detail and any(detail.values())
+                else ""
+            )
             parts.append(f"{n} {reason}{more}")
         return f"{self.tried} candidates: " + ", ".join(parts) if parts else f"{self.tried} candidates"
 
@@ -165,9 +170,14 @@ class LocationReasoner:
     costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
     """
 
-    def __init__(self, geometry: RobotGeometry, environment: Callable[[], Environment],
-                 prospection: Callable[[], Any], known_objects: Callable[[], Sequence[KnownObject]] = lambda: (),
-                 max_candidates: int = MAX_CANDIDATES) -> None:
+    def __init__(
+        self,
+        geometry: RobotGeometry,
+        environment: Callable[[], Environment],
+        prospection: Callable[[], Any],
+        known_objects: Callable[[], Sequence[KnownObject]] = lambda: (),
+        max_candidates: int = MAX_CANDIDATES,
+    ) -> None:
         self.geometry = geometry
         self.environment = environment
         self.prospection = prospection
@@ -185,8 +195,13 @@ class LocationReasoner:
         keys = [k for k, _ in desig.properties]
         if not keys or any(k not in VOCABULARY for k in keys):
             return None
-        for key, method in (("to_reach", self.to_reach), ("to_see", self.to_see), ("to_open", self.to_open),
-                            ("on", self.on), ("in", self.inside)):
+        for key, method in (
+            ("to_reach", self.to_reach),
+            ("to_see", self.to_see),
+            ("to_open", self.to_open),
+            ("on", self.on),
+            ("in", self.inside),
+        ):
             if desig.prop_value(key) is not None:
                 return method(desig)
         return None
@@ -215,8 +230,10 @@ class LocationReasoner:
             yaw = self._natural_yaw(grid, target.position, arm)
             costmap = Costmap(grid, {"occupancy": occupancy})
             d0 = self.geometry.reach_distance(arm)
-            costmap.add("reach", ring_layer(grid, target.position, d0, REACH_SIGMA,
-                                            max(0.2, d0 - REACH_INSIDE), d0 + REACH_OUTSIDE))
+            costmap.add(
+                "reach",
+                ring_layer(grid, target.position, d0, REACH_SIGMA, max(0.2, d0 - REACH_INSIDE), d0 + REACH_OUTSIDE),
+            )
             if facing:
                 costmap.add("facing", self._facing_layer(yaw, facing))
             costmap.add("grasp", self._grasp_layer(yaw, grasps, target))
@@ -227,8 +244,9 @@ class LocationReasoner:
         def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
-            natural = _wrap(math.atan2(target.position[1] - y, target.position[0] - x)
-                            - self.geometry.reach_bearing(arm))
+            natural = _wrap(
+                math.atan2(target.position[1] - y, target.position[0] - x) - self.geometry.reach_bearing(arm)
+            )
             prosp = self.prospection()
             tucked = dict(self.geometry.tucked)
             if prosp.in_collision((x, y, natural), tucked):
@@ -240,8 +258,9 @@ class LocationReasoner:
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
                 point = self._grasp_point(target, grasp)
-                poses = grasp_sequence(self.geometry, point, yaw if grasp.approach != "top" else heading,
-                                       grasp.approach, action)
+                poses = grasp_sequence(
+                    self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
+                )
                 margin = self.geometry.contact_margin if action == "grasp" else 0.0
                 if margin:  # room to spare below the grasp
                     (gx, gy, gz), q = poses[1]
@@ -266,8 +285,9 @@ class LocationReasoner:
         if requested is not None:
             chosen = [g for g in grasps if g.approach == requested]
             if not chosen:
-                raise ValueError(f"no grasp {requested!r} for {target.describe()}; available: "
-                                 f"{[g.approach for g in grasps]}")
+                raise ValueError(
+                    f"no grasp {requested!r} for {target.describe()}; available: {[g.approach for g in grasps]}"
+                )
             return chosen
         return grasps
 
@@ -331,8 +351,13 @@ class LocationReasoner:
         env = self.environment()
         grid = FloorGrid.of(env)
         preferred, sigma, low, high = VIEW_RING
-        costmap = Costmap(grid, {"occupancy": occupancy_layer(env, grid, self._base_radius),
-                                 "view": ring_layer(grid, target.position, preferred, sigma, low, high)})
+        costmap = Costmap(
+            grid,
+            {
+                "occupancy": occupancy_layer(env, grid, self._base_radius),
+                "view": ring_layer(grid, target.position, preferred, sigma, low, high),
+            },
+        )
         self.last_costmaps = {"view": costmap}
         what = target.name if target.kind == "object" and target.name else target.position
 
@@ -361,8 +386,9 @@ class LocationReasoner:
         container = env.container(name)
         lo, hi = container.limits
         wanted = desig.prop_value("opening")
-        opening = min(hi, DRAWER_OPENING if container.kind == "drawer" else DOOR_OPENING) if wanted is None \
-            else float(wanted)
+        opening = (
+            min(hi, DRAWER_OPENING if container.kind == "drawer" else DOOR_OPENING) if wanted is None else float(wanted)
+        )
         if not lo <= opening <= hi:
             raise ValueError(f"opening {opening} of {container.name!r} is outside its limits {container.limits}")
         steps = [opening * k / 3 for k in range(4)]
@@ -381,9 +407,13 @@ class LocationReasoner:
         maps, streams = {}, []
         for i, arm in enumerate(arms):
             d0 = self.geometry.reach_distance(arm)
-            costmap = Costmap(grid, {"occupancy": occupancy,
-                                     "reach": ring_layer(grid, middle, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4),
-                                                         d0 + 0.4)})
+            costmap = Costmap(
+                grid,
+                {
+                    "occupancy": occupancy,
+                    "reach": ring_layer(grid, middle, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4), d0 + 0.4),
+                },
+            )
             costmap.add("facing", self._facing_layer(self._natural_yaw(grid, middle, arm), [headings[0]]))
             maps[arm] = costmap
             streams.append(_ranked(costmap, i, arm))
@@ -432,8 +462,14 @@ class LocationReasoner:
             return []
         x0, y0, x1, y1 = container.body.footprint
         dx, dy = container.opening_direction
-        return [(min(x0, x0 + dx * opening), min(y0, y0 + dy * opening),
-                 max(x1, x1 + dx * opening), max(y1, y1 + dy * opening))]
+        return [
+            (
+                min(x0, x0 + dx * opening),
+                min(y0, y0 + dy * opening),
+                max(x1, x1 + dx * opening),
+                max(y1, y1 + dy * opening),
+            )
+        ]
 
     # ------------------------------------------------------------------ on / in
     def on(self, desig: Any) -> Iterator[Spot]:
@@ -474,9 +510,12 @@ class LocationReasoner:
         near_xy = None if near is None else self._target(near).position[:2]
         fitting = [s for s in surfaces if s.clearance >= 2 * half + 0.01]
         if not fitting:
-            raise self._fail(desig, f"{what} ({2 * half:.2f} m tall) fits on none of "
-                             f"{[s.name for s in surfaces]} (clearance "
-                             f"{', '.join(f'{s.clearance:.2f} m' for s in surfaces)})")
+            raise self._fail(
+                desig,
+                f"{what} ({2 * half:.2f} m tall) fits on none of "
+                f"{[s.name for s in surfaces]} (clearance "
+                f"{', '.join(f'{s.clearance:.2f} m' for s in surfaces)})",
+            )
         candidates = []
         tally = _Tally()
         for surface in fitting:
@@ -507,12 +546,14 @@ class LocationReasoner:
                 cx, cy, _ = surface.centroid
                 cost = np.hypot(gx - cx, gy - cy)
             for i in np.flatnonzero(free.ravel()):
-                candidates.append((float(cost.ravel()[i]), float(gx.ravel()[i]), float(gy.ravel()[i]), z,
-                                   surface.name))
+                candidates.append((float(cost.ravel()[i]), float(gx.ravel()[i]), float(gy.ravel()[i]), z, surface.name))
         candidates.sort()
         if not candidates:
-            raise self._fail(desig, f"no free spot for {what} (footprint radius {radius:.2f} m) on "
-                             f"{', '.join(s.name for s in fitting)}: {tally.summary()}")
+            raise self._fail(
+                desig,
+                f"no free spot for {what} (footprint radius {radius:.2f} m) on "
+                f"{', '.join(s.name for s in fitting)}: {tally.summary()}",
+            )
 
         def spots() -> Iterator[Spot]:
             given: list[tuple[float, float]] = []
@@ -521,6 +562,7 @@ class LocationReasoner:
                     continue
                 given.append((x, y))
                 yield Spot(x, y, z, name, container, None if own else _type_name(desig.prop_value("for")), cost)
+
         return spots()
 
     def _empty_costmap(self, maps: dict[str, Costmap], target: Target) -> str:
@@ -528,18 +570,35 @@ class LocationReasoner:
         the layers that do together."""
         env = self.environment()
         where = "(" + ", ".join(f"{v:.1f}" for v in target.position) + ") [m, map]"
-        alone = sorted({name for m in maps.values() for name, layer in m.layers.items()
-                        if name != "occupancy" and bool(np.isinf(layer).all())})
+        alone = sorted(
+            {
+                name
+                for m in maps.values()
+                for name, layer in m.layers.items()
+                if name != "occupancy" and bool(np.isinf(layer).all())
+            }
+        )
         if alone:
-            return (f"{target.describe()} at {where} is outside the environment: no cell of the floor of "
-                    f"{env.name} lies within the layer {alone[0]!r} around it")
-        return (f"every cell of the floor of {env.name} within reach of {target.describe()} at {where} is "
-                f"occupied (layer 'occupancy': furniture and walls inflated by the {self.geometry.name}'s "
-                f"{self._base_radius:.2f} m footprint radius with clearance; {_layer_summary(maps)})")
+            return (
+                f"{target.describe()} at {where} is outside the environment: no cell of the floor of "
+                f"{env.name} lies within the layer {alone[0]!r} around it"
+            )
+        return (
+            f"every cell of the floor of {env.name} within reach of {target.describe()} at {where} is "
+            f"occupied (layer 'occupancy': furniture and walls inflated by the {self.geometry.name}'s "
+            f"{self._base_radius:.2f} m footprint radius with clearance; {_layer_summary(maps)})"
+        )
 
     # ------------------------------------------------------------------ the search
-    def _search(self, desig: Any, cells: Iterator[tuple], validate: Callable, kind: str,
-                target: Target, maps: dict[str, Costmap]) -> Iterator[BaseLocation]:
+    def _search(
+        self,
+        desig: Any,
+        cells: Iterator[tuple],
+        validate: Callable,
+        kind: str,
+        target: Target,
+        maps: dict[str, Costmap],
+    ) -> Iterator[BaseLocation]:
         """Walk `cells` (cost, tie, arm, row, col) cheapest first; validate each; yield the valid
         ones at least `SPACING` apart; after `max_candidates` checks or when the costmap is used
         up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
@@ -566,8 +625,9 @@ class LocationReasoner:
         if not given:
             if tally.tried == 0:
                 raise self._fail(desig, self._empty_costmap(maps, target))
-            raise self._fail(desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: "
-                             f"{tally.summary()}")
+            raise self._fail(
+                desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: {tally.summary()}"
+            )
 
 
 def _layer_summary(maps: dict[str, Costmap]) -> str:

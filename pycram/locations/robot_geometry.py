@@ -54,24 +54,33 @@ class RobotGeometry:
             if park is not None:
                 tucked.update(zip(spec["joints"], park))
         radius = float(d.BASE["radius"])
-        return cls(name=d.NAME, arms=tuple(d.ARMS), default_arm=d.DEFAULT_ARM,
-                   arm_aliases=dict(d.ARM_ALIASES),
-                   reach_points={a: tuple(map(float, p)) for a, p in d.REACH_POINT_IN_BASE.items()},
-                   inscribed_radius=float(d.BASE.get("inscribed_radius", radius / math.sqrt(2.0))),
-                   circumscribed_radius=radius,
-                   approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
-                   tucked=tucked, arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()},
-                   ready={a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry"]))
-                          for a, s in d.ARMS.items() if "carry" in d.ARM_CONFIGURATIONS[a]},
-                   contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)))
+        return cls(
+            name=d.NAME,
+            arms=tuple(d.ARMS),
+            default_arm=d.DEFAULT_ARM,
+            arm_aliases=dict(d.ARM_ALIASES),
+            reach_points={a: tuple(map(float, p)) for a, p in d.REACH_POINT_IN_BASE.items()},
+            inscribed_radius=float(d.BASE.get("inscribed_radius", radius / math.sqrt(2.0))),
+            circumscribed_radius=radius,
+            approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
+            tucked=tucked,
+            arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()},
+            ready={
+                a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry"]))
+                for a, s in d.ARMS.items()
+                if "carry" in d.ARM_CONFIGURATIONS[a]
+            },
+            contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)),
+        )
 
     def arm(self, name: Any) -> str:
         """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""
         try:
             return self.arm_aliases[name]
         except (KeyError, TypeError):
-            raise ValueError(f"{self.name} has no arm {name!r}; available: "
-                             f"{sorted({str(k) for k in self.arm_aliases})}") from None
+            raise ValueError(
+                f"{self.name} has no arm {name!r}; available: {sorted({str(k) for k in self.arm_aliases})}"
+            ) from None
 
     def reach_distance(self, arm: str) -> float:
         """Distance [m] from the base centre to the comfortable reach point of `arm`."""

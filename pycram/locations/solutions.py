@@ -44,8 +44,16 @@ class Spot(tuple):
     type: str | None
     cost: float
 
-    def __new__(cls, x: float, y: float, z: float, surface: str, container: str | None = None,
-                type: str | None = None, cost: float = 0.0) -> Spot:
+    def __new__(
+        cls,
+        x: float,
+        y: float,
+        z: float,
+        surface: str,
+        container: str | None = None,
+        type: str | None = None,
+        cost: float = 0.0,
+    ) -> Spot:
         spot = super().__new__(cls, (float(x), float(y), float(z)))
         spot.surface, spot.container, spot.type, spot.cost = surface, container, type, cost
         return spot

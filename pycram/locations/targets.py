@@ -103,8 +103,7 @@ def _object_like(value: Any) -> Target | None:
     return Target(position, "object", getattr(value, "name", None), otype, float(yaw))
 
 
-def as_target(value: Any, environment: Environment | None = None,
-              known_objects: Sequence[KnownObject] = ()) -> Target:
+def as_target(value: Any, environment: Environment | None = None, known_objects: Sequence[KnownObject] = ()) -> Target:
     """`value` as a `Target` (see the module docstring).
 
     A string names, in this order, a place, a surface or a container of `environment`, or one of
@@ -120,23 +119,40 @@ def as_target(value: Any, environment: Environment | None = None,
         return Target(value.handle, "container", value.name, thing=value)
     if isinstance(value, str):
         if environment is not None:
-            for kind, things in (("place", environment.places), ("surface", environment.all_surfaces()),
-                                 ("container", environment.containers)):
+            for kind, things in (
+                ("place", environment.places),
+                ("surface", environment.all_surfaces()),
+                ("container", environment.containers),
+            ):
                 for thing in things:
                     if thing.name == value:
-                        return as_target(thing, environment) if kind != "place" else Target(
-                            (thing.pose[0], thing.pose[1], 0.0), "place", thing.name, yaw=thing.pose[2], thing=thing)
+                        return (
+                            as_target(thing, environment)
+                            if kind != "place"
+                            else Target(
+                                (thing.pose[0], thing.pose[1], 0.0), "place", thing.name, yaw=thing.pose[2], thing=thing
+                            )
+                        )
         for known in known_objects:
             if known.name == value:
                 return as_target(known, environment)
         for known in known_objects:  # an object type: the first known object of that type
             if known.type == value:
                 return as_target(known, environment)
-        names = ([p.name for p in environment.places] + [s.name for s in environment.all_surfaces()]
-                 + [c.name for c in environment.containers]) if environment is not None else []
-        raise ValueError(f"unknown target {value!r}: not a place, surface or container of "
-                         f"{environment.name if environment else 'the environment'} nor a known object; "
-                         f"known: {sorted(names + [k.name for k in known_objects])}")
+        names = (
+            (
+                [p.name for p in environment.places]
+                + [s.name for s in environment.all_surfaces()]
+                + [c.name for c in environment.containers]
+            )
+            if environment is not None
+            else []
+        )
+        raise ValueError(
+            f"unknown target {value!r}: not a place, surface or container of "
+            f"{environment.name if environment else 'the environment'} nor a known object; "
+            f"known: {sorted(names + [k.name for k in known_objects])}"
+        )
     found = _object_like(value)
     if found is not None:
         return found
@@ -145,5 +161,7 @@ def as_target(value: Any, environment: Environment | None = None,
         return Target(point, "point")
     if all(hasattr(value, a) for a in ("x", "y", "yaw")):
         return Target((float(value.x), float(value.y), 0.0), "place", yaw=float(value.yaw))
-    raise ValueError(f"a location target is an object (with a pose and a type), an object designator, "
-                     f"a named place/surface/container or a point (x, y, z) [m]; got {value!r}")
+    raise ValueError(
+        f"a location target is an object (with a pose and a type), an object designator, "
+        f"a named place/surface/container or a point (x, y, z) [m]; got {value!r}"
+    )

@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any, Callable, Optional
+from collections.abc import Callable
+from typing import Any
 
+from pycram.failures import MotionFailure, NavigationFailure
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule, ProcessModuleStatus
 from pycram.robot import Robot
-from pycram.failures import MotionFailure, NavigationFailure
 
 __all__ = [
     "SimMotionFailed",
@@ -105,9 +106,13 @@ class SimProcessModule(ProcessModule):
         self.world = world
         self._handle: Any = None
 
-    def _run_command(self, start: Callable[[], Any], command: str,
-                     timeout: float = COMMAND_TIMEOUT,
-                     describe_failure: Optional[Callable[[Any], str]] = None) -> Any:
+    def _run_command(
+        self,
+        start: Callable[[], Any],
+        command: str,
+        timeout: float = COMMAND_TIMEOUT,
+        describe_failure: Callable[[Any], str] | None = None,
+    ) -> Any:
         """Send a command (``start()`` returns its handle), wait for it and return its value.
 
         Blocks until the command ends or ``timeout`` [s, simulated] passes (then the command is
@@ -117,15 +122,13 @@ class SimProcessModule(ProcessModule):
         number -- a NaN time-out would never expire.
         """
         if not (isinstance(timeout, (int, float)) and math.isfinite(timeout) and timeout > 0):
-            raise ValueError(f"{command}: the time-out must be a positive number of seconds, "
-                             f"got {timeout!r}")
+            raise ValueError(f"{command}: the time-out must be a positive number of seconds, got {timeout!r}")
         handle = start()
         self._handle = handle
         if not handle.result.wait_for(timeout):
             self._handle = None
             handle.cancel()
-            raise SimMotionFailed(command, "timeout",
-                                  f"did not end within {timeout:.1f} s of simulated time")
+            raise SimMotionFailed(command, "timeout", f"did not end within {timeout:.1f} s of simulated time")
         outcome = handle.result.get_value()
         self._handle = None
         if not outcome.succeeded:
@@ -172,18 +175,18 @@ class NavigationModule(SimProcessModule):
         solution = designator.reference()
         _check_cmd(self, solution, "navigate")
         pose = solution["pose"]
-        distance = math.hypot(pose.x - self.world.base_pose.get_value().x,
-                              pose.y - self.world.base_pose.get_value().y)
+        distance = math.hypot(pose.x - self.world.base_pose.get_value().x, pose.y - self.world.base_pose.get_value().y)
         try:
             return self._run_command(
-                lambda: self.world.move_base(pose), f"drive to {_fmt_pose2d(pose)}",
+                lambda: self.world.move_base(pose),
+                f"drive to {_fmt_pose2d(pose)}",
                 timeout=30.0 + 4.0 * distance,
-                describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})")
+                describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})",
+            )
         except SimMotionFailed as exc:
             if exc.reason != "no_path":
                 raise
-            raise NavigationFailed(exc.command, exc.reason, exc.message,
-                                   exc.outcome) from None
+            raise NavigationFailed(exc.command, exc.reason, exc.message, exc.outcome) from None
 
 
 class BaseStopModule(SimProcessModule):
@@ -231,8 +234,7 @@ class HeadModule(SimProcessModule):
         if solution.get("track"):
             self.world.track_point(point)
             return None
-        return self._run_command(lambda: self.world.point_head(point),
-                                 f"point the head at {_fmt(point)}", timeout=10.0)
+        return self._run_command(lambda: self.world.point_head(point), f"point the head at {_fmt(point)}", timeout=10.0)
 
 
 class TorsoModule(SimProcessModule):
@@ -245,8 +247,7 @@ class TorsoModule(SimProcessModule):
         solution = designator.reference()
         _check_cmd(self, solution, "set_torso")
         height = float(solution["height"])
-        return self._run_command(lambda: self.world.set_torso(height),
-                                 f"set the torso to {height:.3f} m", timeout=20.0)
+        return self._run_command(lambda: self.world.set_torso(height), f"set the torso to {height:.3f} m", timeout=20.0)
 
 
 class ArmModule(SimProcessModule):
@@ -258,7 +259,7 @@ class ArmModule(SimProcessModule):
     ``'unreachable'``.
     """
 
-    def __init__(self, world: Any, arm: str, name: Optional[str] = None) -> None:
+    def __init__(self, world: Any, arm: str, name: str | None = None) -> None:
         super().__init__(name or f"arm_{arm}", world)
         self.arm = arm
 
@@ -268,18 +269,23 @@ class ArmModule(SimProcessModule):
         if cmd == "move_arm":
             positions = tuple(float(v) for v in solution["positions"])
             what = solution.get("configuration") or _fmt(positions)
-            return self._run_command(lambda: self.world.move_arm(self.arm, positions),
-                                     f"move the {self.arm} arm to {what}", timeout=30.0)
+            return self._run_command(
+                lambda: self.world.move_arm(self.arm, positions), f"move the {self.arm} arm to {what}", timeout=30.0
+            )
         if cmd == "reach":
             position = tuple(float(v) for v in solution["position"])
             orientation = solution.get("orientation")
             phase = solution.get("phase")
             what = f"reach with the {self.arm} arm to {_fmt(position)}" + (
-                f" ({phase} of {_fmt(solution['target'])})" if phase else "")
+                f" ({phase} of {_fmt(solution['target'])})" if phase else ""
+            )
             return self._run_command(
-                lambda: self.world.reach(self.arm, position, orientation,
-                                         tolerance=float(solution.get("tolerance", 0.01))),
-                what, timeout=30.0)
+                lambda: self.world.reach(
+                    self.arm, position, orientation, tolerance=float(solution.get("tolerance", 0.01))
+                ),
+                what,
+                timeout=30.0,
+            )
         _check_cmd(self, solution, "move_arm", "reach")
 
 
@@ -287,7 +293,7 @@ class GripperModule(SimProcessModule):
     """One gripper: ``'cmd': 'set_gripper'`` with ``'opening'`` [m] and ``'effort'`` [N] or
     ``None``. Returns the measured opening [m] (closing on an item stalls at its width)."""
 
-    def __init__(self, world: Any, gripper: str, name: Optional[str] = None) -> None:
+    def __init__(self, world: Any, gripper: str, name: str | None = None) -> None:
         super().__init__(name or f"gripper_{gripper}", world)
         self.gripper = gripper
 
@@ -298,7 +304,9 @@ class GripperModule(SimProcessModule):
         effort = solution.get("effort")
         return self._run_command(
             lambda: self.world.set_gripper(self.gripper, opening, effort),
-            f"set the {self.gripper} gripper to {opening:.3f} m", timeout=10.0)
+            f"set the {self.gripper} gripper to {opening:.3f} m",
+            timeout=10.0,
+        )
 
 
 class _Relay(Fluent):
@@ -380,6 +388,7 @@ class PerceptionModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         from pycram.designators.object import ObjectDesignator
+
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
         report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
@@ -398,8 +407,7 @@ class PerceptionModule(SimProcessModule):
 
 def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
     if not isinstance(solution, dict) or solution.get("cmd") not in expected:
-        raise ValueError(f"{module.name} executes commands {list(expected)}, got solution "
-                         f"{solution!r}")
+        raise ValueError(f"{module.name} executes commands {list(expected)}, got solution {solution!r}")
 
 
 def shutdown_modules(robot: Robot) -> None:
@@ -423,6 +431,7 @@ class SimRobot(Robot):
 
     def __init__(self, name: str, world: Any, description: Any) -> None:
         from pycram.world.belief import BeliefState
+
         super().__init__(name)
         self.world = world
         self.description = description

@@ -39,7 +39,8 @@ executing it.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Optional, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from pycram.sim.types import Pose2D, yaw_to_quat
 from pycram.world.environment import FURNITURE_TOPS
@@ -66,8 +67,9 @@ def physical_arm(description: Any, name: Any) -> str:
     try:
         return description.ARM_ALIASES[name]
     except (KeyError, TypeError):
-        raise ValueError(f"{description.NAME} has no arm {name!r}; available: "
-                         f"{_choices(description.ARM_ALIASES)}") from None
+        raise ValueError(
+            f"{description.NAME} has no arm {name!r}; available: {_choices(description.ARM_ALIASES)}"
+        ) from None
 
 
 def physical_gripper(description: Any, name: Any) -> str:
@@ -75,8 +77,9 @@ def physical_gripper(description: Any, name: Any) -> str:
     try:
         return description.GRIPPER_ALIASES[name]
     except (KeyError, TypeError):
-        raise ValueError(f"{description.NAME} has no gripper {name!r}; available: "
-                         f"{_choices(description.GRIPPER_ALIASES)}") from None
+        raise ValueError(
+            f"{description.NAME} has no gripper {name!r}; available: {_choices(description.GRIPPER_ALIASES)}"
+        ) from None
 
 
 def _pose2d(value: Any) -> Pose2D:
@@ -102,8 +105,7 @@ def _point(value: Any) -> tuple[float, float, float]:
 def _relative_to(base: Pose2D, pose: Pose2D) -> Pose2D:
     """``pose`` given in the frame of the base at ``base``, in the map frame."""
     c, s = math.cos(base.yaw), math.sin(base.yaw)
-    return Pose2D(base.x + c * pose.x - s * pose.y, base.y + s * pose.x + c * pose.y,
-                  base.yaw + pose.yaw)
+    return Pose2D(base.x + c * pose.x - s * pose.y, base.y + s * pose.x + c * pose.y, base.yaw + pose.yaw)
 
 
 def base_goal_in_map(world: Any, pose: Any, frame: Any = None) -> Pose2D:
@@ -140,9 +142,9 @@ def describe_free_floor(world: Any) -> str:
 REACH_GRASPS = ("front", "front_vertical", "top")
 
 
-def approach_target(description: Any, base: Pose2D, target: Sequence[float],
-                    phase: Optional[str], grasp: Optional[str] = None
-                    ) -> tuple[tuple[float, float, float], tuple[float, ...]]:
+def approach_target(
+    description: Any, base: Pose2D, target: Sequence[float], phase: str | None, grasp: str | None = None
+) -> tuple[tuple[float, float, float], tuple[float, ...]]:
     """Tool position [m, map] and orientation (w, x, y, z) for ``phase`` of reaching ``target``.
 
     The approach direction is the base's heading (``grasp`` ``'front'``/``'front_vertical'``,
@@ -180,8 +182,12 @@ def _quat_multiply(a: Sequence[float], b: Sequence[float]) -> tuple[float, float
     """The rotation `a` then `b` (in `a`'s frame): Hamilton product a * b, (w, x, y, z)."""
     aw, ax, ay, az = a
     bw, bx, by, bz = b
-    return (aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw)
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
 
 
 def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
@@ -191,15 +197,15 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
     def arm_configuration(arm: str, name: Any) -> tuple[float, ...]:
         configurations = d.ARM_CONFIGURATIONS[arm]
         if name not in configurations:
-            raise ValueError(f"{d.NAME} {arm} arm has no configuration {name!r}; available: "
-                             f"{sorted(configurations)}")
+            raise ValueError(f"{d.NAME} {arm} arm has no configuration {name!r}; available: {sorted(configurations)}")
         return tuple(configurations[name])
 
     def torso_height(position: Any) -> float:
         if isinstance(position, str):
             if position not in d.TORSO_POSITIONS:
-                raise ValueError(f"unknown torso position {position!r}; available: "
-                                 f"{sorted(d.TORSO_POSITIONS)} or a height in [m]")
+                raise ValueError(
+                    f"unknown torso position {position!r}; available: {sorted(d.TORSO_POSITIONS)} or a height in [m]"
+                )
             return float(d.TORSO_POSITIONS[position])
         low, high = d.TORSO["range"]
         height = float(position)
@@ -218,61 +224,100 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
         wait = desig.prop_value("wait") is not False
         if desig.check_constraints([("type", "moving"), "pose"]):
             pose = base_goal_in_map(world, desig.prop_value("pose"), desig.prop_value("frame"))
-            solutions.append(desig.make_dictionary(
-                [("cmd", "navigate"), ("pose", pose), ("frame", "map"), ("wait", wait)]))
+            solutions.append(
+                desig.make_dictionary([("cmd", "navigate"), ("pose", pose), ("frame", "map"), ("wait", wait)])
+            )
         if desig.check_constraints([("type", "cancelling_movement")]):
             solutions.append(desig.make_dictionary([("cmd", "stop_base")]))
         if desig.check_constraints([("type", "pointing_head"), "coordinates"]):
             frame = desig.prop_value("frame") or "map"
             if frame != "map":
                 raise ValueError(f"pointing_head supports the frame 'map', got {frame!r}")
-            solutions.append(desig.make_dictionary(
-                [("cmd", "point_head"), ("point", _point(desig.prop_value("coordinates"))),
-                 ("frame", "map"), ("track", not wait)]))
+            solutions.append(
+                desig.make_dictionary(
+                    [
+                        ("cmd", "point_head"),
+                        ("point", _point(desig.prop_value("coordinates"))),
+                        ("frame", "map"),
+                        ("track", not wait),
+                    ]
+                )
+            )
         if desig.check_constraints([("type", "setting_torso"), "position"]):
-            solutions.append(desig.make_dictionary(
-                [("cmd", "set_torso"), ("height", torso_height(desig.prop_value("position")))]))
+            solutions.append(
+                desig.make_dictionary([("cmd", "set_torso"), ("height", torso_height(desig.prop_value("position")))])
+            )
         if desig.check_constraints([("type", "setting_gripper"), "gripper", "position"]):
             gripper = physical_gripper(d, desig.prop_value("gripper"))
             spec = d.GRIPPERS[gripper]
             opening = gripper_opening(desig.prop_value("position")) * spec["max_opening"]
             effort = desig.prop_value("max_effort")
-            solutions.append(desig.make_dictionary(
-                [("cmd", "set_gripper"), ("gripper", gripper), ("opening", opening),
-                 ("effort", None if effort is None else float(effort))]))
+            solutions.append(
+                desig.make_dictionary(
+                    [
+                        ("cmd", "set_gripper"),
+                        ("gripper", gripper),
+                        ("opening", opening),
+                        ("effort", None if effort is None else float(effort)),
+                    ]
+                )
+            )
         if desig.check_constraints([("type", "setting_arm_configuration"), "arm", "configuration"]):
             arm = physical_arm(d, desig.prop_value("arm"))
             name = desig.prop_value("configuration")
-            solutions.append(desig.make_dictionary(
-                [("cmd", "move_arm"), ("arm", arm), ("positions", arm_configuration(arm, name)),
-                 ("configuration", name)]))
+            solutions.append(
+                desig.make_dictionary(
+                    [
+                        ("cmd", "move_arm"),
+                        ("arm", arm),
+                        ("positions", arm_configuration(arm, name)),
+                        ("configuration", name),
+                    ]
+                )
+            )
         if desig.check_constraints([("type", "setting_arm_joints"), "arm", "positions"]):
             arm = physical_arm(d, desig.prop_value("arm"))
             positions = tuple(float(v) for v in desig.prop_value("positions"))
             joints = d.ARMS[arm]["joints"]
             if len(positions) != len(joints):
-                raise ValueError(f"the {d.NAME} {arm} arm has {len(joints)} joints {joints}, "
-                                 f"got {len(positions)} positions")
-            solutions.append(desig.make_dictionary(
-                [("cmd", "move_arm"), ("arm", arm), ("positions", positions)]))
+                raise ValueError(
+                    f"the {d.NAME} {arm} arm has {len(joints)} joints {joints}, got {len(positions)} positions"
+                )
+            solutions.append(desig.make_dictionary([("cmd", "move_arm"), ("arm", arm), ("positions", positions)]))
         if desig.check_constraints([("type", "reaching"), "arm", "target"]):
             arm = physical_arm(d, desig.prop_value("arm"))
             phase = desig.prop_value("phase")
             target = _point(desig.prop_value("target"))
-            position, orientation = approach_target(d, world.base_pose.get_value(), target, phase,
-                                                    desig.prop_value("grasp"))
+            position, orientation = approach_target(
+                d, world.base_pose.get_value(), target, phase, desig.prop_value("grasp")
+            )
             tolerance = d.REACH_TOLERANCE.get(phase, d.REACH_TOLERANCE["default"])
-            solutions.append(desig.make_dictionary(
-                [("cmd", "reach"), ("arm", arm), ("position", position),
-                 ("orientation", orientation), ("tolerance", tolerance), ("phase", phase),
-                 ("target", target)]))
+            solutions.append(
+                desig.make_dictionary(
+                    [
+                        ("cmd", "reach"),
+                        ("arm", arm),
+                        ("position", position),
+                        ("orientation", orientation),
+                        ("tolerance", tolerance),
+                        ("phase", phase),
+                        ("target", target),
+                    ]
+                )
+            )
         if desig.check_constraints([("type", "subscribing_pose"), "fl"]):
-            solutions.append(desig.make_dictionary(
-                [("cmd", "subscribe"), ("source", "base_pose"), "fl"]))
+            solutions.append(desig.make_dictionary([("cmd", "subscribe"), ("source", "base_pose"), "fl"]))
         if desig.check_constraints([("type", "subscribing_gripper"), "gripper", "fl"]):
-            solutions.append(desig.make_dictionary(
-                [("cmd", "subscribe"), ("source", "gripper_opening"),
-                 ("gripper", physical_gripper(d, desig.prop_value("gripper"))), "fl"]))
+            solutions.append(
+                desig.make_dictionary(
+                    [
+                        ("cmd", "subscribe"),
+                        ("source", "gripper_opening"),
+                        ("gripper", physical_gripper(d, desig.prop_value("gripper"))),
+                        "fl",
+                    ]
+                )
+            )
         if desig.check_constraints([("type", "detecting")]):
             solutions.append(desig.make_dictionary([("cmd", "perceive"), "object"]))
         return solutions
@@ -284,10 +329,10 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
 # --------------------------------------------------------------------------- locations
 
 
-def _counter_normal(environment: Any, x: float, y: float) -> Optional[tuple[float, float]]:
+def _counter_normal(environment: Any, x: float, y: float) -> tuple[float, float] | None:
     """Outward normal (towards the free floor) of the counter or table edge nearest to (x, y),
     or None when (x, y) is on no counter or table of ``environment`` (its description)."""
-    best: Optional[tuple[float, tuple[float, float]]] = None
+    best: tuple[float, tuple[float, float]] | None = None
     for surface in environment.surfaces_of_kind(*FURNITURE_TOPS):
         if not surface.contains(x, y, -1e-6):
             continue
@@ -301,9 +346,14 @@ def _counter_normal(environment: Any, x: float, y: float) -> Optional[tuple[floa
     return None if best is None else best[1]
 
 
-def base_pose_to_reach(description: Any, point: Sequence[float], arm: str,
-                       current: Optional[Pose2D] = None, extra_standoff: float = 0.0,
-                       environment: Any = None) -> Pose2D:
+def base_pose_to_reach(
+    description: Any,
+    point: Sequence[float],
+    arm: str,
+    current: Pose2D | None = None,
+    extra_standoff: float = 0.0,
+    environment: Any = None,
+) -> Pose2D:
     """The base pose from which ``arm`` reaches ``point`` [m, map].
 
     The base faces the counter or table of ``environment`` (a description) the point lies on
@@ -338,7 +388,7 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
     """
     d = description
 
-    def to_reach(desig: Any) -> Optional[list[Pose2D]]:
+    def to_reach(desig: Any) -> list[Pose2D] | None:
         if not desig.check_constraints(["to_reach"]):
             return None
         point = _point(desig.prop_value("to_reach"))
@@ -346,19 +396,26 @@ def make_to_reach_generator(world: Any, description: Any) -> Callable[[Any], Any
             raise ValueError(f"the point to reach must be finite [m], got {point}")
         arm = physical_arm(d, desig.prop_value("arm") or d.DEFAULT_ARM)
         current = world.base_pose.get_value()
-        candidates = [base_pose_to_reach(d, point, arm, current, extra, world.environment)
-                      for extra in (0.0, 0.05, -0.05, 0.10)]
+        candidates = [
+            base_pose_to_reach(d, point, arm, current, extra, world.environment) for extra in (0.0, 0.05, -0.05, 0.10)
+        ]
         poses = [pose for pose in candidates if on_free_floor(world, pose.x, pose.y)]
         if not poses:
             from pycram.designators.core import NoSolutionError
 
-            where = ("outside the environment" if not on_free_floor(world, point[0], point[1])
-                     and _counter_normal(world.environment, point[0], point[1]) is None else "out of reach")
+            where = (
+                "outside the environment"
+                if not on_free_floor(world, point[0], point[1])
+                and _counter_normal(world.environment, point[0], point[1]) is None
+                else "out of reach"
+            )
             best = candidates[0]
             raise NoSolutionError(
                 f"Cannot resolve {desig!r}: the point {point} [m, map] is {where}: the "
                 f"{d.NAME} {arm} arm would reach it from (x={best.x:.2f}, y={best.y:.2f}), but "
-                f"the base can only stand on {describe_free_floor(world)}", designator=desig)
+                f"the base can only stand on {describe_free_floor(world)}",
+                designator=desig,
+            )
         return poses
 
     to_reach.__qualname__ = f"{d.NAME}_to_reach"
@@ -399,8 +456,12 @@ def make_location_generator(world: Any, description: Any, belief: Any) -> Callab
             raise LookupError(f"{world!r} offers no prospection")
         return make()
 
-    reasoner = LocationReasoner(RobotGeometry.from_description(description), lambda: world.environment,
-                                prospection, lambda: known_objects_of(belief))
+    reasoner = LocationReasoner(
+        RobotGeometry.from_description(description),
+        lambda: world.environment,
+        prospection,
+        lambda: known_objects_of(belief),
+    )
 
     def locations(desig: Any) -> Any:
         return reasoner.generator(desig)

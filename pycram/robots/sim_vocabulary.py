@@ -29,8 +29,11 @@ def _goal_on_free_floor(world: Any):
                 f"motion designator of type {motion_type.name!r}: the goal "
                 f"(x={goal.x:.3f}, y={goal.y:.3f}) [m, map] is outside the environment: the base "
                 f"can only stand on {describe_free_floor(world)} (in {designator!r})",
-                designator=designator, motion_type=motion_type.name, key="pose",
-                valid_keys=[k.name for k in motion_type.all_keys()])
+                designator=designator,
+                motion_type=motion_type.name,
+                key="pose",
+                valid_keys=[k.name for k in motion_type.all_keys()],
+            )
 
     return goal_on_free_floor
 
@@ -44,60 +47,112 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
     configurations = sorted({name for per_arm in d.ARM_CONFIGURATIONS.values() for name in per_arm})
     low, high = d.TORSO["range"]
     types = (
-        MotionType("moving", "drive the base to a pose; returns the reached Pose2D", (
-            MotionKey("pose", "base goal: Pose2D or (x [m], y [m], yaw [rad]); on the free floor",
-                      form="pose2d"),
-            MotionKey("frame", "frame of the pose (default 'map')", form="name", required=False,
-                      choices=("map", "base_footprint")),
-        ), checks=(_goal_on_free_floor(world),)),
+        MotionType(
+            "moving",
+            "drive the base to a pose; returns the reached Pose2D",
+            (
+                MotionKey("pose", "base goal: Pose2D or (x [m], y [m], yaw [rad]); on the free floor", form="pose2d"),
+                MotionKey(
+                    "frame",
+                    "frame of the pose (default 'map')",
+                    form="name",
+                    required=False,
+                    choices=("map", "base_footprint"),
+                ),
+            ),
+            checks=(_goal_on_free_floor(world),),
+        ),
         MotionType("cancelling_movement", "stop the base (and the drive running on it)"),
-        MotionType("pointing_head", "point the head camera at a point; with ('wait', False) "
-                   "keep tracking it", (
-                       MotionKey("coordinates", "point to look at [x, y, z] [m]", form="point"),
-                       MotionKey("frame", "frame of the point (default 'map')", form="name",
-                                 required=False, choices=("map",)),
-                   )),
-        MotionType("setting_torso", "move the torso lift joint", (
-            MotionKey("position", "a named position or a height [m]", form="number",
-                      choices=tuple(d.TORSO_POSITIONS), range=(float(low), float(high))),
-        )),
-        MotionType("setting_gripper", "open or close a gripper; returns the measured opening [m]", (
-            gripper,
-            MotionKey("position", "fraction open: 0 closed, 1 fully open", form="number",
-                      range=(0.0, 1.0)),
-            MotionKey("max_effort", "largest force at the finger tips [N] (default: the "
-                      "gripper's)", form="number", required=False, range=(1e-3, math.inf)),
-        )),
-        MotionType("setting_arm_configuration", "move an arm to a named joint configuration", (
-            arm,
-            MotionKey("configuration", "named configuration", form="name",
-                      choices=tuple(configurations)),
-        )),
-        MotionType("setting_arm_joints", "move an arm's joints", (
-            arm,
-            MotionKey("positions", "joint positions [rad], one per joint of the arm",
-                      form="numbers"),
-        )),
-        MotionType("reaching", "move the tool of an arm to a target, facing along the base's "
-                   "heading; returns the reached tool Pose", (
-                       arm,
-                       MotionKey("target", "point to reach [x, y, z] [m, map]", form="point"),
-                       MotionKey("phase", "approach phase: offset of the tool from the target "
-                                 "(default: none)", form="name", required=False,
-                                 choices=tuple(d.APPROACH_OFFSETS)),
-                       MotionKey("grasp", "how the tool meets the target: 'front' along the base's "
-                                 "heading, fingers opening horizontally (default); "
-                                 "'front_vertical' fingers opening vertically; 'top' from above",
-                                 form="name", required=False, choices=REACH_GRASPS),
-                   )),
-        MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)",
-                   (fluent,)),
-        MotionType("subscribing_gripper", "make a fluent follow a gripper's opening [m]",
-                   (gripper, fluent)),
-        MotionType("detecting", "perceive the objects the head camera sees and update the robot's "
-                   "belief; returns the believed objects seen (PerceivedObject)", (
-                       MotionKey("object", "object type, belief name or object designator to look "
-                                 "for (default: every object seen)", form="any", required=False),
-                   )),
+        MotionType(
+            "pointing_head",
+            "point the head camera at a point; with ('wait', False) keep tracking it",
+            (
+                MotionKey("coordinates", "point to look at [x, y, z] [m]", form="point"),
+                MotionKey("frame", "frame of the point (default 'map')", form="name", required=False, choices=("map",)),
+            ),
+        ),
+        MotionType(
+            "setting_torso",
+            "move the torso lift joint",
+            (
+                MotionKey(
+                    "position",
+                    "a named position or a height [m]",
+                    form="number",
+                    choices=tuple(d.TORSO_POSITIONS),
+                    range=(float(low), float(high)),
+                ),
+            ),
+        ),
+        MotionType(
+            "setting_gripper",
+            "open or close a gripper; returns the measured opening [m]",
+            (
+                gripper,
+                MotionKey("position", "fraction open: 0 closed, 1 fully open", form="number", range=(0.0, 1.0)),
+                MotionKey(
+                    "max_effort",
+                    "largest force at the finger tips [N] (default: the gripper's)",
+                    form="number",
+                    required=False,
+                    range=(1e-3, math.inf),
+                ),
+            ),
+        ),
+        MotionType(
+            "setting_arm_configuration",
+            "move an arm to a named joint configuration",
+            (
+                arm,
+                MotionKey("configuration", "named configuration", form="name", choices=tuple(configurations)),
+            ),
+        ),
+        MotionType(
+            "setting_arm_joints",
+            "move an arm's joints",
+            (
+                arm,
+                MotionKey("positions", "joint positions [rad], one per joint of the arm", form="numbers"),
+            ),
+        ),
+        MotionType(
+            "reaching",
+            "move the tool of an arm to a target, facing along the base's heading; returns the reached tool Pose",
+            (
+                arm,
+                MotionKey("target", "point to reach [x, y, z] [m, map]", form="point"),
+                MotionKey(
+                    "phase",
+                    "approach phase: offset of the tool from the target (default: none)",
+                    form="name",
+                    required=False,
+                    choices=tuple(d.APPROACH_OFFSETS),
+                ),
+                MotionKey(
+                    "grasp",
+                    "how the tool meets the target: 'front' along the base's "
+                    "heading, fingers opening horizontally (default); "
+                    "'front_vertical' fingers opening vertically; 'top' from above",
+                    form="name",
+                    required=False,
+                    choices=REACH_GRASPS,
+                ),
+            ),
+        ),
+        MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)", (fluent,)),
+        MotionType("subscribing_gripper", "make a fluent follow a gripper's opening [m]", (gripper, fluent)),
+        MotionType(
+            "detecting",
+            "perceive the objects the head camera sees and update the robot's "
+            "belief; returns the believed objects seen (PerceivedObject)",
+            (
+                MotionKey(
+                    "object",
+                    "object type, belief name or object designator to look for (default: every object seen)",
+                    form="any",
+                    required=False,
+                ),
+            ),
+        ),
     )
     return {t.name: t for t in types}

@@ -29,7 +29,8 @@ from __future__ import annotations
 import logging
 import math
 import threading
-from typing import Any, Callable, Optional
+from collections.abc import Callable
+from typing import Any
 
 import actionlib
 import rospy
@@ -50,14 +51,16 @@ class _Rejected(Exception):
 class _GoalServer:
     """One action: a goal starts a simulator command; its outcome ends the goal."""
 
-    def __init__(self, name: str, action_type: str, start: Callable[[Any], Any],
-                 make_result: Callable[[Outcome], Any]) -> None:
+    def __init__(
+        self, name: str, action_type: str, start: Callable[[Any], Any], make_result: Callable[[Outcome], Any]
+    ) -> None:
         self.name = name
         self._start, self._make_result = start, make_result
         self._lock = threading.Lock()
         self._running: dict[str, tuple[Any, Any]] = {}  # goal id -> (server goal handle, sim handle)
-        self._server = actionlib.ActionServer(name, message_class(action_type + "Action"),
-                                              self._on_goal, self._on_cancel, auto_start=False)
+        self._server = actionlib.ActionServer(
+            name, message_class(action_type + "Action"), self._on_goal, self._on_cancel, auto_start=False
+        )
         self._server.start()
 
     def _on_goal(self, goal_handle: Any) -> None:
@@ -70,8 +73,9 @@ class _GoalServer:
         with self._lock:
             self._running[goal_id] = (goal_handle, sim_handle)
         goal_handle.set_accepted()
-        threading.Thread(target=self._finish, args=(goal_id, goal_handle, sim_handle),
-                         name=f"bridge {self.name}", daemon=True).start()
+        threading.Thread(
+            target=self._finish, args=(goal_id, goal_handle, sim_handle), name=f"bridge {self.name}", daemon=True
+        ).start()
 
     def _finish(self, goal_id: str, goal_handle: Any, sim_handle: Any) -> None:
         outcome = sim_handle.wait()  # the simulator ends every command (closing ends it "closed")
@@ -103,67 +107,111 @@ class SimRosBridge:
     rate loops; the world is the caller's to close.
     """
 
-    def __init__(self, world: Any, config: RosRobotConfig, publish_rate: float = 50.0,
-                 detection_rate: float = 2.0) -> None:
+    def __init__(
+        self, world: Any, config: RosRobotConfig, publish_rate: float = 50.0, detection_rate: float = 2.0
+    ) -> None:
         if config.robot != world.robot:
             raise ValueError(f"ROS configuration of {config.robot!r} for a world with {world.robot!r}")
         self.world, self.config = world, config
         c, w = config, world
         self._servers = [
-            _GoalServer(c.move_base_action, "move_base_msgs/MoveBase", self._drive,
-                        lambda o: message_class("move_base_msgs/MoveBaseResult")()),
-            _GoalServer(c.head_action, "control_msgs/PointHead", self._point_head,
-                        lambda o: message_class("control_msgs/PointHeadResult")()),
+            _GoalServer(
+                c.move_base_action,
+                "move_base_msgs/MoveBase",
+                self._drive,
+                lambda o: message_class("move_base_msgs/MoveBaseResult")(),
+            ),
+            _GoalServer(
+                c.head_action,
+                "control_msgs/PointHead",
+                self._point_head,
+                lambda o: message_class("control_msgs/PointHeadResult")(),
+            ),
         ]
         if c.torso_interface == "single_joint_position":
-            self._servers.append(_GoalServer(
-                c.torso_action, "control_msgs/SingleJointPosition",
-                lambda goal: w.set_torso(float(goal.position)),
-                lambda o: message_class("control_msgs/SingleJointPositionResult")()))
+            self._servers.append(
+                _GoalServer(
+                    c.torso_action,
+                    "control_msgs/SingleJointPosition",
+                    lambda goal: w.set_torso(float(goal.position)),
+                    lambda o: message_class("control_msgs/SingleJointPositionResult")(),
+                )
+            )
         else:
-            self._servers.append(_GoalServer(
-                c.torso_action, "control_msgs/FollowJointTrajectory",
-                lambda goal: w.set_torso(self._trajectory_end(goal, (c.torso_joint,))[0]),
-                self._trajectory_result))
+            self._servers.append(
+                _GoalServer(
+                    c.torso_action,
+                    "control_msgs/FollowJointTrajectory",
+                    lambda goal: w.set_torso(self._trajectory_end(goal, (c.torso_joint,))[0]),
+                    self._trajectory_result,
+                )
+            )
         for arm, interface in c.arms.items():
-            self._servers.append(_GoalServer(
-                interface.trajectory_action, "control_msgs/FollowJointTrajectory",
-                lambda goal, a=arm, j=interface.joint_names: w.move_arm(a, self._trajectory_end(goal, j)),
-                self._trajectory_result))
-            self._servers.append(_GoalServer(interface.reach_action, "pycram_msgs/Reach",
-                                             lambda goal, a=arm: self._reach(a, goal), self._reach_result))
+            self._servers.append(
+                _GoalServer(
+                    interface.trajectory_action,
+                    "control_msgs/FollowJointTrajectory",
+                    lambda goal, a=arm, j=interface.joint_names: w.move_arm(a, self._trajectory_end(goal, j)),
+                    self._trajectory_result,
+                )
+            )
+            self._servers.append(
+                _GoalServer(
+                    interface.reach_action,
+                    "pycram_msgs/Reach",
+                    lambda goal, a=arm: self._reach(a, goal),
+                    self._reach_result,
+                )
+            )
         for gripper, interface in c.grippers.items():
-            self._servers.append(_GoalServer(
-                interface.action, "control_msgs/GripperCommand",
-                lambda goal, g=gripper: w.set_gripper(
-                    g, float(goal.command.position),
-                    float(goal.command.max_effort) if goal.command.max_effort > 0 else None),
-                self._gripper_result))
+            self._servers.append(
+                _GoalServer(
+                    interface.action,
+                    "control_msgs/GripperCommand",
+                    lambda goal, g=gripper: w.set_gripper(
+                        g,
+                        float(goal.command.position),
+                        float(goal.command.max_effort) if goal.command.max_effort > 0 else None,
+                    ),
+                    self._gripper_result,
+                )
+            )
         self._clock_pub = rospy.Publisher(c.clock_topic, message_class("rosgraph_msgs/Clock"), queue_size=1)
-        self._pose_pub = rospy.Publisher(c.pose_topic, message_class("geometry_msgs/PoseWithCovarianceStamped"),
-                                         queue_size=1)
-        self._joints_pub = rospy.Publisher(c.joint_states_topic, message_class("sensor_msgs/JointState"),
-                                           queue_size=1)
-        self._items_pub = rospy.Publisher(f"{c.sim_namespace}/items", message_class("pycram_msgs/ItemStates"),
-                                          queue_size=1)
-        self._detections_pub = rospy.Publisher(c.detections_topic, message_class("pycram_msgs/DetectedItems"),
-                                               queue_size=1)
+        self._pose_pub = rospy.Publisher(
+            c.pose_topic, message_class("geometry_msgs/PoseWithCovarianceStamped"), queue_size=1
+        )
+        self._joints_pub = rospy.Publisher(c.joint_states_topic, message_class("sensor_msgs/JointState"), queue_size=1)
+        self._items_pub = rospy.Publisher(
+            f"{c.sim_namespace}/items", message_class("pycram_msgs/ItemStates"), queue_size=1
+        )
+        self._detections_pub = rospy.Publisher(
+            c.detections_topic, message_class("pycram_msgs/DetectedItems"), queue_size=1
+        )
         import tf2_ros
 
         self._tf = tf2_ros.TransformBroadcaster()
-        self._service = rospy.Service(f"{c.sim_namespace}/command", message_class("pycram_msgs/SimCommand", "srv"),
-                                      self._on_command)
+        self._service = rospy.Service(
+            f"{c.sim_namespace}/command", message_class("pycram_msgs/SimCommand", "srv"), self._on_command
+        )
         rospy.set_param("/use_sim_time", True)
         self._publish()
         # Rate loops in wall time (not rospy.Timer: with /use_sim_time set by an earlier bridge,
         # rospy's timers would wait for a /clock that only this bridge publishes).
         self._stop = threading.Event()
-        self._threads = [threading.Thread(target=self._every, args=(1.0 / publish_rate, self._publish),
-                                          name="bridge-publish", daemon=True)]
+        self._threads = [
+            threading.Thread(
+                target=self._every, args=(1.0 / publish_rate, self._publish), name="bridge-publish", daemon=True
+            )
+        ]
         if detection_rate > 0:
-            self._threads.append(threading.Thread(target=self._every,
-                                                  args=(1.0 / detection_rate, self._publish_detections),
-                                                  name="bridge-detections", daemon=True))
+            self._threads.append(
+                threading.Thread(
+                    target=self._every,
+                    args=(1.0 / detection_rate, self._publish_detections),
+                    name="bridge-detections",
+                    daemon=True,
+                )
+            )
         for thread in self._threads:
             thread.start()
         logger.info("sim-ros-bridge for %s: serving %d actions", c.robot, len(self._servers))
@@ -171,8 +219,7 @@ class SimRosBridge:
     # -- goals → simulator commands ------------------------------------------------------------
     def _check_frame(self, header: Any, what: str) -> None:
         if header.frame_id not in ("", self.config.map_frame):
-            raise _Rejected(f"{what} must be given in the {self.config.map_frame!r} frame, not "
-                            f"{header.frame_id!r}")
+            raise _Rejected(f"{what} must be given in the {self.config.map_frame!r} frame, not {header.frame_id!r}")
 
     def _drive(self, goal: Any) -> Any:
         self._check_frame(goal.target_pose.header, "a move_base goal")
@@ -190,8 +237,7 @@ class SimRosBridge:
         """The last point's positions of ``goal``'s trajectory, in the order of ``joints``."""
         names = list(goal.trajectory.joint_names)
         if sorted(names) != sorted(joints) or not goal.trajectory.points:
-            raise _Rejected(f"a trajectory for joints {list(joints)} with at least one point, got "
-                            f"joints {names}")
+            raise _Rejected(f"a trajectory for joints {list(joints)} with at least one point, got joints {names}")
         positions = dict(zip(names, goal.trajectory.points[-1].positions))
         return [float(positions[j]) for j in joints]
 
@@ -205,8 +251,9 @@ class SimRosBridge:
         self._check_frame(goal.target.header, "a reach target")
         p, q = goal.target.pose.position, goal.target.pose.orientation
         orientation = (q.w, q.x, q.y, q.z) if goal.use_orientation else None
-        return self.world.reach(arm, (p.x, p.y, p.z), orientation,
-                                tolerance=float(goal.tolerance) if goal.tolerance > 0 else 0.01)
+        return self.world.reach(
+            arm, (p.x, p.y, p.z), orientation, tolerance=float(goal.tolerance) if goal.tolerance > 0 else 0.01
+        )
 
     def _reach_result(self, outcome: Outcome) -> Any:
         result = message_class("pycram_msgs/ReachResult")()
@@ -217,8 +264,7 @@ class SimRosBridge:
     @staticmethod
     def _gripper_result(outcome: Outcome) -> Any:
         opening = float(outcome.value) if isinstance(outcome.value, (int, float)) else 0.0
-        return message_class("control_msgs/GripperCommandResult")(
-            position=opening, reached_goal=outcome.succeeded)
+        return message_class("control_msgs/GripperCommandResult")(position=opening, reached_goal=outcome.succeeded)
 
     # -- topics ---------------------------------------------------------------------------------
     def _publish(self) -> None:
@@ -248,9 +294,10 @@ class SimRosBridge:
         holders = {state.get_value().holding: g for g, state in w.gripper_states.items()}
         items = message_class("pycram_msgs/ItemStates")()
         items.header.stamp, items.header.frame_id = stamp, c.map_frame
-        items.items = [message_class("pycram_msgs/ItemState")(name=name, pose=_pose_msg(p),
-                                                             held_by=holders.get(name, ""))
-                       for name, p in w.item_poses.get_value().items()]
+        items.items = [
+            message_class("pycram_msgs/ItemState")(name=name, pose=_pose_msg(p), held_by=holders.get(name, ""))
+            for name, p in w.item_poses.get_value().items()
+        ]
         self._items_pub.publish(items)
 
     def _publish_detections(self) -> None:
@@ -262,9 +309,17 @@ class SimRosBridge:
         message = message_class("pycram_msgs/DetectedItems")()
         message.header.stamp = rospy.Time.from_sec(self.world.sim_time.get_value())
         message.header.frame_id = self.config.map_frame
-        message.items = [message_class("pycram_msgs/DetectedItem")(
-            name=v.name, type=v.type, pose=_pose_msg(v.pose), pixels=int(v.pixels),
-            u=float(v.centroid[0]), v=float(v.centroid[1])) for v in outcome.value]
+        message.items = [
+            message_class("pycram_msgs/DetectedItem")(
+                name=v.name,
+                type=v.type,
+                pose=_pose_msg(v.pose),
+                pixels=int(v.pixels),
+                u=float(v.centroid[0]),
+                v=float(v.centroid[1]),
+            )
+            for v in outcome.value
+        ]
         self._detections_pub.publish(message)
 
     # -- the environment's hands ----------------------------------------------------------------
@@ -274,22 +329,32 @@ class SimRosBridge:
             if request.command == "take_item":
                 handle = self.world.take_item(gripper=request.gripper or None, item=request.item or None)
             elif request.command == "give_item":
-                handle = self.world.give_item(request.item, request.gripper, close=request.close,
-                                              timeout=request.timeout if request.timeout > 0 else 5.0)
+                handle = self.world.give_item(
+                    request.item,
+                    request.gripper,
+                    close=request.close,
+                    timeout=request.timeout if request.timeout > 0 else 5.0,
+                )
             elif request.command == "snapshot":
                 self.world.snapshot(request.item)
                 return response(success=True, reason="succeeded", message=request.item, value=request.item)
             else:
-                return response(success=False, reason="invalid",
-                                message=f"unknown command {request.command!r}; available: take_item, "
-                                        f"give_item, snapshot")
+                return response(
+                    success=False,
+                    reason="invalid",
+                    message=f"unknown command {request.command!r}; available: take_item, give_item, snapshot",
+                )
         except Exception as e:  # an unknown item or gripper: say so to the caller
             return response(success=False, reason="invalid", message=str(e))
         outcome = handle.wait(request.wait if request.wait > 0 else None)
         if outcome is None:
             return response(success=True, reason="running", message=f"{request.command} still running")
-        return response(success=outcome.succeeded, reason=outcome.reason, message=outcome.message,
-                        value="" if outcome.value is None else str(outcome.value))
+        return response(
+            success=outcome.succeeded,
+            reason=outcome.reason,
+            message=outcome.message,
+            value="" if outcome.value is None else str(outcome.value),
+        )
 
     def _every(self, period: float, publish: Callable[[], None]) -> None:
         """Call ``publish`` every ``period`` [s, wall] until :meth:`close`."""
@@ -316,9 +381,15 @@ def _pose_msg(pose: Any) -> Any:
     return msg
 
 
-def run_bridge(robot: str, item_at: int = 1, base_pose: Optional[tuple[float, float, float]] = None,
-               realtime: bool = False, publish_rate: float = 50.0, detection_rate: float = 2.0,
-               ready: Optional[Callable[[], None]] = None) -> None:
+def run_bridge(
+    robot: str,
+    item_at: int = 1,
+    base_pose: tuple[float, float, float] | None = None,
+    realtime: bool = False,
+    publish_rate: float = 50.0,
+    detection_rate: float = 2.0,
+    ready: Callable[[], None] | None = None,
+) -> None:
     """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the demo kitchen with
     ``robot`` and the demo's mug at slot ``item_at`` (0: no item), at ``base_pose`` (default the
     demo's start). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once

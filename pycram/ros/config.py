@@ -34,11 +34,17 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["ArmInterface", "GripperInterface", "RosRobotConfig", "ROBOT_CONFIGS", "robot_config",
-           "config_from_dict"]
+__all__ = ["ArmInterface", "GripperInterface", "RosRobotConfig", "ROBOT_CONFIGS", "robot_config", "config_from_dict"]
 
-_PR2_ARM_JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "upper_arm_roll_joint",
-                   "elbow_flex_joint", "forearm_roll_joint", "wrist_flex_joint", "wrist_roll_joint")
+_PR2_ARM_JOINTS = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "upper_arm_roll_joint",
+    "elbow_flex_joint",
+    "forearm_roll_joint",
+    "wrist_flex_joint",
+    "wrist_roll_joint",
+)
 
 
 @dataclass(frozen=True)
@@ -91,10 +97,12 @@ class RosRobotConfig:
 
     def __post_init__(self) -> None:
         if self.torso_interface not in ("single_joint_position", "joint_trajectory"):
-            raise ValueError(f"ROS config of {self.robot!r}: torso_interface must be "
-                             f"'single_joint_position' or 'joint_trajectory', not {self.torso_interface!r}")
+            raise ValueError(
+                f"ROS config of {self.robot!r}: torso_interface must be "
+                f"'single_joint_position' or 'joint_trajectory', not {self.torso_interface!r}"
+            )
 
-    def replace(self, **changes: Any) -> "RosRobotConfig":
+    def replace(self, **changes: Any) -> RosRobotConfig:
         """A copy with ``changes`` (field names; ``TypeError`` names an unknown one)."""
         return dataclasses.replace(self, **changes)
 
@@ -103,11 +111,16 @@ class RosRobotConfig:
 
     def actions(self) -> dict[str, str]:
         """``{action name: action type}`` of every action this robot offers."""
-        torso_type = ("control_msgs/SingleJointPosition" if self.torso_interface == "single_joint_position"
-                      else "control_msgs/FollowJointTrajectory")
-        result = {self.move_base_action: "move_base_msgs/MoveBase",
-                  self.head_action: "control_msgs/PointHead",
-                  self.torso_action: torso_type}
+        torso_type = (
+            "control_msgs/SingleJointPosition"
+            if self.torso_interface == "single_joint_position"
+            else "control_msgs/FollowJointTrajectory"
+        )
+        result = {
+            self.move_base_action: "move_base_msgs/MoveBase",
+            self.head_action: "control_msgs/PointHead",
+            self.torso_action: torso_type,
+        }
         for arm in self.arms.values():
             result[arm.trajectory_action] = "control_msgs/FollowJointTrajectory"
             result[arm.reach_action] = "pycram_msgs/Reach"
@@ -118,14 +131,19 @@ class RosRobotConfig:
 
 def _pr2() -> RosRobotConfig:
     def arm(side: str) -> ArmInterface:
-        return ArmInterface(f"/{side}_arm_controller/follow_joint_trajectory",
-                            tuple(f"{side}_{j}" for j in _PR2_ARM_JOINTS), f"/{side}_arm_reach")
+        return ArmInterface(
+            f"/{side}_arm_controller/follow_joint_trajectory",
+            tuple(f"{side}_{j}" for j in _PR2_ARM_JOINTS),
+            f"/{side}_arm_reach",
+        )
 
     return RosRobotConfig(
         robot="pr2",
         arms={"right": arm("r"), "left": arm("l")},
-        grippers={"right": GripperInterface("/r_gripper_controller/gripper_action", ("r_gripper_joint",)),
-                  "left": GripperInterface("/l_gripper_controller/gripper_action", ("l_gripper_joint",))},
+        grippers={
+            "right": GripperInterface("/r_gripper_controller/gripper_action", ("r_gripper_joint",)),
+            "left": GripperInterface("/l_gripper_controller/gripper_action", ("l_gripper_joint",)),
+        },
         head_action="/head_traj_controller/point_head_action",
         head_pointing_frame="high_def_frame",
         head_pointing_axis=(1.0, 0.0, 0.0),
@@ -138,10 +156,16 @@ def _pr2() -> RosRobotConfig:
 def _tiago() -> RosRobotConfig:
     return RosRobotConfig(
         robot="tiago",
-        arms={"right": ArmInterface("/arm_controller/follow_joint_trajectory",
-                                    tuple(f"arm_{i}_joint" for i in range(1, 8)), "/arm_reach")},
-        grippers={"right": GripperInterface("/gripper_controller/gripper_action",
-                                            ("gripper_left_finger_joint", "gripper_right_finger_joint"))},
+        arms={
+            "right": ArmInterface(
+                "/arm_controller/follow_joint_trajectory", tuple(f"arm_{i}_joint" for i in range(1, 8)), "/arm_reach"
+            )
+        },
+        grippers={
+            "right": GripperInterface(
+                "/gripper_controller/gripper_action", ("gripper_left_finger_joint", "gripper_right_finger_joint")
+            )
+        },
         head_action="/head_controller/point_head_action",
         head_pointing_frame="xtion_rgb_optical_frame",
         head_pointing_axis=(0.0, 0.0, 1.0),
@@ -160,8 +184,9 @@ def robot_config(robot: str) -> RosRobotConfig:
     try:
         return ROBOT_CONFIGS[robot]
     except KeyError:
-        raise ValueError(f"no ROS configuration for robot {robot!r}; available: "
-                         f"{', '.join(sorted(ROBOT_CONFIGS))}") from None
+        raise ValueError(
+            f"no ROS configuration for robot {robot!r}; available: {', '.join(sorted(ROBOT_CONFIGS))}"
+        ) from None
 
 
 def config_from_dict(data: dict[str, Any]) -> RosRobotConfig:
@@ -172,9 +197,12 @@ def config_from_dict(data: dict[str, Any]) -> RosRobotConfig:
     if unknown:
         raise ValueError(f"unknown ROS configuration keys {unknown}; valid: {sorted(base)}")
     merged = {**base, **data}
-    merged["arms"] = {k: ArmInterface(v["trajectory_action"], tuple(v["joint_names"]), v["reach_action"])
-                      for k, v in merged["arms"].items()}
-    merged["grippers"] = {k: GripperInterface(v["action"], tuple(v["opening_joints"]))
-                          for k, v in merged["grippers"].items()}
+    merged["arms"] = {
+        k: ArmInterface(v["trajectory_action"], tuple(v["joint_names"]), v["reach_action"])
+        for k, v in merged["arms"].items()
+    }
+    merged["grippers"] = {
+        k: GripperInterface(v["action"], tuple(v["opening_joints"])) for k, v in merged["grippers"].items()
+    }
     merged["head_pointing_axis"] = tuple(merged["head_pointing_axis"])
     return RosRobotConfig(**merged)

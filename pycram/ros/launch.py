@@ -23,7 +23,6 @@ import threading
 import time
 import xmlrpc.client
 from pathlib import Path
-from typing import Optional
 from urllib.parse import urlparse
 
 __all__ = ["free_port", "loopback_env", "check_master_uri", "RosMaster", "BridgeProcess"]
@@ -38,7 +37,7 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def loopback_env(master_uri: str, log_dir: Optional[str] = None) -> dict[str, str]:
+def loopback_env(master_uri: str, log_dir: str | None = None) -> dict[str, str]:
     """The environment of a ROS process on loopback talking to ``master_uri``."""
     env = dict(os.environ)
     env.update(ROS_MASTER_URI=master_uri, ROS_IP=LOOPBACK, ROS_HOSTNAME=LOOPBACK)
@@ -48,18 +47,22 @@ def loopback_env(master_uri: str, log_dir: Optional[str] = None) -> dict[str, st
     return env
 
 
-def check_master_uri(uri: Optional[str], allow_remote: bool = False) -> str:
+def check_master_uri(uri: str | None, allow_remote: bool = False) -> str:
     """``uri`` if it is an http URI of a master on loopback (or ``allow_remote``); else
     ``ValueError`` saying what is wrong."""
     if not uri:
-        raise ValueError("ROS_MASTER_URI is not set: start roscore (e.g. `roscore -p 11311`) and set "
-                         "ROS_MASTER_URI=http://127.0.0.1:11311")
+        raise ValueError(
+            "ROS_MASTER_URI is not set: start roscore (e.g. `roscore -p 11311`) and set "
+            "ROS_MASTER_URI=http://127.0.0.1:11311"
+        )
     parsed = urlparse(uri)
     if parsed.scheme != "http" or not parsed.hostname or not parsed.port:
         raise ValueError(f"ROS_MASTER_URI {uri!r} is not of the form http://HOST:PORT")
     if not allow_remote and parsed.hostname not in ("127.0.0.1", "localhost", "::1"):
-        raise ValueError(f"ROS_MASTER_URI {uri!r} is not on loopback; pass --allow-remote-master to talk "
-                         f"to a master on another machine (anyone on that network can then command the robot)")
+        raise ValueError(
+            f"ROS_MASTER_URI {uri!r} is not on loopback; pass --allow-remote-master to talk "
+            f"to a master on another machine (anyone on that network can then command the robot)"
+        )
     return uri
 
 
@@ -80,16 +83,21 @@ def _stop_process(process: subprocess.Popen, timeout: float = 10.0) -> None:
 class RosMaster:
     """``roscore`` on ``127.0.0.1:port`` (a free port by default). ``uri`` is its address."""
 
-    def __init__(self, port: Optional[int] = None, startup_timeout: float = 20.0) -> None:
+    def __init__(self, port: int | None = None, startup_timeout: float = 20.0) -> None:
         if shutil.which("roscore") is None:
             raise RuntimeError("roscore not found: run scripts/install_ros.sh (Debian package ros-core)")
         self.port = port or free_port()
         self.uri = f"http://{LOOPBACK}:{self.port}"
         self.log_dir = tempfile.mkdtemp(prefix="pycram-ros-")
         self._log = open(Path(self.log_dir) / "roscore.log", "wb")
-        self.process = subprocess.Popen(["roscore", "-p", str(self.port)], env=loopback_env(self.uri, self.log_dir),
-                                        stdout=self._log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                        start_new_session=True)
+        self.process = subprocess.Popen(
+            ["roscore", "-p", str(self.port)],
+            env=loopback_env(self.uri, self.log_dir),
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         try:
             self._wait_ready(startup_timeout)
         except BaseException:
@@ -110,8 +118,7 @@ class RosMaster:
             except (OSError, xmlrpc.client.Error):
                 pass
             if time.monotonic() > deadline:
-                raise RuntimeError(f"roscore on {self.uri} did not answer within {timeout:.0f} s: "
-                                   f"{self.log_tail()}")
+                raise RuntimeError(f"roscore on {self.uri} did not answer within {timeout:.0f} s: {self.log_tail()}")
             time.sleep(0.05)
 
     def log_tail(self, chars: int = 1500) -> str:
@@ -124,7 +131,7 @@ class RosMaster:
         self._log.close()
         shutil.rmtree(self.log_dir, ignore_errors=True)
 
-    def __enter__(self) -> "RosMaster":
+    def __enter__(self) -> RosMaster:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -139,16 +146,39 @@ class BridgeProcess:
     :meth:`stop` ends it cleanly.
     """
 
-    def __init__(self, robot: str, master_uri: str, item_at: int = 1, realtime: bool = False,
-                 startup_timeout: float = 60.0, extra_args: tuple[str, ...] = ()) -> None:
+    def __init__(
+        self,
+        robot: str,
+        master_uri: str,
+        item_at: int = 1,
+        realtime: bool = False,
+        startup_timeout: float = 60.0,
+        extra_args: tuple[str, ...] = (),
+    ) -> None:
         self.robot, self.master_uri = robot, master_uri
         self.log_dir = tempfile.mkdtemp(prefix="pycram-bridge-")
         env = loopback_env(master_uri, self.log_dir)
         env.setdefault("MUJOCO_GL", "egl")
-        command = [sys.executable, "-m", "pycram", "sim-ros-bridge", "--robot", robot, "--item-at", str(item_at),
-                   *(["--realtime"] if realtime else []), *extra_args]
-        self.process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                        stdin=subprocess.DEVNULL, start_new_session=True)
+        command = [
+            sys.executable,
+            "-m",
+            "pycram",
+            "sim-ros-bridge",
+            "--robot",
+            robot,
+            "--item-at",
+            str(item_at),
+            *(["--realtime"] if realtime else []),
+            *extra_args,
+        ]
+        self.process = subprocess.Popen(
+            command,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         self._lines: list[str] = []
         self._ready = threading.Event()
         self._reader = threading.Thread(target=self._read, name="pycram-bridge-output", daemon=True)
@@ -184,7 +214,7 @@ class BridgeProcess:
         self._reader.join(5)
         shutil.rmtree(self.log_dir, ignore_errors=True)
 
-    def __enter__(self) -> "BridgeProcess":
+    def __enter__(self) -> BridgeProcess:
         return self
 
     def __exit__(self, *exc: object) -> None:

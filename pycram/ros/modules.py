@@ -31,14 +31,13 @@ import logging
 import math
 import threading
 import time
-from typing import Any, Optional
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule
 from pycram.robots.sim_modules import _check_cmd, _fmt, _fmt_pose2d, cancel_running_handle
 from pycram.ros.config import RosRobotConfig
-from pycram.ros.transport import (ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed,
-                                  Transport)
+from pycram.ros.transport import ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed, Transport
 from pycram.sim.types import Pose, Pose2D, VisibleItem
 
 __all__ = [
@@ -128,7 +127,7 @@ class RosRobotState:
         self.pose_updates.tick()
         self._check_ready()
 
-    def fresh_base_pose(self, timeout: float = 2.0) -> Optional[Pose2D]:
+    def fresh_base_pose(self, timeout: float = 2.0) -> Pose2D | None:
         """The base pose from a message sampled after now (see :meth:`wait_fresh`)."""
         self.wait_fresh(self.pose_updates, timeout)
         return self.base_pose.get_value()
@@ -151,8 +150,11 @@ class RosRobotState:
         self._check_ready()
 
     def _check_ready(self) -> None:
-        if not self._ready.is_set() and self.base_pose.get_value() is not None and all(
-                f.get_value() is not None for f in self.gripper_openings.values()):
+        if (
+            not self._ready.is_set()
+            and self.base_pose.get_value() is not None
+            and all(f.get_value() is not None for f in self.gripper_openings.values())
+        ):
             self._ready.set()
 
     def wait_ready(self, timeout: float) -> bool:
@@ -179,19 +181,17 @@ def _reason_of(outcome: GoalOutcome) -> tuple[str, str]:
 class RosProcessModule(ProcessModule):
     """Base class: sends goals over a transport; the cancel hook cancels the running goal."""
 
-    def __init__(self, name: str, transport: Transport, config: RosRobotConfig,
-                 state: RosRobotState) -> None:
+    def __init__(self, name: str, transport: Transport, config: RosRobotConfig, state: RosRobotState) -> None:
         super().__init__(name)
         self.transport, self.config, self.state = transport, config, state
-        self._handle: Optional[GoalHandle] = None
+        self._handle: GoalHandle | None = None
 
     def _send(self, action: str, action_type: str, goal: Any) -> GoalHandle:
         handle = self.transport.action(action, action_type).send(goal)
         self._handle = handle
         return handle
 
-    def _run_goal(self, action: str, action_type: str, goal: Any, command: str,
-                  timeout: float) -> Any:
+    def _run_goal(self, action: str, action_type: str, goal: Any, command: str, timeout: float) -> Any:
         """Send ``goal``, wait for it (evaporably, at most ``timeout`` [s, active clock]) and
         return the server's result message. Raises :class:`RosMotionFailed` (or a subclass)."""
         handle = self._send(action, action_type, goal)
@@ -222,8 +222,9 @@ class RosNavigationModule(RosProcessModule):
     """``'cmd': 'navigate'`` → a ``move_base`` goal in the map frame; returns the base pose
     reached (from a pose message sampled after the goal succeeded)."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 name: str = "navigation") -> None:
+    def __init__(
+        self, transport: Transport, config: RosRobotConfig, state: RosRobotState, name: str = "navigation"
+    ) -> None:
         super().__init__(name, transport, config, state)
 
     def _execute(self, designator: Any) -> Any:
@@ -234,14 +235,22 @@ class RosNavigationModule(RosProcessModule):
         distance = math.hypot(pose.x - here.x, pose.y - here.y) if here is not None else 10.0
         m = self.transport.message
         goal = m("move_base_msgs/MoveBaseGoal")
-        goal.target_pose = m("geometry_msgs/PoseStamped", header=self._header(), pose=m(
-            "geometry_msgs/Pose", position=self._point(pose.x, pose.y, 0.0),
-            orientation=m("geometry_msgs/Quaternion", x=0.0, y=0.0, z=math.sin(pose.yaw / 2),
-                          w=math.cos(pose.yaw / 2))))
+        goal.target_pose = m(
+            "geometry_msgs/PoseStamped",
+            header=self._header(),
+            pose=m(
+                "geometry_msgs/Pose",
+                position=self._point(pose.x, pose.y, 0.0),
+                orientation=m(
+                    "geometry_msgs/Quaternion", x=0.0, y=0.0, z=math.sin(pose.yaw / 2), w=math.cos(pose.yaw / 2)
+                ),
+            ),
+        )
         command = f"drive to {_fmt_pose2d(pose)}"
         try:
-            self._run_goal(self.config.move_base_action, "move_base_msgs/MoveBase", goal, command,
-                           timeout=30.0 + 4.0 * distance)
+            self._run_goal(
+                self.config.move_base_action, "move_base_msgs/MoveBase", goal, command, timeout=30.0 + 4.0 * distance
+            )
         except RosMotionFailed as e:
             e.args = (f"{e.args[0]} (stopped at {_fmt_pose2d(self.state.base_pose.get_value())})",)
             raise
@@ -253,8 +262,14 @@ class RosBaseStopModule(RosProcessModule):
     ``move_base``; returns the base pose. Separate from navigation so it never queues behind
     the drive it stops."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 navigation: RosNavigationModule, name: str = "base_stop") -> None:
+    def __init__(
+        self,
+        transport: Transport,
+        config: RosRobotConfig,
+        state: RosRobotState,
+        navigation: RosNavigationModule,
+        name: str = "base_stop",
+    ) -> None:
         super().__init__(name, transport, config, state)
         self.navigation = navigation
 
@@ -276,8 +291,7 @@ class RosHeadModule(RosProcessModule):
     (a ``('wait', False)`` designator) the goal is sent and the module returns at once; the next
     head goal replaces it on the server. Returns ``None`` (PointHead's result is empty)."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 name: str = "head") -> None:
+    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState, name: str = "head") -> None:
         super().__init__(name, transport, config, state)
 
     def _execute(self, designator: Any) -> Any:
@@ -287,13 +301,13 @@ class RosHeadModule(RosProcessModule):
         m, c = self.transport.message, self.config
         goal = m("control_msgs/PointHeadGoal", pointing_frame=c.head_pointing_frame, max_velocity=1.0)
         goal.target = m("geometry_msgs/PointStamped", header=self._header(), point=self._point(*point))
-        goal.pointing_axis = m("geometry_msgs/Vector3", x=c.head_pointing_axis[0],
-                               y=c.head_pointing_axis[1], z=c.head_pointing_axis[2])
+        goal.pointing_axis = m(
+            "geometry_msgs/Vector3", x=c.head_pointing_axis[0], y=c.head_pointing_axis[1], z=c.head_pointing_axis[2]
+        )
         if solution.get("track"):
             self._send(c.head_action, "control_msgs/PointHead", goal)
             return None
-        self._run_goal(c.head_action, "control_msgs/PointHead", goal, f"point the head at {_fmt(point)}",
-                       timeout=10.0)
+        self._run_goal(c.head_action, "control_msgs/PointHead", goal, f"point the head at {_fmt(point)}", timeout=10.0)
         return None
 
 
@@ -302,8 +316,7 @@ class RosTorsoModule(RosProcessModule):
     trajectory (TIAGo); returns the height reached [m] (the commanded one: the server succeeds
     only within its tolerance)."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 name: str = "torso") -> None:
+    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState, name: str = "torso") -> None:
         super().__init__(name, transport, config, state)
 
     def _execute(self, designator: Any) -> Any:
@@ -312,8 +325,7 @@ class RosTorsoModule(RosProcessModule):
         height = float(solution["height"])
         c = self.config
         if c.torso_interface == "single_joint_position":
-            goal = self.transport.message("control_msgs/SingleJointPositionGoal", position=height,
-                                          max_velocity=1.0)
+            goal = self.transport.message("control_msgs/SingleJointPositionGoal", position=height, max_velocity=1.0)
             action_type = "control_msgs/SingleJointPosition"
         else:
             goal = _trajectory_goal(self.transport, (c.torso_joint,), (height,))
@@ -324,9 +336,12 @@ class RosTorsoModule(RosProcessModule):
 
 def _trajectory_goal(transport: Transport, joints: tuple[str, ...], positions: tuple[float, ...]) -> Any:
     m = transport.message
-    point = m("trajectory_msgs/JointTrajectoryPoint", positions=list(positions),
-              velocities=[0.0] * len(positions),
-              time_from_start=transport.duration(ARM_MOTION_DURATION))
+    point = m(
+        "trajectory_msgs/JointTrajectoryPoint",
+        positions=list(positions),
+        velocities=[0.0] * len(positions),
+        time_from_start=transport.duration(ARM_MOTION_DURATION),
+    )
     trajectory = m("trajectory_msgs/JointTrajectory", joint_names=list(joints), points=[point])
     return m("control_msgs/FollowJointTrajectoryGoal", trajectory=trajectory)
 
@@ -336,8 +351,9 @@ class RosArmModule(RosProcessModule):
     Reach goal (tool pose in the map frame). Returns the commanded joint positions [rad]
     (``move_arm``) or the reached tool ``Pose`` (``reach``)."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 arm: str, name: Optional[str] = None) -> None:
+    def __init__(
+        self, transport: Transport, config: RosRobotConfig, state: RosRobotState, arm: str, name: str | None = None
+    ) -> None:
         super().__init__(name or f"arm_{arm}", transport, config, state)
         self.arm = arm
         self.interface = config.arms[arm]
@@ -348,12 +364,19 @@ class RosArmModule(RosProcessModule):
         if cmd == "move_arm":
             positions = tuple(float(v) for v in solution["positions"])
             if len(positions) != len(self.interface.joint_names):
-                raise ValueError(f"the {self.arm} arm has {len(self.interface.joint_names)} joints "
-                                 f"{list(self.interface.joint_names)}, got {len(positions)} positions")
+                raise ValueError(
+                    f"the {self.arm} arm has {len(self.interface.joint_names)} joints "
+                    f"{list(self.interface.joint_names)}, got {len(positions)} positions"
+                )
             what = solution.get("configuration") or _fmt(positions)
             goal = _trajectory_goal(self.transport, self.interface.joint_names, positions)
-            self._run_goal(self.interface.trajectory_action, "control_msgs/FollowJointTrajectory",
-                                  goal, f"move the {self.arm} arm to {what}", timeout=30.0)
+            self._run_goal(
+                self.interface.trajectory_action,
+                "control_msgs/FollowJointTrajectory",
+                goal,
+                f"move the {self.arm} arm to {what}",
+                timeout=30.0,
+            )
             return positions
         if cmd == "reach":
             return self._reach(solution)
@@ -364,15 +387,26 @@ class RosArmModule(RosProcessModule):
         position = tuple(float(v) for v in solution["position"])
         orientation = solution.get("orientation")
         w, x, y, z = orientation if orientation is not None else (1.0, 0.0, 0.0, 0.0)
-        target = m("geometry_msgs/PoseStamped", header=self._header(), pose=m(
-            "geometry_msgs/Pose", position=self._point(*position),
-            orientation=m("geometry_msgs/Quaternion", x=float(x), y=float(y), z=float(z), w=float(w))))
-        goal = m("pycram_msgs/ReachGoal", arm=self.arm, target=target,
-                 use_orientation=orientation is not None,
-                 tolerance=float(solution.get("tolerance", 0.01)))
+        target = m(
+            "geometry_msgs/PoseStamped",
+            header=self._header(),
+            pose=m(
+                "geometry_msgs/Pose",
+                position=self._point(*position),
+                orientation=m("geometry_msgs/Quaternion", x=float(x), y=float(y), z=float(z), w=float(w)),
+            ),
+        )
+        goal = m(
+            "pycram_msgs/ReachGoal",
+            arm=self.arm,
+            target=target,
+            use_orientation=orientation is not None,
+            tolerance=float(solution.get("tolerance", 0.01)),
+        )
         phase = solution.get("phase")
         what = f"reach with the {self.arm} arm to {_fmt(position)}" + (
-            f" ({phase} of {_fmt(solution['target'])})" if phase else "")
+            f" ({phase} of {_fmt(solution['target'])})" if phase else ""
+        )
         result = self._run_goal(self.interface.reach_action, "pycram_msgs/Reach", goal, what, timeout=30.0)
         p, q = result.reached.position, result.reached.orientation
         return Pose((p.x, p.y, p.z), (q.w, q.x, q.y, q.z))
@@ -383,8 +417,9 @@ class RosGripperModule(RosProcessModule):
     0 for the gripper's default); returns the measured opening [m] once the joint states (and
     so the gripper-opening fluents) show the gripper after the command."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 gripper: str, name: Optional[str] = None) -> None:
+    def __init__(
+        self, transport: Transport, config: RosRobotConfig, state: RosRobotState, gripper: str, name: str | None = None
+    ) -> None:
         super().__init__(name or f"gripper_{gripper}", transport, config, state)
         self.gripper = gripper
 
@@ -394,10 +429,17 @@ class RosGripperModule(RosProcessModule):
         opening = float(solution["opening"])
         effort = solution.get("effort")
         m = self.transport.message
-        goal = m("control_msgs/GripperCommandGoal", command=m(
-            "control_msgs/GripperCommand", position=opening, max_effort=float(effort or 0.0)))
-        result = self._run_goal(self.config.grippers[self.gripper].action, "control_msgs/GripperCommand",
-                                goal, f"set the {self.gripper} gripper to {opening:.3f} m", timeout=10.0)
+        goal = m(
+            "control_msgs/GripperCommandGoal",
+            command=m("control_msgs/GripperCommand", position=opening, max_effort=float(effort or 0.0)),
+        )
+        result = self._run_goal(
+            self.config.grippers[self.gripper].action,
+            "control_msgs/GripperCommand",
+            goal,
+            f"set the {self.gripper} gripper to {opening:.3f} m",
+            timeout=10.0,
+        )
         self.state.wait_fresh(self.state.joint_updates)  # the opening fluents show the result
         return float(result.position)
 
@@ -407,8 +449,9 @@ class RosPerceptionModule(RosProcessModule):
     visible first), restricted to ``'object'`` (name or type) when given. Fails with reason
     ``'timeout'`` when no detections arrive within 10 s (wall time)."""
 
-    def __init__(self, transport: Transport, config: RosRobotConfig, state: RosRobotState,
-                 name: str = "perception") -> None:
+    def __init__(
+        self, transport: Transport, config: RosRobotConfig, state: RosRobotState, name: str = "perception"
+    ) -> None:
         super().__init__(name, transport, config, state)
         self.detections = MessageCounter()
         self._subscription: Any = None  # subscribed on first use: the bridge renders only for subscribers
@@ -417,17 +460,27 @@ class RosPerceptionModule(RosProcessModule):
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
         if self._subscription is None:
-            self._subscription = self.transport.subscribe(self.config.detections_topic,
-                                                          "pycram_msgs/DetectedItems", self.detections.tick)
+            self._subscription = self.transport.subscribe(
+                self.config.detections_topic, "pycram_msgs/DetectedItems", self.detections.tick
+            )
         # the second message from now: the first may show the scene from before the request
         if not self.detections.wait_for_count(self.detections.count + 2, 10.0):
-            raise RosMotionFailed("perceive", "timeout", f"no detections on "
-                                  f"{self.config.detections_topic} within 10.0 s")
+            raise RosMotionFailed(
+                "perceive", "timeout", f"no detections on {self.config.detections_topic} within 10.0 s"
+            )
         message = self.detections.latest
-        items = [VisibleItem(i.name, i.type, Pose((i.pose.position.x, i.pose.position.y, i.pose.position.z),
-                                                  (i.pose.orientation.w, i.pose.orientation.x,
-                                                   i.pose.orientation.y, i.pose.orientation.z)),
-                             int(i.pixels), (float(i.u), float(i.v)))
-                 for i in message.items]
+        items = [
+            VisibleItem(
+                i.name,
+                i.type,
+                Pose(
+                    (i.pose.position.x, i.pose.position.y, i.pose.position.z),
+                    (i.pose.orientation.w, i.pose.orientation.x, i.pose.orientation.y, i.pose.orientation.z),
+                ),
+                int(i.pixels),
+                (float(i.u), float(i.v)),
+            )
+            for i in message.items
+        ]
         wanted = solution.get("object")
         return items if wanted is None else [i for i in items if wanted in (i.name, i.type)]

@@ -9,13 +9,12 @@ numbers (joint configurations, torso heights, reaching offsets) come from its de
 from __future__ import annotations
 
 import importlib
-from typing import Any, Optional
+from typing import Any
 
 from pycram.process_module import ProcessModule
 from pycram.robot import Robot
 from pycram.robots.sim_modules import SensorModule, shutdown_modules
-from pycram.robots.sim_resolvers import (make_motion_resolver, make_to_reach_generator,
-                                         physical_arm, physical_gripper)
+from pycram.robots.sim_resolvers import make_motion_resolver, make_to_reach_generator, physical_arm, physical_gripper
 from pycram.robots.sim_vocabulary import motion_types
 from pycram.ros import modules as rm
 from pycram.ros.config import RosRobotConfig, robot_config
@@ -29,8 +28,9 @@ class RosRobot(Robot):
     (:class:`~pycram.ros.modules.RosRobotState`); :meth:`shutdown` ends subscriptions and takes
     the modules offline (idempotent)."""
 
-    def __init__(self, name: str, transport: Transport, config: RosRobotConfig,
-                 state: rm.RosRobotState, description: Any) -> None:
+    def __init__(
+        self, name: str, transport: Transport, config: RosRobotConfig, state: rm.RosRobotState, description: Any
+    ) -> None:
         super().__init__(name)
         self.transport, self.config, self.state, self.description = transport, config, state, description
 
@@ -42,8 +42,9 @@ class RosRobot(Robot):
         return f"RosRobot({self.name!r})"
 
 
-def make_ros_robot(name: str, transport: Optional[Transport] = None,
-                   config: Optional[RosRobotConfig] = None, wait_for_state: float = 10.0) -> RosRobot:
+def make_ros_robot(
+    name: str, transport: Transport | None = None, config: RosRobotConfig | None = None, wait_for_state: float = 10.0
+) -> RosRobot:
     """The robot ``name`` (``'pr2'``, ``'tiago'``) over ROS, modules online.
 
     ``transport`` defaults to the process's ROS 1 transport (node initialised on first use),
@@ -62,9 +63,11 @@ def make_ros_robot(name: str, transport: Optional[Transport] = None,
     state = rm.RosRobotState(transport, config)
     if not state.wait_ready(wait_for_state):
         state.close()
-        raise TimeoutError(f"no data from robot {name!r} on {config.pose_topic} and "
-                           f"{config.joint_states_topic} within {wait_for_state:.1f} s: is the robot "
-                           f"(or `pycram sim-ros-bridge --robot {name}`) running on this ROS master?")
+        raise TimeoutError(
+            f"no data from robot {name!r} on {config.pose_topic} and "
+            f"{config.joint_states_topic} within {wait_for_state:.1f} s: is the robot "
+            f"(or `pycram sim-ros-bridge --robot {name}`) running on this ROS master?"
+        )
     robot = RosRobot(name, transport, config, state, description)
     args = (transport, config, state)
     navigation = robot.add_process_module("navigation", rm.RosNavigationModule(*args))
@@ -72,8 +75,7 @@ def make_ros_robot(name: str, transport: Optional[Transport] = None,
     head = robot.add_process_module("head", rm.RosHeadModule(*args))
     torso = robot.add_process_module("torso", rm.RosTorsoModule(*args))
     arms = {a: robot.add_process_module(f"arm_{a}", rm.RosArmModule(*args, a)) for a in config.arms}
-    grippers = {g: robot.add_process_module(f"gripper_{g}", rm.RosGripperModule(*args, g))
-                for g in config.grippers}
+    grippers = {g: robot.add_process_module(f"gripper_{g}", rm.RosGripperModule(*args, g)) for g in config.grippers}
     sensors = robot.add_process_module("sensors", SensorModule(state))
     perception = robot.add_process_module("perception", rm.RosPerceptionModule(*args))
 
@@ -81,19 +83,26 @@ def make_ros_robot(name: str, transport: Optional[Transport] = None,
     robot.motion_resolvers.append(make_motion_resolver(state, description))
     robot.location_generators.append(make_to_reach_generator(state, description))
 
-    by_type = {"moving": navigation, "cancelling_movement": base_stop, "pointing_head": head,
-               "setting_torso": torso, "detecting": perception, "subscribing_pose": sensors,
-               "subscribing_gripper": sensors}
+    by_type = {
+        "moving": navigation,
+        "cancelling_movement": base_stop,
+        "pointing_head": head,
+        "setting_torso": torso,
+        "detecting": perception,
+        "subscribing_pose": sensors,
+        "subscribing_gripper": sensors,
+    }
 
-    def ros_process_modules(desig: Any) -> Optional[ProcessModule]:
+    def ros_process_modules(desig: Any) -> ProcessModule | None:
         """Choose the module by the designator's type (and physical arm / gripper)."""
         motion_type = desig.prop_value("type")
         if isinstance(motion_type, str) and motion_type in by_type:
             return by_type[motion_type]
         if motion_type == "setting_gripper" and desig.check_constraints(["gripper"]):
             return grippers[physical_gripper(description, desig.prop_value("gripper"))]
-        if (motion_type in ("setting_arm_configuration", "setting_arm_joints", "reaching")
-                and desig.check_constraints(["arm"])):
+        if motion_type in ("setting_arm_configuration", "setting_arm_joints", "reaching") and desig.check_constraints(
+            ["arm"]
+        ):
             return arms[physical_arm(description, desig.prop_value("arm"))]
         return None
 

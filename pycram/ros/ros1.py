@@ -17,14 +17,21 @@ import importlib
 import logging
 import threading
 import time
-from typing import Any, Callable, Optional
+from collections.abc import Callable
+from typing import Any
 
 import actionlib
 import rospy
 from actionlib_msgs.msg import GoalStatus
 
-from pycram.ros.transport import (ActionChannel, ActionServerUnavailable, GoalHandle, GoalOutcome,
-                                  Subscription, Transport)
+from pycram.ros.transport import (
+    ActionChannel,
+    ActionServerUnavailable,
+    GoalHandle,
+    GoalOutcome,
+    Subscription,
+    Transport,
+)
 from pycram.runtime.clock import ManualClock
 
 __all__ = ["Ros1Transport", "ros1_transport", "message_class"]
@@ -41,7 +48,7 @@ _STATUS_NAMES = {
 }
 
 _lock = threading.Lock()
-_transport: Optional["Ros1Transport"] = None
+_transport: Ros1Transport | None = None
 
 
 def message_class(msg_type: str, kind: str = "msg") -> Any:
@@ -51,12 +58,12 @@ def message_class(msg_type: str, kind: str = "msg") -> Any:
     try:
         return getattr(importlib.import_module(f"{package}.{kind}"), name)
     except (ImportError, AttributeError) as e:
-        raise ValueError(f"ROS {kind} type {msg_type!r} is not available ({e}); run "
-                         f"scripts/install_ros.sh") from None
+        raise ValueError(f"ROS {kind} type {msg_type!r} is not available ({e}); run scripts/install_ros.sh") from None
 
 
-def ros1_transport(node_name: str = "pycram", server_timeout: float = 2.0,
-                   connect_timeout: float = 10.0) -> "Ros1Transport":
+def ros1_transport(
+    node_name: str = "pycram", server_timeout: float = 2.0, connect_timeout: float = 10.0
+) -> Ros1Transport:
     """The process's ROS 1 transport (created, and the node initialised, on the first call)."""
     global _transport
     with _lock:
@@ -89,13 +96,12 @@ class _StatusWatchingClient(actionlib.ActionClient):
 
 
 class Ros1ActionChannel(ActionChannel):
-    def __init__(self, transport: "Ros1Transport", name: str, action_type: str) -> None:
+    def __init__(self, transport: Ros1Transport, name: str, action_type: str) -> None:
         self.name, self.action_type = name, action_type
         self._transport = transport
         self._cond = threading.Condition()
         self.last_status = float("-inf")  # monotonic time of the server's last status message
-        self._client = _StatusWatchingClient(name, message_class(action_type + "Action"),
-                                             self._status_seen)
+        self._client = _StatusWatchingClient(name, message_class(action_type + "Action"), self._status_seen)
 
     def _status_seen(self) -> None:
         with self._cond:
@@ -115,9 +121,12 @@ class Ros1ActionChannel(ActionChannel):
         if status is None or not self.server_alive():
             return False
         server = status._connection_header["callerid"]
-        return (client.pub_goal.impl.has_connection(server) and client.pub_cancel.impl.has_connection(server)
-                and any(c.callerid_pub == server for c in client.result_sub.impl.connections)
-                and any(c.callerid_pub == server for c in client.feedback_sub.impl.connections))
+        return (
+            client.pub_goal.impl.has_connection(server)
+            and client.pub_cancel.impl.has_connection(server)
+            and any(c.callerid_pub == server for c in client.result_sub.impl.connections)
+            and any(c.callerid_pub == server for c in client.feedback_sub.impl.connections)
+        )
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait at most ``timeout`` [s, wall] until the server's status arrives and it is
@@ -137,17 +146,23 @@ class Ros1ActionChannel(ActionChannel):
     def send(self, goal: Any) -> GoalHandle:
         if not self.wait_for_server(self._transport.connect_timeout):
             raise ActionServerUnavailable(
-                f"send a goal to {self.name}", "unavailable",
+                f"send a goal to {self.name}",
+                "unavailable",
                 f"no action server answered within {self._transport.connect_timeout:.1f} s "
-                f"(master {rosgraph_master()})", action=self.name)
+                f"(master {rosgraph_master()})",
+                action=self.name,
+            )
         handle = _Ros1GoalHandle(self.name)
 
         def transition(client_handle: Any) -> None:
             if client_handle.get_comm_state() != actionlib.CommState.DONE:
                 return
             status = client_handle.get_goal_status()
-            outcome = GoalOutcome(_STATUS_NAMES.get(status, f"status {status}"),
-                                  client_handle.get_result(), client_handle.get_goal_status_text())
+            outcome = GoalOutcome(
+                _STATUS_NAMES.get(status, f"status {status}"),
+                client_handle.get_result(),
+                client_handle.get_goal_status_text(),
+            )
             if handle._finish(outcome):
                 self._transport._unwatch(handle)
 
@@ -213,8 +228,7 @@ class Ros1Transport(Transport):
     ``connect_timeout`` [s, wall]: how long :meth:`ActionChannel.send` waits for a server.
     """
 
-    def __init__(self, node_name: str = "pycram", server_timeout: float = 2.0,
-                 connect_timeout: float = 10.0) -> None:
+    def __init__(self, node_name: str = "pycram", server_timeout: float = 2.0, connect_timeout: float = 10.0) -> None:
         self.server_timeout, self.connect_timeout = float(server_timeout), float(connect_timeout)
         if not rospy.core.is_initialized():
             rospy.init_node(node_name, anonymous=True, disable_signals=True)
@@ -224,8 +238,7 @@ class Ros1Transport(Transport):
         self._watch_cond = threading.Condition()
         self._watched: dict[_Ros1GoalHandle, Ros1ActionChannel] = {}
         self._closed = False
-        self._watchdog = threading.Thread(target=self._watch_servers, name="pycram-ros-watchdog",
-                                          daemon=True)
+        self._watchdog = threading.Thread(target=self._watch_servers, name="pycram-ros-watchdog", daemon=True)
         self._watchdog.start()
 
     # -- Transport ------------------------------------------------------------------------------
@@ -258,8 +271,9 @@ class Ros1Transport(Transport):
         try:
             rospy.wait_for_service(name, timeout)
         except rospy.ROSException:
-            raise ActionServerUnavailable(f"call service {name}", "unavailable",
-                                          f"not offered within {timeout:.1f} s") from None
+            raise ActionServerUnavailable(
+                f"call service {name}", "unavailable", f"not offered within {timeout:.1f} s"
+            ) from None
         return rospy.ServiceProxy(name, message_class(srv_type, "srv"))
 
     def duration(self, seconds: float) -> Any:
@@ -308,9 +322,11 @@ class Ros1Transport(Transport):
                     if now >= deadline:
                         del self._watched[handle]
                         silent = now - max(channel.last_status, handle.sent)
-                        if handle._finish(GoalOutcome(
-                                "lost", None, f"the action server {channel.name} vanished: no status "
-                                f"for {silent:.1f} s")):
+                        if handle._finish(
+                            GoalOutcome(
+                                "lost", None, f"the action server {channel.name} vanished: no status for {silent:.1f} s"
+                            )
+                        ):
                             logger.warning("goal on %s lost: its server stopped answering", channel.name)
                     elif next_deadline is None or deadline < next_deadline:
                         next_deadline = deadline

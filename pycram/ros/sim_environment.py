@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 import os
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.runtime.clock import set_clock
@@ -34,10 +34,10 @@ class _ServiceCall:
     """A simulator command sent when waited for: ``wait(timeout)`` -> ``Outcome`` or ``None``
     while still running after ``timeout`` [s of simulated time]."""
 
-    def __init__(self, environment: "RosSimEnvironment", **request: Any) -> None:
+    def __init__(self, environment: RosSimEnvironment, **request: Any) -> None:
         self._environment, self._request = environment, request
 
-    def wait(self, timeout: Optional[float] = None) -> Optional[Outcome]:
+    def wait(self, timeout: float | None = None) -> Outcome | None:
         return self._environment._command(wait=float(timeout or 0.0), **self._request)
 
 
@@ -50,16 +50,18 @@ class RosSimEnvironment:
         config = robot.config
         self.base_pose = robot.state.base_pose
         self.gripper_openings = robot.state.gripper_openings
-        self.gripper_states = {g: Fluent(GripperState(f.get_value()), name=f"{g}_gripper_state")
-                               for g, f in self.gripper_openings.items()}
+        self.gripper_states = {
+            g: Fluent(GripperState(f.get_value()), name=f"{g}_gripper_state") for g, f in self.gripper_openings.items()
+        }
         self.item_poses = Fluent({}, name="item_poses")
         self.sim_time = Fluent(clock.now(), name="sim_time")
         self._processes = list(processes)
         self._previous_clock: Any = None
         self._subscriptions = [
             transport.subscribe(f"{config.sim_namespace}/items", "pycram_msgs/ItemStates", self._on_items),
-            transport.subscribe(config.clock_topic, "rosgraph_msgs/Clock",
-                                lambda m: self.sim_time.set_value(m.clock.to_sec())),
+            transport.subscribe(
+                config.clock_topic, "rosgraph_msgs/Clock", lambda m: self.sim_time.set_value(m.clock.to_sec())
+            ),
         ]
         self._service = transport.service(f"{config.sim_namespace}/command", "pycram_msgs/SimCommand")
 
@@ -75,7 +77,7 @@ class RosSimEnvironment:
             opening = self.gripper_openings[gripper].get_value()
             state.set_value(GripperState(float(opening or 0.0), holding.get(gripper)))
 
-    def _command(self, **request: Any) -> Optional[Outcome]:
+    def _command(self, **request: Any) -> Outcome | None:
         try:
             response = self._service(**request)
         except Exception as e:  # the bridge went away
@@ -85,12 +87,11 @@ class RosSimEnvironment:
         return Outcome(response.success, response.reason, response.message, response.value or None)
 
     # -- the World's environment commands --------------------------------------------------------
-    def take_item(self, gripper: Optional[str] = None, item: Optional[str] = None) -> _ServiceCall:
+    def take_item(self, gripper: str | None = None, item: str | None = None) -> _ServiceCall:
         return _ServiceCall(self, command="take_item", gripper=gripper or "", item=item or "")
 
     def give_item(self, item: str, gripper: str, close: bool = True, timeout: float = 5.0) -> _ServiceCall:
-        return _ServiceCall(self, command="give_item", item=item, gripper=gripper, close=close,
-                            timeout=float(timeout))
+        return _ServiceCall(self, command="give_item", item=item, gripper=gripper, close=close, timeout=float(timeout))
 
     def snapshot(self, path: str | Path, *args: Any, **kwargs: Any) -> None:
         """The bridge renders the overview camera into ``path`` (same machine: loopback)."""
@@ -125,8 +126,9 @@ class RosSimEnvironment:
         return f"RosSimEnvironment({self.robot!r})"
 
 
-def open_ros_world(robot: str, item_at: int = 1, realtime: bool = False,
-                   master_uri: Optional[str] = None) -> tuple[RosSimEnvironment, Any]:
+def open_ros_world(
+    robot: str, item_at: int = 1, realtime: bool = False, master_uri: str | None = None
+) -> tuple[RosSimEnvironment, Any]:
     """Connect to the simulated ``robot`` over ROS; return ``(environment, robot)``.
 
     ``master_uri`` (default ``$ROS_MASTER_URI``): a master with ``pycram sim-ros-bridge`` already
@@ -177,8 +179,10 @@ def _use_master(master_uri: str) -> None:
     if rospy.core.is_initialized():
         current = rosgraph.get_master_uri()
         if current != master_uri:
-            raise RuntimeError(f"this process's ROS node already talks to {current}; rospy cannot move "
-                               f"it to {master_uri} (run one ROS master per process)")
+            raise RuntimeError(
+                f"this process's ROS node already talks to {current}; rospy cannot move "
+                f"it to {master_uri} (run one ROS master per process)"
+            )
         return
     os.environ["ROS_MASTER_URI"] = master_uri
     os.environ.setdefault("ROS_IP", "127.0.0.1")

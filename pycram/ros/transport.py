@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import threading
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable, Optional
+from typing import Any
 
-from pycram.fluent import Fluent
 from pycram.failures import MotionFailure
+from pycram.fluent import Fluent
 
 __all__ = [
     "RosMotionFailed",
@@ -53,8 +54,9 @@ class RosMotionFailed(MotionFailure):
     ``'unavailable'``), ``outcome`` (the :class:`GoalOutcome`, if any).
     """
 
-    def __init__(self, command: str, reason: str, message: str, action: str = "",
-                 outcome: Optional["GoalOutcome"] = None) -> None:
+    def __init__(
+        self, command: str, reason: str, message: str, action: str = "", outcome: GoalOutcome | None = None
+    ) -> None:
         where = f" (action {action})" if action else ""
         super().__init__(f"{command} failed{where}: {reason}: {message}")
         self.command, self.reason, self.action, self.outcome = command, reason, action, outcome

@@ -16,11 +16,19 @@ import heapq
 import itertools
 import threading
 import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Callable, Iterator
 
-__all__ = ["Clock", "WallClock", "ManualClock", "current_clock", "use_clock", "set_clock",
-           "add_clock_listener", "remove_clock_listener"]
+__all__ = [
+    "Clock",
+    "WallClock",
+    "ManualClock",
+    "current_clock",
+    "use_clock",
+    "set_clock",
+    "add_clock_listener",
+    "remove_clock_listener",
+]
 
 
 class Clock:

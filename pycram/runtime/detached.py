@@ -17,8 +17,8 @@ at the block's end instead of the thread's::
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Iterator
 
 from pycram.runtime.evaporation import current_runner, shielded, wait_until
 

@@ -30,8 +30,9 @@ from __future__ import annotations
 import os
 import sys
 import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator
+from typing import Any
 
 from pycram.runtime.clock import current_clock
 
@@ -63,8 +64,22 @@ class Evaporated(BaseException):
 class Runner:
     """The per-thread execution state: current task, wait registration, interrupt state."""
 
-    __slots__ = ("task", "ident", "detached", "_mode", "_waiting_on", "_injected", "_missed", "_protected", "_lock",
-                 "_sleep", "_delivered_to", "_delivered_top", "resurfacing", "in_plan")
+    __slots__ = (
+        "task",
+        "ident",
+        "detached",
+        "_mode",
+        "_waiting_on",
+        "_injected",
+        "_missed",
+        "_protected",
+        "_lock",
+        "_sleep",
+        "_delivered_to",
+        "_delivered_top",
+        "resurfacing",
+        "in_plan",
+    )
 
     def __init__(self, task: object | None = None, ident: int | None = None) -> None:
         self.task = task
@@ -203,8 +218,13 @@ class Runner:
             # Only into plan code: the runtime's own bookkeeping (in_plan False) checks for a due
             # evaporation when it hands back to plan code. No eval-breaker check lies between
             # reading in_plan and the C call, so the thread cannot leave plan code in between.
-            if condition is None and self._mode == _USER and self.in_plan and not self._injected \
-                    and self.ident is not None:
+            if (
+                condition is None
+                and self._mode == _USER
+                and self.in_plan
+                and not self._injected
+                and self.ident is not None
+            ):
                 self._injected = injected = True
                 inject(self.ident, Evaporated)
             elif condition is None and self._mode == _RUNTIME:
@@ -316,8 +336,9 @@ def wait_until(
     return _wait(condition, predicate, timeout, True)
 
 
-def _wait(condition: threading.Condition, predicate: Callable[[], object], timeout: float | None,
-          suspendable: bool) -> bool:
+def _wait(
+    condition: threading.Condition, predicate: Callable[[], object], timeout: float | None, suspendable: bool
+) -> bool:
     runner = current_runner()
     if runner.evaporation_due():
         raise runner.evaporated()
@@ -338,8 +359,14 @@ def _wait(condition: threading.Condition, predicate: Callable[[], object], timeo
         _suspension.block(runner)  # type: ignore[union-attr]
 
 
-def _wait_locked(runner: Runner, condition: threading.Condition, predicate: Callable[[], object],
-                 timeout: float | None, deadline: float | None, suspendable: bool) -> object:
+def _wait_locked(
+    runner: Runner,
+    condition: threading.Condition,
+    predicate: Callable[[], object],
+    timeout: float | None,
+    deadline: float | None,
+    suspendable: bool,
+) -> object:
     """The body of `wait_until`, with `condition` held and the runner in runtime mode.
 
     Returns True / False (predicate / time-out) or `_SUSPENDED` when the task must block for
@@ -398,8 +425,9 @@ def install_suspension_point(point: SuspensionPoint) -> None:
     _suspension = point
 
 
-def wait_unsuspendable(condition: threading.Condition, predicate: Callable[[], object],
-                       timeout: float | None = None) -> bool:
+def wait_unsuspendable(
+    condition: threading.Condition, predicate: Callable[[], object], timeout: float | None = None
+) -> bool:
     """`wait_until` that a suspension does not stop (runtime internal: the suspension block)."""
     return _wait(condition, predicate, timeout, False)
 

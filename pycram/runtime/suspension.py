@@ -40,8 +40,9 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator
+from typing import Any
 
 import pycram.fluent as _fluent
 from pycram.runtime import evaporation as _evaporation

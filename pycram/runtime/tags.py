@@ -22,7 +22,8 @@ around it (as in CRAM). `tag` introduces no parallelism: `fn` runs in the callin
 from __future__ import annotations
 
 import fnmatch
-from typing import Any, Callable, Iterator
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.runtime.evaporation import Evaporated

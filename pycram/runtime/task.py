@@ -17,8 +17,9 @@ import functools
 import itertools
 import sys
 import threading
+from collections.abc import Callable, Iterator
 from enum import Enum
-from typing import Any, Callable, Iterator, Protocol
+from typing import Any, Protocol
 
 import pycram.fluent as _fluent  # imported as a module: pycram.fluent imports this package
 from pycram.runtime.clock import current_clock
@@ -333,8 +334,9 @@ def current_task() -> Task:
     return task
 
 
-def run_subtask(name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", location: str | None = None,
-                **kwargs: Any) -> Any:
+def run_subtask(
+    name: str, fn: Callable[..., Any], *args: Any, kind: str = "task", location: str | None = None, **kwargs: Any
+) -> Any:
     """Run `fn(*args, **kwargs)` as a child task of the current task, in the calling thread.
 
     Returns fn's result or re-raises its exception; the child ends SUCCEEDED, FAILED or

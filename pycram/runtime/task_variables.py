@@ -17,8 +17,9 @@ changed by its own thread).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any, Generic, Iterator, TypeVar
+from typing import Any, Generic, TypeVar
 
 from pycram.runtime.task import Task, current_task
 

@@ -13,7 +13,7 @@ worker running no plan code, never a branch.
 from __future__ import annotations
 
 import threading
-from typing import Callable
+from collections.abc import Callable
 
 __all__ = ["submit", "shutdown_idle_workers", "worker_count", "IDLE_SECONDS"]
 

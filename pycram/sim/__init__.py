@@ -23,8 +23,24 @@ from .types import GripperState, JointStates, Outcome, Pose, Pose2D, VisibleItem
 from .world import World  # noqa: E402
 
 __all__ = [
-    "World", "CommandHandle", "Outcome", "Pose", "Pose2D", "VisibleItem", "GripperState", "JointStates",
-    "ItemSpec", "DEFAULT_ITEMS", "HEAD_CAMERA", "ROBOTS",
-    "Scene", "build_scene", "yaw_to_quat", "FollowView",
-    "SimulationError", "UnknownNameError", "WorldClosedError", "CommandFailed",
+    "World",
+    "CommandHandle",
+    "Outcome",
+    "Pose",
+    "Pose2D",
+    "VisibleItem",
+    "GripperState",
+    "JointStates",
+    "ItemSpec",
+    "DEFAULT_ITEMS",
+    "HEAD_CAMERA",
+    "ROBOTS",
+    "Scene",
+    "build_scene",
+    "yaw_to_quat",
+    "FollowView",
+    "SimulationError",
+    "UnknownNameError",
+    "WorldClosedError",
+    "CommandFailed",
 ]

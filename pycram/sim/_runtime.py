@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any, Iterator
+from typing import Any
 
 _log = logging.getLogger(__name__)
 
@@ -38,6 +39,7 @@ except ImportError:  # pragma: no cover
         def wait_for(self, timeout: float | None = None) -> bool:
             with self._cond:
                 return self._cond.wait_for(lambda: self._value is not None, timeout)
+
 
 try:  # pragma: no cover
     from pycram.runtime.clock import ManualClock, current_clock, set_clock, use_clock  # type: ignore[attr-defined]

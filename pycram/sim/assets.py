@@ -15,11 +15,12 @@ from pathlib import Path
 from .errors import SimulationError
 
 #: The compiler options injected into every URDF (see SIM_NOTES: keep static bodies as links).
-_COMPILER = ('<mujoco><compiler strippath="false" fusestatic="false" balanceinertia="true" '
-             'discardvisual="false"/></mujoco>')
+_COMPILER = (
+    '<mujoco><compiler strippath="false" fusestatic="false" balanceinertia="true" discardvisual="false"/></mujoco>'
+)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def robot_data_dir() -> Path:
     """The `share/example-robot-data` directory of the installed `example-robot-data` package.
 

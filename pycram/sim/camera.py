@@ -64,8 +64,9 @@ class FollowView:
             if body not in names:
                 raise ValueError(f"FollowView: no body {body!r} in the model (bodies: {', '.join(names)})")
 
-    def view(self, model: mujoco.MjModel, data: mujoco.MjData,
-             previous: mujoco.MjvCamera | None = None) -> mujoco.MjvCamera:
+    def view(
+        self, model: mujoco.MjModel, data: mujoco.MjData, previous: mujoco.MjvCamera | None = None
+    ) -> mujoco.MjvCamera:
         """The free camera for the body poses in `data` (kinematics computed), smoothed towards
         from `previous` if given."""
         points = []

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -98,14 +98,18 @@ class BaseDrive(Controller):
 
     channel = "base"
 
-    def __init__(self, goal: Pose2D, tolerance: float = 0.005, yaw_tolerance: float = 0.009,
-                 max_lag: float = 0.06) -> None:
+    def __init__(
+        self, goal: Pose2D, tolerance: float = 0.005, yaw_tolerance: float = 0.009, max_lag: float = 0.06
+    ) -> None:
         self.goal, self.tol, self.yaw_tol, self.max_lag = goal, tolerance, yaw_tolerance, max_lag
 
     def start(self, eng: Engine) -> Outcome | None:
-        refused = invalid_input(goal=(self.goal.x, self.goal.y, self.goal.yaw),
-                                positive_tolerance=self.tol, positive_yaw_tolerance=self.yaw_tol,
-                                positive_max_lag=self.max_lag)
+        refused = invalid_input(
+            goal=(self.goal.x, self.goal.y, self.goal.yaw),
+            positive_tolerance=self.tol,
+            positive_yaw_tolerance=self.yaw_tol,
+            positive_max_lag=self.max_lag,
+        )
         if refused is not None:
             return refused
         b = eng.desc.BASE
@@ -163,18 +167,29 @@ class JointTrajectory(Controller):
     not reached within `settle_time` [s].
     """
 
-    def __init__(self, channel: str, joints: Sequence[str], goal: Sequence[float],
-                 duration: float | None = None, max_velocity: float = 1.0,
-                 tolerance: float = 0.01, settle_time: float = 2.0) -> None:
+    def __init__(
+        self,
+        channel: str,
+        joints: Sequence[str],
+        goal: Sequence[float],
+        duration: float | None = None,
+        max_velocity: float = 1.0,
+        tolerance: float = 0.01,
+        settle_time: float = 2.0,
+    ) -> None:
         self.channel = channel
         self.joints, self.goal = list(joints), np.asarray(goal, float)
         self.duration, self.vmax = duration, max_velocity
         self.tol, self.settle = tolerance, settle_time
 
     def start(self, eng: Engine) -> Outcome | None:
-        refused = invalid_input(goal=self.goal, positive_duration=self.duration,
-                                positive_max_velocity=self.vmax, positive_tolerance=self.tol,
-                                positive_settle_time=self.settle)
+        refused = invalid_input(
+            goal=self.goal,
+            positive_duration=self.duration,
+            positive_max_velocity=self.vmax,
+            positive_tolerance=self.tol,
+            positive_settle_time=self.settle,
+        )
         if refused is not None:
             return refused
         if len(self.goal) != len(self.joints):
@@ -350,8 +365,9 @@ class Reach(Controller):
     when the arm does not get within `tolerance` [m] of the goal.
     """
 
-    def __init__(self, arm: str, goal, use_orientation: bool = True, duration: float | None = None,
-                 tolerance: float = 0.01) -> None:
+    def __init__(
+        self, arm: str, goal, use_orientation: bool = True, duration: float | None = None, tolerance: float = 0.01
+    ) -> None:
         self.channel = f"arm:{arm}"
         self.arm, self.goal, self.use_orientation = arm, goal, use_orientation
         self.duration, self.tol = duration, tolerance
@@ -360,15 +376,20 @@ class Reach(Controller):
     def start(self, eng: Engine) -> Outcome | None:
         from .ik import solve_ik
 
-        refused = invalid_input(position=self.goal.position, orientation=self.goal.orientation,
-                                positive_duration=self.duration, positive_tolerance=self.tol)
+        refused = invalid_input(
+            position=self.goal.position,
+            orientation=self.goal.orientation,
+            positive_duration=self.duration,
+            positive_tolerance=self.tol,
+        )
         if refused is not None:
             return refused
         sol = solve_ik(eng, self.arm, self.goal, self.use_orientation)
         if sol is None:
             return fail("unreachable", f"no IK solution for {self.arm} arm to {self.goal}")
-        self.inner = JointTrajectory(self.channel, eng.desc.ARMS[self.arm]["joints"], sol.positions,
-                                     self.duration, tolerance=0.005)
+        self.inner = JointTrajectory(
+            self.channel, eng.desc.ARMS[self.arm]["joints"], sol.positions, self.duration, tolerance=0.005
+        )
         return self.inner.start(eng)
 
     def update(self, eng: Engine, t: float) -> Outcome | None:

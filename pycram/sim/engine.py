@@ -28,7 +28,7 @@ MIN_GRASP_OPENING = 0.003
 class Gripper:
     """Index data and grasp state of one gripper."""
 
-    def __init__(self, engine: "Engine", name: str, spec: dict) -> None:
+    def __init__(self, engine: Engine, name: str, spec: dict) -> None:
         s = engine.scene
         m = s.model
         self.name = name
@@ -57,9 +57,11 @@ class Gripper:
         scratch.qpos[:] = engine.data.qpos
         jid = s.joint_id(self.joint)
         #: (qpos index, offset, factor) of every joint coupled to the driving one by an equality
-        self.coupled = [(int(m.jnt_qposadr[m.eq_obj1id[e]]), float(m.eq_data[e, 0]), float(m.eq_data[e, 1]))
-                        for e in range(m.neq)
-                        if m.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT and m.eq_obj2id[e] == jid]
+        self.coupled = [
+            (int(m.jnt_qposadr[m.eq_obj1id[e]]), float(m.eq_data[e, 0]), float(m.eq_data[e, 1]))
+            for e in range(m.neq)
+            if m.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT and m.eq_obj2id[e] == jid
+        ]
         widths = []
         for q in self.table_q:
             self.set_qpos(scratch, q)
@@ -103,27 +105,37 @@ class Engine:
         self.camera = scene.camera(HEAD_CAMERA)
         self.tool_sites = {arm: scene.site(tool_site(arm)) for arm in desc.ARMS}
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
-        self.item_geoms = {it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name)
-                           for it in scene.items}
+        self.item_geoms = {
+            it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name) for it in scene.items
+        }
         #: every geom of each item (items of several parts: bowls, plates)
-        self.item_part_geoms = {name: [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == b]
-                                for name, b in self.item_bodies.items()}
+        self.item_part_geoms = {
+            name: [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == b]
+            for name, b in self.item_bodies.items()
+        }
         self.geom_item = {g: name for name, gs in self.item_part_geoms.items() for g in gs}
-        self.item_qpos = {it.name: int(self.model.jnt_qposadr[self.model.body_jntadr[b]])
-                          for it, b in zip(scene.items, self.item_bodies.values())}
-        self.item_dof = {it.name: int(self.model.jnt_dofadr[self.model.body_jntadr[b]])
-                         for it, b in zip(scene.items, self.item_bodies.values())}
+        self.item_qpos = {
+            it.name: int(self.model.jnt_qposadr[self.model.body_jntadr[b]])
+            for it, b in zip(scene.items, self.item_bodies.values())
+        }
+        self.item_dof = {
+            it.name: int(self.model.jnt_dofadr[self.model.body_jntadr[b]])
+            for it, b in zip(scene.items, self.item_bodies.values())
+        }
         # robot joints reported in joint states: everything but the items' free joints and furniture
         furniture_joints = {c.joint_name for c in scene.environment.containers}
-        self.robot_joints = [(self.model.joint(j).name, int(self.model.jnt_qposadr[j]), int(self.model.jnt_dofadr[j]))
-                             for j in range(self.model.njnt)
-                             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
-                             and self.model.joint(j).name not in furniture_joints]
+        self.robot_joints = [
+            (self.model.joint(j).name, int(self.model.jnt_qposadr[j]), int(self.model.jnt_dofadr[j]))
+            for j in range(self.model.njnt)
+            if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE and self.model.joint(j).name not in furniture_joints
+        ]
         from .furniture import Furniture  # (furniture's controllers import this module)
 
         self.furniture = Furniture(self)
-        self.obstacles = {f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])
-                          for i in range(self._count_obstacles())}
+        self.obstacles = {
+            f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])
+            for i in range(self._count_obstacles())
+        }
         self.obstacles_used: set[str] = set()
         self._aside_count = 0
 
@@ -178,8 +190,11 @@ class Engine:
 
     def joint_states(self) -> JointStates:
         qp, qv = self.data.qpos, self.data.qvel
-        return JointStates(self.time, {n: float(qp[a]) for n, a, _ in self.robot_joints},
-                           {n: float(qv[d]) for n, a, d in self.robot_joints})
+        return JointStates(
+            self.time,
+            {n: float(qp[a]) for n, a, _ in self.robot_joints},
+            {n: float(qv[d]) for n, a, d in self.robot_joints},
+        )
 
     def gripper_state(self, name: str) -> GripperState:
         """Opening [m], held item and effort [N] at the finger tips of gripper `name`."""
@@ -272,16 +287,20 @@ class Engine:
         return None
 
     # --- fault injection ------------------------------------------------------------------
-    def set_item_pose(self, item: str, position: tuple[float, float, float],
-                      orientation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)) -> None:
+    def set_item_pose(
+        self,
+        item: str,
+        position: tuple[float, float, float],
+        orientation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
+    ) -> None:
         """Put `item` at a pose with zero velocity (releasing any grasp first)."""
         g = self.holder_of(item)
         if g is not None:
             self.release(g)
         a, d = self.item_qpos[item], self.item_dof[item]
-        self.data.qpos[a:a + 3] = position
-        self.data.qpos[a + 3:a + 7] = orientation
-        self.data.qvel[d:d + 6] = 0.0
+        self.data.qpos[a : a + 3] = position
+        self.data.qpos[a + 3 : a + 7] = orientation
+        self.data.qvel[d : d + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
 
     def aside_position(self, item: str) -> tuple[float, float, float]:

@@ -56,8 +56,9 @@ def look_at_quat(position: tuple[float, float, float], target: tuple[float, floa
 
 
 def _geom(body: mujoco.MjsBody, name: str, pos, half, rgba, group: int | None, **kw) -> mujoco.MjsGeom:
-    geom = body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=list(pos), size=list(half),
-                         rgba=list(rgba), **kw)
+    geom = body.add_geom(
+        name=name, type=mujoco.mjtGeom.mjGEOM_BOX, pos=list(pos), size=list(half), rgba=list(rgba), **kw
+    )
     if group is None:
         geom.contype = 0
         geom.conaffinity = 0
@@ -73,19 +74,35 @@ def _static_box(body: mujoco.MjsBody, box: Box) -> None:
 def add_environment(spec: mujoco.MjSpec, env: Environment) -> None:
     """Add floor, light, static geometry, surfaces, containers, obstacles and the overview camera."""
     world = spec.worldbody
-    tex = spec.add_texture(name="floor_tex", type=mujoco.mjtTexture.mjTEXTURE_2D,
-                           builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, width=256, height=256,
-                           rgb1=[0.62, 0.6, 0.55], rgb2=[0.52, 0.5, 0.46])
+    tex = spec.add_texture(
+        name="floor_tex",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        width=256,
+        height=256,
+        rgb1=[0.62, 0.6, 0.55],
+        rgb2=[0.52, 0.5, 0.46],
+    )
     mat = spec.add_material(name="floor_mat", texrepeat=[8, 8], reflectance=0.0)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
     x0, y0, x1, y1 = env.extent
-    floor = world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                           size=[(x1 - x0) / 2, (y1 - y0) / 2, 0.1],
-                           pos=[(x0 + x1) / 2, (y0 + y1) / 2, 0.0], material="floor_mat")
+    floor = world.add_geom(
+        name="floor",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[(x1 - x0) / 2, (y1 - y0) / 2, 0.1],
+        pos=[(x0 + x1) / 2, (y0 + y1) / 2, 0.0],
+        material="floor_mat",
+    )
     collision.set_group(floor, collision.FLOOR)
     cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
-    world.add_light(name="sun", pos=[cx, cy - 0.5, 4.0], dir=[-0.2, 0.1, -1.0], castshadow=False,
-                    diffuse=[0.7, 0.7, 0.7], ambient=[0.25, 0.25, 0.25])
+    world.add_light(
+        name="sun",
+        pos=[cx, cy - 0.5, 4.0],
+        dir=[-0.2, 0.1, -1.0],
+        castshadow=False,
+        diffuse=[0.7, 0.7, 0.7],
+        ambient=[0.25, 0.25, 0.25],
+    )
     fixed = world.add_body(name="environment")
     for box in env.static:
         _static_box(fixed, box)
@@ -93,8 +110,13 @@ def add_environment(spec: mujoco.MjSpec, env: Environment) -> None:
         x, y, z = surface.centroid
         if surface.kind == "cooker":
             bx0, by0, bx1, by1 = surface.bounds
-            g = fixed.add_geom(name=surface.name, type=mujoco.mjtGeom.mjGEOM_CYLINDER, pos=[x, y, z + 0.005],
-                               size=[min(bx1 - bx0, by1 - by0) / 2, 0.002, 0], rgba=_COOKER_RGBA)
+            g = fixed.add_geom(
+                name=surface.name,
+                type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                pos=[x, y, z + 0.005],
+                size=[min(bx1 - bx0, by1 - by0) / 2, 0.002, 0],
+                rgba=_COOKER_RGBA,
+            )
             g.contype = 0
             g.conaffinity = 0
         fixed.add_site(name=surface.name, pos=[x, y, z], size=[0.01, 0.01, 0.01], rgba=[0, 0, 0, 0])
@@ -102,15 +124,23 @@ def add_environment(spec: mujoco.MjSpec, env: Environment) -> None:
         _add_container(spec, container)
     for i in range(N_OBSTACLES):
         body = world.add_body(name=f"obstacle_{i}", mocap=True, pos=list(OBSTACLE_PARKING))
-        g = body.add_geom(name=f"obstacle_{i}", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.15, 0.15, 0.5],
-                          pos=[0, 0, 0.5], rgba=[0.9, 0.5, 0.1, 1])
+        g = body.add_geom(
+            name=f"obstacle_{i}",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[0.15, 0.15, 0.5],
+            pos=[0, 0, 0.5],
+            rgba=[0.9, 0.5, 0.1, 1],
+        )
         collision.set_group(g, collision.ENVIRONMENT)
     cam = env.camera
-    world.add_camera(name=cam.name, pos=list(cam.position), fovy=cam.fovy,
-                     quat=look_at_quat(cam.position, cam.target))
+    world.add_camera(name=cam.name, pos=list(cam.position), fovy=cam.fovy, quat=look_at_quat(cam.position, cam.target))
     px0, py0, px1, py1 = plan_view(env)
-    top = world.add_camera(name=PLAN_CAMERA, pos=[(px0 + px1) / 2, (py0 + py1) / 2, PLAN_CAMERA_HEIGHT],
-                           fovy=py1 - py0, quat=look_at_quat((0, 0, 1), (0, 0, 0)))
+    top = world.add_camera(
+        name=PLAN_CAMERA,
+        pos=[(px0 + px1) / 2, (py0 + py1) / 2, PLAN_CAMERA_HEIGHT],
+        fovy=py1 - py0,
+        quat=look_at_quat((0, 0, 1), (0, 0, 0)),
+    )
     top.proj = mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC
 
 
@@ -135,8 +165,14 @@ def _add_container(spec: mujoco.MjSpec, c: Container) -> None:
         origin = np.array([c.hinge[0], c.hinge[1], box.center[2]])  # type: ignore[index]
     body = spec.worldbody.add_body(name=c.name, pos=origin.tolist())
     dx, dy = c.opening_direction
-    joint = body.add_joint(name=c.joint_name, damping=c.damping, frictionloss=c.friction, armature=0.02,
-                           limited=mujoco.mjtLimited.mjLIMITED_TRUE, range=list(c.limits))
+    joint = body.add_joint(
+        name=c.joint_name,
+        damping=c.damping,
+        frictionloss=c.friction,
+        armature=0.02,
+        limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+        range=list(c.limits),
+    )
     if c.kind == "drawer":
         joint.type = mujoco.mjtJoint.mjJNT_SLIDE
         joint.axis = [dx, dy, 0.0]
@@ -169,11 +205,20 @@ def _add_container(spec: mujoco.MjSpec, c: Container) -> None:
         half = 0.008 * (np.ones(3) - np.abs(normal)) + np.abs(normal) * _HANDLE_STANDOFF / 2
         _geom(body, f"{c.name}:handle_post{side:+d}", pos, half, _HANDLE_RGBA, env, density=2000.0)
     body.add_site(name=c.handle_site, pos=handle.tolist(), size=[0.012, 0.012, 0.012], rgba=[0, 0, 0, 0])
-    eq = spec.add_equality(name=stuck_equality(c.name), type=mujoco.mjtEq.mjEQ_JOINT,
-                           objtype=mujoco.mjtObj.mjOBJ_JOINT, name1=c.joint_name)
+    eq = spec.add_equality(
+        name=stuck_equality(c.name), type=mujoco.mjtEq.mjEQ_JOINT, objtype=mujoco.mjtObj.mjOBJ_JOINT, name1=c.joint_name
+    )
     eq.active = False
     eq.solref = [0.005, 1.0]
 
 
-__all__ = ["add_environment", "look_at_quat", "stuck_equality", "plan_view", "N_OBSTACLES", "OBSTACLE_PARKING",
-           "PLAN_CAMERA", "PLAN_ASPECT"]
+__all__ = [
+    "add_environment",
+    "look_at_quat",
+    "stuck_equality",
+    "plan_view",
+    "N_OBSTACLES",
+    "OBSTACLE_PARKING",
+    "PLAN_CAMERA",
+    "PLAN_ASPECT",
+]

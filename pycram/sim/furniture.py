@@ -8,7 +8,7 @@ and stay where they are left. A stuck container is held where it is by its joint
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -55,8 +55,9 @@ class ContainerPush(Controller):
     joint position at the end [m or rad].
     """
 
-    def __init__(self, name: str, force: Sequence[float], duration: float,
-                 point: Sequence[float] | None = None) -> None:
+    def __init__(
+        self, name: str, force: Sequence[float], duration: float, point: Sequence[float] | None = None
+    ) -> None:
         self.name, self.force, self.duration = name, np.asarray(force, float), float(duration)
         self.point = None if point is None else np.asarray(point, float)
         self.channel = f"hand:{name}"

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import logging
 import struct
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 from PIL import GifImagePlugin, Image
@@ -61,10 +61,11 @@ class GifEncoder:
 
     # ------------------------------------------------------------------ adding
     def _set_palette(self, rgb: np.ndarray) -> None:
-        quantized = Image.fromarray(rgb).quantize(_ADAPTIVE_COLOURS, method=Image.Quantize.MEDIANCUT,
-                                                  dither=Image.Dither.NONE)
+        quantized = Image.fromarray(rgb).quantize(
+            _ADAPTIVE_COLOURS, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE
+        )
         used = int(np.asarray(quantized).max()) + 1
-        colours = bytes(quantized.getpalette() or [])[:3 * used] + _CUBE
+        colours = bytes(quantized.getpalette() or [])[: 3 * used] + _CUBE
         self._palette_image = Image.new("P", (1, 1))
         self._palette_image.putpalette(colours)
         self._palette_bytes = colours

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import itertools
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from ._runtime import Fluent
 from .errors import CommandFailed
@@ -20,7 +21,7 @@ class CommandHandle:
     world closed). Every method is thread-safe.
     """
 
-    def __init__(self, name: str, canceller: Callable[["CommandHandle"], None]) -> None:
+    def __init__(self, name: str, canceller: Callable[[CommandHandle], None]) -> None:
         self.id = next(_ids)
         self.name = name
         self.result = Fluent(None, name=f"{name}#{self.id}.result")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import mujoco
 import numpy as np
@@ -25,10 +25,18 @@ class IKSolution:
     orientation_error: float
 
 
-def solve_ik(eng: Engine, arm: str, goal: Pose, use_orientation: bool = True,
-             seeds: Sequence[Sequence[float]] = (), position_tolerance: float = 0.002,
-             orientation_tolerance: float = 0.02, iterations: int = 400, damping: float = 0.02,
-             rng_seed: int = 0) -> IKSolution | None:
+def solve_ik(
+    eng: Engine,
+    arm: str,
+    goal: Pose,
+    use_orientation: bool = True,
+    seeds: Sequence[Sequence[float]] = (),
+    position_tolerance: float = 0.002,
+    orientation_tolerance: float = 0.02,
+    iterations: int = 400,
+    damping: float = 0.02,
+    rng_seed: int = 0,
+) -> IKSolution | None:
     """Arm joint positions that put the tool site of `arm` at `goal` (map frame), or None.
 
     Uses a scratch copy of the current state (the base and torso stay where they are). Tries the
@@ -57,23 +65,52 @@ def solve_ik(eng: Engine, arm: str, goal: Pose, use_orientation: bool = True,
         candidates.append(r)
     best: IKSolution | None = None
     for seed in candidates:
-        sol, converged = dls_ik(m, scratch, site, qadr, dadr, lo, hi, target_p,
-                                target_q if use_orientation else None, seed, iterations, damping,
-                                position_tolerance, orientation_tolerance)
+        sol, converged = dls_ik(
+            m,
+            scratch,
+            site,
+            qadr,
+            dadr,
+            lo,
+            hi,
+            target_p,
+            target_q if use_orientation else None,
+            seed,
+            iterations,
+            damping,
+            position_tolerance,
+            orientation_tolerance,
+        )
         if converged:
             return sol
         if best is None or sol.position_error < best.position_error:
             best = sol
-    _log.debug("IK for %s failed; best errors %.3f m / %.3f rad", arm, best.position_error if best else -1,
-               best.orientation_error if best else -1)
+    _log.debug(
+        "IK for %s failed; best errors %.3f m / %.3f rad",
+        arm,
+        best.position_error if best else -1,
+        best.orientation_error if best else -1,
+    )
     return None
 
 
-def dls_ik(model: mujoco.MjModel, data: mujoco.MjData, site: int, qadr: np.ndarray, dadr: np.ndarray,
-           lo: np.ndarray, hi: np.ndarray, target_p: np.ndarray, target_q: np.ndarray | None,
-           seed: Sequence[float], iterations: int = 400, damping: float = 0.02,
-           position_tolerance: float = 0.002, orientation_tolerance: float = 0.02,
-           stall_window: int = 0) -> tuple[IKSolution, bool]:
+def dls_ik(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    site: int,
+    qadr: np.ndarray,
+    dadr: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    target_p: np.ndarray,
+    target_q: np.ndarray | None,
+    seed: Sequence[float],
+    iterations: int = 400,
+    damping: float = 0.02,
+    position_tolerance: float = 0.002,
+    orientation_tolerance: float = 0.02,
+    stall_window: int = 0,
+) -> tuple[IKSolution, bool]:
     """Damped least squares from `seed` for the joints at qpos `qadr` / dofs `dadr`, clipped to
     [`lo`, `hi`], moving `site` to `target_p` [m] (and `target_q` (w, x, y, z) unless None).
 
@@ -87,7 +124,7 @@ def dls_ik(model: mujoco.MjModel, data: mujoco.MjData, site: int, qadr: np.ndarr
     rows = 6 if target_q is not None else 3
     J = np.zeros((rows, len(dadr)))
     e = np.zeros(rows)
-    damp = np.eye(rows) * damping ** 2
+    damp = np.eye(rows) * damping**2
     q = np.clip(np.asarray(seed, float), lo, hi)
     pe = re = float("inf")
     history: list[float] = []

@@ -32,8 +32,9 @@ class ItemSpec:
     yaw: float = 0.0
 
     @classmethod
-    def of(cls, object_type: ObjectType, name: str, position: tuple[float, float, float | None],
-           yaw: float = 0.0) -> "ItemSpec":
+    def of(
+        cls, object_type: ObjectType, name: str, position: tuple[float, float, float | None], yaw: float = 0.0
+    ) -> ItemSpec:
         """An item of `object_type` called `name` at `position` [m] turned by `yaw` [rad]."""
         t = object_type
         return cls(name, t.name, t.shape, t.size, t.mass, position, t.rgba, yaw)
@@ -67,8 +68,9 @@ def add_item(spec: mujoco.MjSpec, item: ItemSpec, position: tuple[float, float, 
     """Add `item` at `position` [m] as a free body named `item.name`, with one collision geom per
     part of its shape (the first named like the item); the parts share the item's mass."""
     half_yaw = 0.5 * item.yaw
-    body = spec.worldbody.add_body(name=item.name, pos=list(position),
-                                   quat=[math.cos(half_yaw), 0.0, 0.0, math.sin(half_yaw)])
+    body = spec.worldbody.add_body(
+        name=item.name, pos=list(position), quat=[math.cos(half_yaw), 0.0, 0.0, math.sin(half_yaw)]
+    )
     body.add_freejoint(name=f"{item.name}_free")
     parts = shape_parts(item.shape, item.size)
     volumes = [_volume(p.kind, p.size) for p in parts]
@@ -77,10 +79,17 @@ def add_item(spec: mujoco.MjSpec, item: ItemSpec, position: tuple[float, float, 
             gtype, size = mujoco.mjtGeom.mjGEOM_BOX, list(part.size)
         else:
             gtype, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [part.size[0], part.size[1], 0.0]
-        geom = body.add_geom(name=part_geom_name(item.name, i), type=gtype, size=size, pos=list(part.pos),
-                             quat=[math.cos(part.yaw / 2), 0.0, 0.0, math.sin(part.yaw / 2)],
-                             mass=item.mass * volume / sum(volumes), rgba=list(item.rgba),
-                             friction=[1.2, 0.01, 0.001], condim=4)
+        geom = body.add_geom(
+            name=part_geom_name(item.name, i),
+            type=gtype,
+            size=size,
+            pos=list(part.pos),
+            quat=[math.cos(part.yaw / 2), 0.0, 0.0, math.sin(part.yaw / 2)],
+            mass=item.mass * volume / sum(volumes),
+            rgba=list(item.rgba),
+            friction=[1.2, 0.01, 0.001],
+            condim=4,
+        )
         collision.set_group(geom, collision.ITEM)
 
 

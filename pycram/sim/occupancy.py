@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from pycram.world.navigation import Footprint, OccupancyGrid, dilate
+from pycram.world.navigation import Footprint, OccupancyGrid
 
 from .scene import Scene
 
@@ -42,11 +42,11 @@ def local_vertices(model: mujoco.MjModel, geom: int, directions: int = 0) -> np.
     if gtype == mujoco.mjtGeom.mjGEOM_MESH and model.geom_dataid[geom] >= 0:
         mesh = int(model.geom_dataid[geom])
         adr, num = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-        local = np.asarray(model.mesh_vert[adr:adr + num], float)
+        local = np.asarray(model.mesh_vert[adr : adr + num], float)
         if directions and num > directions:
             k = np.arange(directions) + 0.5  # a Fibonacci sphere
             z = 1.0 - 2.0 * k / directions
-            phi = np.pi * (1.0 + 5 ** 0.5) * k
+            phi = np.pi * (1.0 + 5**0.5) * k
             r = np.sqrt(1.0 - z * z)
             dirs = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
             local = local[np.unique(np.argmax(local @ dirs.T, axis=0))]
@@ -57,8 +57,7 @@ def local_vertices(model: mujoco.MjModel, geom: int, directions: int = 0) -> np.
     return center + _UNIT_BOX * half
 
 
-def geom_vertices(model: mujoco.MjModel, data: mujoco.MjData, geom: int,
-                  local: np.ndarray | None = None) -> np.ndarray:
+def geom_vertices(model: mujoco.MjModel, data: mujoco.MjData, geom: int, local: np.ndarray | None = None) -> np.ndarray:
     """Points (n x 3, map frame [m]) whose convex hull contains `geom` at its current pose
     (`local`: its points in the geom frame, when already known)."""
     if local is None:
@@ -76,8 +75,11 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
     def half(seq: list) -> list:
         out: list = []
         for p in seq:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+            while (
+                len(out) >= 2
+                and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1]) - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0]))
+                <= 0
+            ):
                 out.pop()
             out.append(p)
         return out
@@ -142,9 +144,13 @@ class FloorMap:
 
     def movable_state(self, data: mujoco.MjData) -> np.ndarray:
         """The part of the state that moves movable geoms (to notice changes cheaply)."""
-        return np.concatenate([data.mocap_pos[list(self.mocap_ids)].ravel(),
-                               data.mocap_quat[list(self.mocap_ids)].ravel(),
-                               data.qpos[list(self.qpos_addresses)]])
+        return np.concatenate(
+            [
+                data.mocap_pos[list(self.mocap_ids)].ravel(),
+                data.mocap_quat[list(self.mocap_ids)].ravel(),
+                data.qpos[list(self.qpos_addresses)],
+            ]
+        )
 
 
 def band_top(z: float) -> float:
@@ -152,8 +158,9 @@ def band_top(z: float) -> float:
     return min(MAX_HEIGHT, math.ceil(z / BAND - 1e-9) * BAND)
 
 
-def _add(bands: dict[float, np.ndarray], floor: "FloorMap", model: mujoco.MjModel,
-         data: mujoco.MjData, geom: int) -> None:
+def _add(
+    bands: dict[float, np.ndarray], floor: FloorMap, model: mujoco.MjModel, data: mujoco.MjData, geom: int
+) -> None:
     """Rasterize `geom` into the band of its top (if it can touch the robot at all)."""
     verts = geom_vertices(model, data, geom)
     if verts[:, 2].max() < MIN_HEIGHT or verts[:, 2].min() > MAX_HEIGHT:
@@ -171,8 +178,9 @@ def _moves(model: mujoco.MjModel, body: int) -> bool:
     return False
 
 
-def build_floor_map(scene: Scene, data: mujoco.MjData, resolution: float = RESOLUTION,
-                    margin: float = MAP_MARGIN) -> FloorMap:
+def build_floor_map(
+    scene: Scene, data: mujoco.MjData, resolution: float = RESOLUTION, margin: float = MAP_MARGIN
+) -> FloorMap:
     """Rasterize the static environment of `scene` (state `data`, kinematics computed)."""
     model = scene.model
     env = sorted(scene.environment_geoms)
@@ -194,11 +202,23 @@ def build_floor_map(scene: Scene, data: mujoco.MjData, resolution: float = RESOL
             if model.body_mocapid[b] >= 0:
                 mocaps.add(int(model.body_mocapid[b]))
             for j in range(int(model.body_jntadr[b]), int(model.body_jntadr[b] + model.body_jntnum[b])):
-                qadr.update(range(int(model.jnt_qposadr[j]),
-                                  int(model.jnt_qposadr[j]) + (7 if model.jnt_type[j] == 0 else 4 if model.jnt_type[j] == 1 else 1)))
+                qadr.update(
+                    range(
+                        int(model.jnt_qposadr[j]),
+                        int(model.jnt_qposadr[j])
+                        + (7 if model.jnt_type[j] == 0 else 4 if model.jnt_type[j] == 1 else 1),
+                    )
+                )
             b = int(model.body_parentid[b])
-    return FloorMap(origin, resolution, dict(sorted(floor.static.items())), movable, tuple(sorted(mocaps)),
-                    tuple(sorted(qadr)), shape)
+    return FloorMap(
+        origin,
+        resolution,
+        dict(sorted(floor.static.items())),
+        movable,
+        tuple(sorted(mocaps)),
+        tuple(sorted(qadr)),
+        shape,
+    )
 
 
 def base_footprint(scene: Scene, data: mujoco.MjData) -> Footprint:
@@ -247,8 +267,9 @@ def descends(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
     return False
 
 
-def body_outline(scene: Scene, data: mujoco.MjData, below: float, parts: list[dict[int, np.ndarray]]
-                 ) -> list[Footprint]:
+def body_outline(
+    scene: Scene, data: mujoco.MjData, below: float, parts: list[dict[int, np.ndarray]]
+) -> list[Footprint]:
     """The outline on the floor, in the base frame, of the robot as it stands in `data`: one
     convex footprint per part of `robot_parts` (the base's first, always including the base
     geoms), counting only the parts of the geoms below `below` [m]."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
@@ -47,10 +47,10 @@ class Navigation:
     def __init__(self, eng: Engine) -> None:
         self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
         self.footprint: Footprint = base_footprint(eng.scene, eng.data)
-        self._state: Optional[np.ndarray] = None
+        self._state: np.ndarray | None = None
         self._outline = np.zeros(0)
         self._robot_parts = robot_parts(eng.scene)
-        self._planner: Optional[PathPlanner] = None
+        self._planner: PathPlanner | None = None
         self._robot_state = StateSnapshot.of(eng.data)
         # no tolerance: a drive fails on any contact
         self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=0.0)
@@ -79,8 +79,12 @@ class Navigation:
         outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, self._robot_parts) for top in bands}
         # the robot's pose, to the cm
         key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
-        if (self._planner is not None and not moved and key.shape == self._outline.shape
-                and float(np.abs(key - self._outline).max(initial=0.0)) <= MOVED):
+        if (
+            self._planner is not None
+            and not moved
+            and key.shape == self._outline.shape
+            and float(np.abs(key - self._outline).max(initial=0.0)) <= MOVED
+        ):
             return self._planner, False
         self._state, self._outline = state, key
         layers = [(mask, outlines[top]) for top, mask in bands.items()]
@@ -128,11 +132,11 @@ class PlannedDrive(Controller):
     def __init__(self, goal: Pose2D) -> None:
         self.goal = goal
         self.waypoints: list[BasePose] = []
-        self.segment: Optional[BaseDrive] = None
+        self.segment: BaseDrive | None = None
         self.stopping = False
         self.replans = 0
 
-    def _plan(self, eng: Engine) -> Optional[Outcome]:
+    def _plan(self, eng: Engine) -> Outcome | None:
         nav = navigation_of(eng)
         planner, _ = nav.planner(eng)
         here = eng.base_pose()
@@ -141,11 +145,15 @@ class PlannedDrive(Controller):
         except NoPathError as exc:
             return fail("no_path", str(exc), here)
         if len(self.waypoints) > 1:
-            _log.info("drive to (%.2f, %.2f): path around obstacles with %d waypoints",
-                      self.goal.x, self.goal.y, len(self.waypoints))
+            _log.info(
+                "drive to (%.2f, %.2f): path around obstacles with %d waypoints",
+                self.goal.x,
+                self.goal.y,
+                len(self.waypoints),
+            )
         return self._next_segment(eng)
 
-    def _next_segment(self, eng: Engine) -> Optional[Outcome]:
+    def _next_segment(self, eng: Engine) -> Outcome | None:
         w = self.waypoints.pop(0)
         if self.waypoints:
             self.segment = BaseDrive(Pose2D(w.x, w.y, w.yaw), *WAYPOINT_TOLERANCE)
@@ -153,18 +161,21 @@ class PlannedDrive(Controller):
             self.segment = BaseDrive(self.goal)
         return self.segment.start(eng)
 
-    def start(self, eng: Engine) -> Optional[Outcome]:
+    def start(self, eng: Engine) -> Outcome | None:
         refused = invalid_input(goal=(self.goal.x, self.goal.y, self.goal.yaw))
         if refused is not None:  # "invalid" before anything is planned or moves, as BaseDrive
             return refused
         return self._plan(eng)
 
     def _remaining_free(self, eng: Engine, planner: PathPlanner) -> bool:
-        rest = ([BasePose(self.segment.goal.x, self.segment.goal.y, self.segment.goal.yaw)]
-                if self.segment is not None else []) + self.waypoints
+        rest = (
+            [BasePose(self.segment.goal.x, self.segment.goal.y, self.segment.goal.yaw)]
+            if self.segment is not None
+            else []
+        ) + self.waypoints
         return planner.path_free(_pose(eng.base_pose()), rest, navigation_of(eng).exact_check(eng))
 
-    def update(self, eng: Engine, t: float) -> Optional[Outcome]:
+    def update(self, eng: Engine, t: float) -> Outcome | None:
         if self.stopping:
             v = math.hypot(*(float(eng.data.qvel[i]) for i in eng.base_dof[:2]))
             if v > STOPPED_SPEED or abs(float(eng.data.qvel[eng.base_dof[2]])) > STOPPED_SPEED * 10:

@@ -70,13 +70,20 @@ def _back_project(view: CameraView, rows: np.ndarray, cols: np.ndarray) -> np.nd
     width, height = view.size
     focal = 0.5 * height / math.tan(math.radians(view.fovy) / 2.0)
     depth = view.depth[rows, cols]
-    local = np.stack([(cols + 0.5 - width / 2.0) / focal * depth,
-                      -(rows + 0.5 - height / 2.0) / focal * depth, -depth], axis=1)
+    local = np.stack(
+        [(cols + 0.5 - width / 2.0) / focal * depth, -(rows + 0.5 - height / 2.0) / focal * depth, -depth], axis=1
+    )
     return local @ np.asarray(view.rotation, float).reshape(3, 3).T + np.asarray(view.position, float)
 
 
-def _measure(view: CameraView, type_name: str, points: np.ndarray, colours: np.ndarray,
-             environment: Environment, container_states: dict[str, float]) -> Detection:
+def _measure(
+    view: CameraView,
+    type_name: str,
+    points: np.ndarray,
+    colours: np.ndarray,
+    environment: Environment,
+    container_states: dict[str, float],
+) -> Detection:
     """A detection from an object's visible pixels: their map `points` [m] and `colours`."""
     # horizontal axes of the view: across it and along it (away from the camera)
     rotation = np.asarray(view.rotation, float).reshape(3, 3)
@@ -97,16 +104,30 @@ def _measure(view: CameraView, type_name: str, points: np.ndarray, colours: np.n
     bottom = surface.height if surface is not None else max(0.0, lowest)
     container = None if surface is None else environment.container_of(surface.name)
     mean = colours.mean(axis=0) / 255.0
-    return Detection(type_name, (x, y, (top + bottom) / 2.0), (width, depth, top - bottom),
-                     color_name(mean), tuple(float(c) for c in mean),
-                     None if surface is None else surface.name, None if container is None else container.name,
-                     int(len(points)))
+    return Detection(
+        type_name,
+        (x, y, (top + bottom) / 2.0),
+        (width, depth, top - bottom),
+        color_name(mean),
+        tuple(float(c) for c in mean),
+        None if surface is None else surface.name,
+        None if container is None else container.name,
+        int(len(points)),
+    )
 
 
-def measure_detections(ids: np.ndarray, depth: np.ndarray, rgb: np.ndarray, view: CameraView,
-                       objects: dict[str, tuple[str, list[int]]], environment: Environment,
-                       container_states: dict[str, float], faults: PerceptionFaults,
-                       rng: np.random.Generator, min_pixels: int = MIN_PIXELS) -> list[Detection]:
+def measure_detections(
+    ids: np.ndarray,
+    depth: np.ndarray,
+    rgb: np.ndarray,
+    view: CameraView,
+    objects: dict[str, tuple[str, list[int]]],
+    environment: Environment,
+    container_states: dict[str, float],
+    faults: PerceptionFaults,
+    rng: np.random.Generator,
+    min_pixels: int = MIN_PIXELS,
+) -> list[Detection]:
     """The detections in one look: `ids` geom ids per pixel (-1: none), `depth` [m] and `rgb`
     images of the same camera; `objects` maps each object to (type, its geoms). Most visible
     first."""
@@ -140,8 +161,14 @@ def _replace(detection: Detection, **changes: object) -> Detection:
     return replace(detection, **changes)
 
 
-def view_of(position: np.ndarray, rotation: np.ndarray, fovy: float, depth: np.ndarray,
-            max_range: float = MAX_RANGE) -> CameraView:
+def view_of(
+    position: np.ndarray, rotation: np.ndarray, fovy: float, depth: np.ndarray, max_range: float = MAX_RANGE
+) -> CameraView:
     """A `CameraView` from a camera's map position, rotation matrix and depth image."""
-    return CameraView(tuple(float(v) for v in position), np.asarray(rotation, float).reshape(3, 3).copy(),
-                      float(fovy), depth, max_range)
+    return CameraView(
+        tuple(float(v) for v in position),
+        np.asarray(rotation, float).reshape(3, 3).copy(),
+        float(fovy),
+        depth,
+        max_range,
+    )

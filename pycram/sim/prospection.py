@@ -18,14 +18,14 @@ from __future__ import annotations
 
 import math
 import queue
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator, Mapping, Optional, Sequence
+from typing import Any
 
 import mujoco
 import numpy as np
 
-from pycram.world.prospection import (Prospection, Reachability, ToolPose, Visibility, as_base_pose,
-                                      as_tool_pose)
+from pycram.world.prospection import Prospection, Reachability, ToolPose, Visibility, as_base_pose, as_tool_pose
 
 from .ik import dls_ik
 from .occupancy import descends
@@ -66,14 +66,16 @@ class _Arm:
         self.hi = np.where(limited, m.jnt_range[jids, 1], np.inf)
         self.limited = limited
         self.site = scene.site(tool_site(arm))
-        self.configurations = [np.asarray(c, float) for _, c in
-                               sorted(scene.description.ARM_CONFIGURATIONS[arm].items())]
+        self.configurations = [
+            np.asarray(c, float) for _, c in sorted(scene.description.ARM_CONFIGURATIONS[arm].items())
+        ]
         rng = np.random.default_rng(0)
-        self.random_seeds = [rng.uniform(np.where(limited, self.lo, -np.pi), np.where(limited, self.hi, np.pi))
-                             for _ in range(2)]
+        self.random_seeds = [
+            rng.uniform(np.where(limited, self.lo, -np.pi), np.where(limited, self.hi, np.pi)) for _ in range(2)
+        ]
         self.reach = 0.0  # [m] from the first joint's anchor; measured by SimProspection
 
-    def seeds(self, current: np.ndarray, previous: Optional[np.ndarray]) -> list[np.ndarray]:
+    def seeds(self, current: np.ndarray, previous: np.ndarray | None) -> list[np.ndarray]:
         out = [] if previous is None else [previous]
         return out + [current] + self.configurations + self.random_seeds
 
@@ -86,18 +88,20 @@ class SimProspection(Prospection):
     reference read is enough: snapshots are immutable once published).
     """
 
-    def __init__(self, scene: Scene, snapshot: Callable[[], StateSnapshot],
-                 tolerance: float = COLLISION_TOLERANCE) -> None:
+    def __init__(
+        self, scene: Scene, snapshot: Callable[[], StateSnapshot], tolerance: float = COLLISION_TOLERANCE
+    ) -> None:
         self.scene = scene
         self.tolerance = tolerance
         self.model = scene.model
         self._snapshot = snapshot
-        self._pool: "queue.SimpleQueue[mujoco.MjData]" = queue.SimpleQueue()
+        self._pool: queue.SimpleQueue[mujoco.MjData] = queue.SimpleQueue()
         m = self.model
         desc = scene.description
         self._base_qpos = [scene.joint_qpos(j) for j in BASE_JOINTS]
-        self._joint_qpos = {m.joint(j).name: int(m.jnt_qposadr[j]) for j in range(m.njnt)
-                            if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE}
+        self._joint_qpos = {
+            m.joint(j).name: int(m.jnt_qposadr[j]) for j in range(m.njnt) if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
+        }
         self._is_robot = np.zeros(m.ngeom, bool)
         self._is_robot[list(scene.robot_geoms)] = True
         self._is_env = np.zeros(m.ngeom, bool)
@@ -137,8 +141,7 @@ class SimProspection(Prospection):
         finally:
             self._pool.put(d)
 
-    def _prepare(self, d: mujoco.MjData, base_pose: Any,
-                 joint_configuration: Optional[Mapping[str, float]]) -> None:
+    def _prepare(self, d: mujoco.MjData, base_pose: Any, joint_configuration: Mapping[str, float] | None) -> None:
         """`d` := the latest snapshot, the base at `base_pose`, joints as configured; kinematics."""
         pose = as_base_pose(base_pose)
         snap = self._snapshot()
@@ -151,8 +154,9 @@ class SimProspection(Prospection):
             for name, value in joint_configuration.items():
                 adr = self._joint_qpos.get(name)
                 if adr is None:
-                    raise ValueError(f"unknown joint {name!r} of {self.scene.robot}; valid joints: "
-                                     f"{sorted(self._joint_qpos)}")
+                    raise ValueError(
+                        f"unknown joint {name!r} of {self.scene.robot}; valid joints: {sorted(self._joint_qpos)}"
+                    )
                 d.qpos[adr] = float(value)
         mujoco.mj_kinematics(self.model, d)
 
@@ -181,14 +185,14 @@ class SimProspection(Prospection):
         return name or self.model.body(int(self.model.geom_bodyid[g])).name
 
     # ------------------------------------------------------------------ collision
-    def collisions(self, base_pose: Any,
-                   joint_configuration: Optional[Mapping[str, float]] = None) -> list[tuple[str, str]]:
+    def collisions(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None
+    ) -> list[tuple[str, str]]:
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
             return self._contacts(d)
 
-    def in_collision(self, base_pose: Any,
-                     joint_configuration: Optional[Mapping[str, float]] = None) -> bool:
+    def in_collision(self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> bool:
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
             return bool(self._touching(d)[3].any())
@@ -207,8 +211,9 @@ class SimProspection(Prospection):
                 far = max(far, float(np.linalg.norm(d.site_xpos[arm.site] - d.xanchor[arm.jids[0]])))
             arm.reach = far * 1.05  # sampling under-estimates the true maximum a little
 
-    def reachable(self, arm: str, poses: Sequence[Any], base_pose: Any,
-                  joint_configuration: Optional[Mapping[str, float]] = None) -> Reachability:
+    def reachable(
+        self, arm: str, poses: Sequence[Any], base_pose: Any, joint_configuration: Mapping[str, float] | None = None
+    ) -> Reachability:
         if arm not in self._arms:
             raise ValueError(f"unknown arm {arm!r} of {self.scene.robot}; valid arms: {list(self._arms)}")
         goals = [as_tool_pose(p) for p in poses]
@@ -219,11 +224,16 @@ class SimProspection(Prospection):
             self._prepare(d, base_pose, joint_configuration)
             contacts = self._contacts(d)
             if contacts:
-                return Reachability(arm, (), "collision", -1, f"the robot at the base pose touches "
-                                    f"{contacts[0][1]} with {contacts[0][0]}")
+                return Reachability(
+                    arm,
+                    (),
+                    "collision",
+                    -1,
+                    f"the robot at the base pose touches {contacts[0][1]} with {contacts[0][0]}",
+                )
             current = d.qpos[a.qadr].copy()
             solutions: list[tuple[float, ...]] = []
-            previous: Optional[np.ndarray] = None
+            previous: np.ndarray | None = None
             for i, goal in enumerate(goals):
                 result = self._solve(d, a, goal, current, previous)
                 if isinstance(result, tuple):
@@ -233,22 +243,25 @@ class SimProspection(Prospection):
                 previous = result
             return Reachability(arm, tuple(solutions))
 
-    def _solve(self, d: mujoco.MjData, a: _Arm, goal: ToolPose, current: np.ndarray,
-               previous: Optional[np.ndarray]) -> np.ndarray | tuple[str, str]:
+    def _solve(
+        self, d: mujoco.MjData, a: _Arm, goal: ToolPose, current: np.ndarray, previous: np.ndarray | None
+    ) -> np.ndarray | tuple[str, str]:
         """A collision-free IK solution for `goal`, or (reason, message)."""
         m = self.model
         target_p = np.asarray(goal.position, float)
         target_q = None if goal.orientation is None else np.asarray(goal.orientation, float)
         distance = float(np.linalg.norm(target_p - d.xanchor[a.jids[0]]))
         if distance > a.reach:
-            return "out_of_reach", (f"{distance:.2f} m from the {a.name} shoulder, farther than its "
-                                    f"reach of {a.reach:.2f} m")
+            return "out_of_reach", (
+                f"{distance:.2f} m from the {a.name} shoulder, farther than its reach of {a.reach:.2f} m"
+            )
         seeds = a.seeds(current, previous)
-        collided: Optional[list[tuple[str, str]]] = None
+        collided: list[tuple[str, str]] | None = None
         colliding = 0
         for seed in seeds:
-            sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, a.lo, a.hi, target_p, target_q, seed,
-                                    IK_ITERATIONS, stall_window=IK_STALL)
+            sol, converged = dls_ik(
+                m, d, a.site, a.qadr, a.dadr, a.lo, a.hi, target_p, target_q, seed, IK_ITERATIONS, stall_window=IK_STALL
+            )
             if not converged:
                 continue
             q = np.asarray(sol.positions)
@@ -265,13 +278,27 @@ class SimProspection(Prospection):
             return "collision", f"every solution found touches {collided[0][1]} with {collided[0][0]}"
         free_lo, free_hi = np.full_like(a.lo, -np.inf), np.full_like(a.hi, np.inf)
         for seed in seeds[:2]:
-            sol, converged = dls_ik(m, d, a.site, a.qadr, a.dadr, free_lo, free_hi, target_p, target_q,
-                                    seed, IK_ITERATIONS, stall_window=IK_STALL)
+            sol, converged = dls_ik(
+                m,
+                d,
+                a.site,
+                a.qadr,
+                a.dadr,
+                free_lo,
+                free_hi,
+                target_p,
+                target_q,
+                seed,
+                IK_ITERATIONS,
+                stall_window=IK_STALL,
+            )
             if converged:
                 q = np.asarray(sol.positions)
                 worst = int(np.argmax(np.maximum(a.lo - q, q - a.hi)))
-                return "joint_limit", (f"only outside the joint limits ({a.joints[worst]}={q[worst]:.2f} "
-                                       f"outside [{a.lo[worst]:.2f}, {a.hi[worst]:.2f}])")
+                return "joint_limit", (
+                    f"only outside the joint limits ({a.joints[worst]}={q[worst]:.2f} "
+                    f"outside [{a.lo[worst]:.2f}, {a.hi[worst]:.2f}])"
+                )
         return "out_of_reach", f"no arm configuration puts the tool there ({distance:.2f} m from the shoulder)"
 
     # ------------------------------------------------------------------ visibility
@@ -295,12 +322,21 @@ class SimProspection(Prospection):
         """The visible geoms of the object (body) `name`; ValueError listing the objects if none."""
         m = self.model
         bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
-        geoms = [g for g in range(m.ngeom) if bid >= 0 and int(m.geom_bodyid[g]) == bid
-                 and VISIBLE_GROUPS[min(int(m.geom_group[g]), 5)]]
+        geoms = [
+            g
+            for g in range(m.ngeom)
+            if bid >= 0 and int(m.geom_bodyid[g]) == bid and VISIBLE_GROUPS[min(int(m.geom_group[g]), 5)]
+        ]
         if not geoms:
-            known = sorted({m.body(int(m.geom_bodyid[g])).name for g in range(m.ngeom)
-                            if m.geom_bodyid[g] > 0 and m.body(int(m.geom_bodyid[g])).name == m.geom(g).name
-                            and not self._is_robot[g]})
+            known = sorted(
+                {
+                    m.body(int(m.geom_bodyid[g])).name
+                    for g in range(m.ngeom)
+                    if m.geom_bodyid[g] > 0
+                    and m.body(int(m.geom_bodyid[g])).name == m.geom(g).name
+                    and not self._is_robot[g]
+                }
+            )
             raise ValueError(f"unknown object {name!r}; known objects: {known}")
         return geoms
 
@@ -318,11 +354,13 @@ class SimProspection(Prospection):
                 pts = np.column_stack([r * np.cos(a), r * np.sin(a), rng.uniform(-0.9, 0.9, n) * size[1]])
             elif t == mujoco.mjtGeom.mjGEOM_SPHERE:
                 v = rng.normal(size=(n, 3))
-                pts = v / np.linalg.norm(v, axis=1, keepdims=True) * size[0] * 0.9 * rng.uniform(0, 1, (n, 1)) ** (1 / 3)
+                pts = (
+                    v / np.linalg.norm(v, axis=1, keepdims=True) * size[0] * 0.9 * rng.uniform(0, 1, (n, 1)) ** (1 / 3)
+                )
             elif t == mujoco.mjtGeom.mjGEOM_MESH and m.geom_dataid[g] >= 0:
                 mesh = int(m.geom_dataid[g])
                 adr, num = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
-                verts = np.asarray(m.mesh_vert[adr:adr + num], float)
+                verts = np.asarray(m.mesh_vert[adr : adr + num], float)
                 pick = verts[rng.choice(num, min(n, num), replace=False)]
                 centre = verts.mean(axis=0)
                 pts = centre + 0.8 * (pick - centre)
@@ -355,8 +393,9 @@ class SimProspection(Prospection):
             mujoco.mj_kinematics(m, d)
         mujoco.mj_camlight(m, d)
 
-    def _look_past_head(self, d: mujoco.MjData, cam: np.ndarray, vec: np.ndarray, geomid: np.ndarray,
-                        dist: np.ndarray) -> None:
+    def _look_past_head(
+        self, d: mujoco.MjData, cam: np.ndarray, vec: np.ndarray, geomid: np.ndarray, dist: np.ndarray
+    ) -> None:
         """Re-cast the rays whose first hit is part of the head, from just beyond that hit."""
         unit = np.zeros(1, np.int32)
         for i in np.nonzero(self._is_head[np.maximum(geomid, 0)] & (geomid >= 0))[0]:
@@ -366,14 +405,18 @@ class SimProspection(Prospection):
                 if g < 0 or not self._is_head[g]:
                     break
                 start = cam + (travelled + 1e-4) * vec[i]
-                x = mujoco.mj_ray(self.model, d, start, vec[i], VISIBLE_GROUPS, 1,
-                                  int(self.model.geom_bodyid[g]), unit)
+                x = mujoco.mj_ray(self.model, d, start, vec[i], VISIBLE_GROUPS, 1, int(self.model.geom_bodyid[g]), unit)
                 geomid[i] = unit[0] if x >= 0 else -1
                 travelled += 1e-4 + max(x, 0.0)
             dist[i] = travelled
 
-    def visible(self, target: Any, base_pose: Any, threshold: float = 0.5,
-                joint_configuration: Optional[Mapping[str, float]] = None) -> Visibility:
+    def visible(
+        self,
+        target: Any,
+        base_pose: Any,
+        threshold: float = 0.5,
+        joint_configuration: Mapping[str, float] | None = None,
+    ) -> Visibility:
         m = self.model
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
@@ -386,13 +429,17 @@ class SimProspection(Prospection):
             local = vec @ rot  # camera frame: looks along -z, up +y
             depth = -local[:, 2]
             with np.errstate(divide="ignore", invalid="ignore"):
-                in_view = (depth > 1e-6) & (np.abs(local[:, 0]) <= self._tan_x * depth) & (
-                    np.abs(local[:, 1]) <= self._tan_y * depth)
+                in_view = (
+                    (depth > 1e-6)
+                    & (np.abs(local[:, 0]) <= self._tan_x * depth)
+                    & (np.abs(local[:, 1]) <= self._tan_y * depth)
+                )
             n = len(points)
             geomid = np.full(n, -1, np.int32)
             dist = np.zeros(n)
-            mujoco.mj_multiRay(m, d, cam, vec.ravel().copy(), VISIBLE_GROUPS, 1, self._camera_body,
-                               geomid, dist, None, n, np.inf)
+            mujoco.mj_multiRay(
+                m, d, cam, vec.ravel().copy(), VISIBLE_GROUPS, 1, self._camera_body, geomid, dist, None, n, np.inf
+            )
             self._look_past_head(d, cam, vec, geomid, dist)
             if own:
                 seen = np.isin(geomid, list(own))
@@ -406,5 +453,9 @@ class SimProspection(Prospection):
                     name = self._geom_name(int(g))
                     blockers[name] = blockers.get(name, 0) + 1
             fraction = float(seen.sum()) / n
-            return Visibility(fraction, fraction >= threshold, float(in_view.sum()) / n,
-                              tuple(sorted(blockers, key=lambda k: -blockers[k])))
+            return Visibility(
+                fraction,
+                fraction >= threshold,
+                float(in_view.sum()) / n,
+                tuple(sorted(blockers, key=lambda k: -blockers[k])),
+            )

@@ -27,8 +27,8 @@ import os
 import threading
 import time
 import weakref
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Callable, Iterable
 
 import mujoco
 import numpy as np
@@ -45,7 +45,7 @@ RECORDER_NICE = 5
 DEFAULT_MAX_PENDING = 512
 #: Recorders whose thread may still run: ended at interpreter exit, so that no recorder thread
 #: is inside MuJoCo or the GL driver while the interpreter and its libraries shut down.
-_LIVE_RECORDERS: "weakref.WeakSet[FrameRecorder]" = weakref.WeakSet()
+_LIVE_RECORDERS: weakref.WeakSet[FrameRecorder] = weakref.WeakSet()
 
 
 @atexit.register
@@ -71,7 +71,7 @@ class StateSnapshot:
     caption: str = ""  #: what the frame's caption says besides the time (e.g. the plan's phase)
 
     @classmethod
-    def of(cls, data: mujoco.MjData, caption: str = "") -> "StateSnapshot":
+    def of(cls, data: mujoco.MjData, caption: str = "") -> StateSnapshot:
         """Copy the state of `data` (call from the thread that owns `data`; a few microseconds)."""
         return cls(float(data.time), data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy(), caption)
 
@@ -95,8 +95,14 @@ class RecordedFrames(list):
     time [s] and caption text (`captions`, "" without a caption function).
     """
 
-    def __init__(self, frames: Iterable[np.ndarray] = (), fps: float = 1.0, dropped: int = 0,
-                 gif: GifEncoder | None = None, captions: Iterable[tuple[float, str]] = ()) -> None:
+    def __init__(
+        self,
+        frames: Iterable[np.ndarray] = (),
+        fps: float = 1.0,
+        dropped: int = 0,
+        gif: GifEncoder | None = None,
+        captions: Iterable[tuple[float, str]] = (),
+    ) -> None:
         super().__init__(frames)
         self.fps = fps
         self.dropped = dropped
@@ -125,9 +131,17 @@ class FrameRecorder:
     must not block (`abort` never blocks).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str | FollowView, fps: float, width: int, height: int,
-                 max_pending: int = DEFAULT_MAX_PENDING, name: str = "pycram-recorder",
-                 caption: Callable[[], str] | None = None) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        camera: str | FollowView,
+        fps: float,
+        width: int,
+        height: int,
+        max_pending: int = DEFAULT_MAX_PENDING,
+        name: str = "pycram-recorder",
+        caption: Callable[[], str] | None = None,
+    ) -> None:
         if fps <= 0:
             raise ValueError(f"fps must be positive, got {fps}")
         if width <= 0 or height <= 0:
@@ -235,9 +249,16 @@ class FrameRecorder:
         if self.error is not None:
             raise SimulationError(f"recording failed: {type(self.error).__name__}: {self.error}") from self.error
         level = logging.WARNING if self.dropped else logging.INFO
-        _log.log(level, "recorded %d frames of %s at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
-                 len(self._frames), self.camera if isinstance(self.camera, FollowView) else repr(self.camera),
-                 self.fps, *self.size, self.dropped, self.render_time)
+        _log.log(
+            level,
+            "recorded %d frames of %s at %.1f fps, %dx%d (%d dropped; %.2f s of rendering)",
+            len(self._frames),
+            self.camera if isinstance(self.camera, FollowView) else repr(self.camera),
+            self.fps,
+            *self.size,
+            self.dropped,
+            self.render_time,
+        )
         return RecordedFrames(self._frames, self.fps, self.dropped, self._gif, self._captions)
 
     def close(self, timeout: float = 10.0) -> None:
@@ -311,10 +332,11 @@ def draw_caption(rgb: np.ndarray, text: str, sim_time: float) -> np.ndarray:
     draw = ImageDraw.Draw(strip)
     clock = f"t = {sim_time:5.1f} s"
     draw.text((6, band / 2), text, fill=(255, 255, 255), font=font, anchor="lm")
-    draw.text((width - 6 - draw.textlength(clock, font=font), band / 2), clock, fill=(255, 255, 255), font=font,
-              anchor="lm")
+    draw.text(
+        (width - 6 - draw.textlength(clock, font=font), band / 2), clock, fill=(255, 255, 255), font=font, anchor="lm"
+    )
     captioned = rgb.copy()
-    captioned[height - band:] = np.asarray(strip)
+    captioned[height - band :] = np.asarray(strip)
     return captioned
 
 

@@ -8,8 +8,8 @@ closed by it. Animation frames are rendered elsewhere, by a recorder thread of t
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import mujoco
 import numpy as np
@@ -34,8 +34,9 @@ class Renderers:
             self._renderers[key] = r
         return r
 
-    def rgb(self, data: mujoco.MjData, camera: int | str | FollowView, width: int, height: int,
-            shadows: bool = True) -> np.ndarray:
+    def rgb(
+        self, data: mujoco.MjData, camera: int | str | FollowView, width: int, height: int, shadows: bool = True
+    ) -> np.ndarray:
         """An RGB image (height x width x 3, uint8) from `camera` (id, name or `FollowView`);
         `shadows` False also leaves out reflections (faster: what object perception uses)."""
         r = self.get(width, height)
@@ -64,8 +65,9 @@ class Renderers:
         ids[seg[:, :, 1] != int(mujoco.mjtObj.mjOBJ_GEOM)] = -1
         return ids
 
-    def segmentation_and_depth(self, data: mujoco.MjData, camera: int | str, width: int,
-                               height: int) -> tuple[np.ndarray, np.ndarray]:
+    def segmentation_and_depth(
+        self, data: mujoco.MjData, camera: int | str, width: int, height: int
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Geom ids per pixel (-1: background or not a geom) and the distance along the optical
         axis per pixel [m] (float32), both height x width, from one render of `camera`.
 
@@ -89,8 +91,11 @@ class Renderers:
         finally:
             np.copyto(scene.flags, flags)
         colour, depth = colour[::-1], depth[::-1]  # GL images are upside down
-        segid = colour[:, :, 0].astype(np.int64) | (colour[:, :, 1].astype(np.int64) << 8) | (
-            colour[:, :, 2].astype(np.int64) << 16)
+        segid = (
+            colour[:, :, 0].astype(np.int64)
+            | (colour[:, :, 1].astype(np.int64) << 8)
+            | (colour[:, :, 2].astype(np.int64) << 16)
+        )
         n = scene.ngeom
         geoms = scene.geoms[:n]
         lookup = np.full(n + 1, -1, np.int64)  # segid 0 is the background; segid i + 1 is scene geom i
@@ -165,6 +170,8 @@ def write_animation(path: str | Path, frames: Sequence[np.ndarray], fps: float) 
     try:
         iio.imwrite(path, np.stack(frames), fps=fps)
     except Exception as exc:  # imageio raises several types when no plugin can write the format
-        raise SimulationError(f"cannot write {path.suffix!r} animations ({type(exc).__name__}: {exc}); "
-                              "use a .gif path, or install imageio-ffmpeg (or av) for video") from exc
+        raise SimulationError(
+            f"cannot write {path.suffix!r} animations ({type(exc).__name__}: {exc}); "
+            "use a .gif path, or install imageio-ffmpeg (or av) for video"
+        ) from exc
     return path

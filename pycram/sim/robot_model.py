@@ -58,21 +58,33 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
     mount = spec.body(g["mount_link"])
     px, py, pz = g["palm_size"]
     fx, fy, fz = g["finger_size"]
-    palm = mount.add_body(name=grip["palm_link"], pos=[px, 0, 0], mass=g["mass"],
-                          inertia=[1e-3, 1e-3, 1e-3])
+    palm = mount.add_body(name=grip["palm_link"], pos=[px, 0, 0], mass=g["mass"], inertia=[1e-3, 1e-3, 1e-3])
     palm.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[px, py, pz], rgba=[0.25, 0.25, 0.28, 1])
-    tool = palm.add_body(name=desc.ARMS[desc.DEFAULT_ARM]["tool_link"], pos=[g["tool_offset"] - px, 0, 0],
-                         mass=0.001, inertia=[1e-6, 1e-6, 1e-6])
+    tool = palm.add_body(
+        name=desc.ARMS[desc.DEFAULT_ARM]["tool_link"],
+        pos=[g["tool_offset"] - px, 0, 0],
+        mass=0.001,
+        inertia=[1e-6, 1e-6, 1e-6],
+    )
     del tool
     names = (grip["joint"],) + tuple(grip["coupled_joints"])
     for side, (link, jname) in enumerate(zip(grip["finger_links"], names)):
         sign = 1.0 if side == 0 else -1.0
-        finger = palm.add_body(name=link, pos=[px + fx, sign * fy, 0], mass=0.05,
-                               inertia=[2e-5, 2e-5, 2e-5])
-        finger.add_joint(name=jname, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, sign, 0],
-                         range=list(grip["joint_range"]), limited=mujoco.mjtLimited.mjLIMITED_TRUE)
-        finger.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[fx, fy, fz], rgba=[0.35, 0.35, 0.4, 1],
-                        friction=[1.5, 0.01, 0.001], condim=4)
+        finger = palm.add_body(name=link, pos=[px + fx, sign * fy, 0], mass=0.05, inertia=[2e-5, 2e-5, 2e-5])
+        finger.add_joint(
+            name=jname,
+            type=mujoco.mjtJoint.mjJNT_SLIDE,
+            axis=[0, sign, 0],
+            range=list(grip["joint_range"]),
+            limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+        )
+        finger.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[fx, fy, fz],
+            rgba=[0.35, 0.35, 0.4, 1],
+            friction=[1.5, 0.01, 0.001],
+            condim=4,
+        )
 
 
 def build_robot_spec(desc: ModuleType) -> mujoco.MjSpec:
@@ -97,8 +109,7 @@ def build_robot_spec(desc: ModuleType) -> mujoco.MjSpec:
         joint.armature = 0.002 if light else 0.05
         joint.damping = [0.02 if light else 1.0, 0.0, 0.0]
         joint.frictionloss = 0.0
-    spec.body(desc.HEAD["camera_link"]).add_camera(name=HEAD_CAMERA, quat=_camera_quat(),
-                                                    fovy=desc.HEAD["fovy"])
+    spec.body(desc.HEAD["camera_link"]).add_camera(name=HEAD_CAMERA, quat=_camera_quat(), fovy=desc.HEAD["fovy"])
     for arm, a in desc.ARMS.items():
         spec.body(a["tool_link"]).add_site(name=tool_site(arm), size=[0.005, 0, 0], rgba=[0, 1, 0, 0])
     for gname, g in desc.GRIPPERS.items():
@@ -145,5 +156,10 @@ def add_robot(spec: mujoco.MjSpec, desc: ModuleType) -> None:
         for other in g["coupled_joints"]:
             if other in already:  # the URDF importer turned a mimic tag into an equality
                 continue
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=other, name2=g["joint"],
-                              data=[0, 1, 0, 0, 0] + [0] * 7, solref=[0.005, 1.0])
+            spec.add_equality(
+                type=mujoco.mjtEq.mjEQ_JOINT,
+                name1=other,
+                name2=g["joint"],
+                data=[0, 1, 0, 0, 0] + [0] * 7,
+                solref=[0.005, 1.0],
+            )

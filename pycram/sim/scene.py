@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from types import ModuleType
-from typing import Sequence
 
 import mujoco
 import numpy as np
@@ -120,9 +120,12 @@ def _subtree_bodies(model: mujoco.MjModel, root: int) -> set[int]:
     return out
 
 
-def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
-                offscreen_size: tuple[int, int] = (640, 480),
-                environment: str | Environment = environments.DEFAULT_ENVIRONMENT) -> Scene:
+def build_scene(
+    robot: str = "pr2",
+    items: Sequence[ItemSpec] | None = None,
+    offscreen_size: tuple[int, int] = (640, 480),
+    environment: str | Environment = environments.DEFAULT_ENVIRONMENT,
+) -> Scene:
     """Compile `environment` (a name or a description) with `robot` ("pr2" or "tiago") and
     `items` (default: `DEFAULT_ITEMS` in the thesis kitchen, none elsewhere).
 
@@ -155,8 +158,13 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     add_robot(spec, desc)
     for gname, g in desc.GRIPPERS.items():
         for it in items:
-            eq = spec.add_equality(name=weld_name(gname, it.name), type=mujoco.mjtEq.mjEQ_WELD,
-                                   objtype=mujoco.mjtObj.mjOBJ_BODY, name1=g["palm_link"], name2=it.name)
+            eq = spec.add_equality(
+                name=weld_name(gname, it.name),
+                type=mujoco.mjtEq.mjEQ_WELD,
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+                name1=g["palm_link"],
+                name2=it.name,
+            )
             eq.active = False
             eq.solref = [0.01, 1.0]
     model = spec.compile()
@@ -164,12 +172,21 @@ def build_scene(robot: str = "pr2", items: Sequence[ItemSpec] | None = None,
     robot_bodies = _subtree_bodies(model, mount)
     base_bodies = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in desc.BASE["collision_links"]}
     geoms_of = lambda bodies: frozenset(  # noqa: E731
-        g for g in range(model.ngeom) if model.geom_bodyid[g] in bodies and model.geom_contype[g])
+        g for g in range(model.ngeom) if model.geom_bodyid[g] in bodies and model.geom_contype[g]
+    )
     env_geoms = frozenset(g for g in range(model.ngeom) if model.geom_contype[g] == 1)
-    scene = Scene(model=model, description=desc, items=items, environment=env, robot_geoms=geoms_of(robot_bodies),
-                  base_geoms=geoms_of(base_bodies), environment_geoms=env_geoms)
-    _log.info("scene %s built in %.3f s (nq=%d, ngeom=%d)", spec.modelname,
-              time.perf_counter() - t0, model.nq, model.ngeom)
+    scene = Scene(
+        model=model,
+        description=desc,
+        items=items,
+        environment=env,
+        robot_geoms=geoms_of(robot_bodies),
+        base_geoms=geoms_of(base_bodies),
+        environment_geoms=env_geoms,
+    )
+    _log.info(
+        "scene %s built in %.3f s (nq=%d, ngeom=%d)", spec.modelname, time.perf_counter() - t0, model.nq, model.ngeom
+    )
     return scene
 
 

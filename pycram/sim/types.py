@@ -22,11 +22,11 @@ class Pose2D:
     y: float
     yaw: float
 
-    def distance_to(self, other: "Pose2D") -> float:
+    def distance_to(self, other: Pose2D) -> float:
         """Planar distance [m]."""
         return math.hypot(self.x - other.x, self.y - other.y)
 
-    def yaw_error_to(self, other: "Pose2D") -> float:
+    def yaw_error_to(self, other: Pose2D) -> float:
         """Absolute yaw difference [rad], wrapped to [0, pi]."""
         return abs(wrap_angle(self.yaw - other.yaw))
 
@@ -48,8 +48,19 @@ class Outcome:
     message: str = ""
     value: Any = None
 
-    REASONS = ("succeeded", "blocked", "collision", "cancelled", "preempted", "unreachable",
-               "timeout", "invalid", "closed", "error", "no_path")
+    REASONS = (
+        "succeeded",
+        "blocked",
+        "collision",
+        "cancelled",
+        "preempted",
+        "unreachable",
+        "timeout",
+        "invalid",
+        "closed",
+        "error",
+        "no_path",
+    )
 
     def __bool__(self) -> bool:
         return self.succeeded

@@ -26,8 +26,9 @@ import queue
 import threading
 import time
 import weakref
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -39,12 +40,11 @@ from pycram.world.scenes import random_scene
 
 from ._runtime import Fluent, ManualClock, current_clock, set_clock
 from .camera import FollowView
-from .controllers import (BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant,
-                          JointTrajectory, Reach)
+from .controllers import BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant, JointTrajectory, Reach
 from .engine import Engine
 from .environment_builder import OBSTACLE_PARKING
-from .furniture import ContainerPush
 from .errors import UnknownNameError, WorldClosedError
+from .furniture import ContainerPush
 from .handle import CommandHandle
 from .items import ItemSpec
 from .path_drive import PlannedDrive
@@ -63,14 +63,14 @@ _log = logging.getLogger(__name__)
 #: The thesis kitchen's start pose [m, m, rad] (on the free floor between the counters).
 DEFAULT_BASE_POSE = (0.8, 0.6, 0.0)
 #: Clocks of closed worlds -> the clock that was active before each (to skip them when restoring).
-_CLOSED_CLOCKS: "weakref.WeakKeyDictionary[ManualClock, Any]" = weakref.WeakKeyDictionary()
+_CLOSED_CLOCKS: weakref.WeakKeyDictionary[ManualClock, Any] = weakref.WeakKeyDictionary()
 _CLOCK_LOCK = threading.Lock()
 #: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
 #: trying to catch up (it then paces from where it is).
 REALTIME_SLACK = 0.05
 #: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
 #: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
-_LIVE_WORLDS: "weakref.WeakSet[World]" = weakref.WeakSet()
+_LIVE_WORLDS: weakref.WeakSet[World] = weakref.WeakSet()
 
 
 @atexit.register
@@ -99,13 +99,24 @@ class World:
     `stop_recording`, `wait_*`).
     """
 
-    def __init__(self, robot: str = "pr2", items: Sequence[ItemSpec] | None = None, *,
-                 environment: str | Environment = DEFAULT_ENVIRONMENT,
-                 objects: Sequence[str] | None = None, seed: int = 0,
-                 supports: Sequence[str] | None = None, base_pose: tuple[float, float, float] | None = None, realtime: bool = False,
-                 realtime_factor: float = 1.0, sensor_rate: float = 50.0, control_period: float = 0.01,
-                 offscreen_size: tuple[int, int] = (640, 480), activate_clock: bool = True,
-                 perception_faults: PerceptionFaults | None = None) -> None:
+    def __init__(
+        self,
+        robot: str = "pr2",
+        items: Sequence[ItemSpec] | None = None,
+        *,
+        environment: str | Environment = DEFAULT_ENVIRONMENT,
+        objects: Sequence[str] | None = None,
+        seed: int = 0,
+        supports: Sequence[str] | None = None,
+        base_pose: tuple[float, float, float] | None = None,
+        realtime: bool = False,
+        realtime_factor: float = 1.0,
+        sensor_rate: float = 50.0,
+        control_period: float = 0.01,
+        offscreen_size: tuple[int, int] = (640, 480),
+        activate_clock: bool = True,
+        perception_faults: PerceptionFaults | None = None,
+    ) -> None:
         env = load_environment(environment)
         #: Faults of `detect` (none by default); its random generator is seeded from them.
         self.perception_faults = perception_faults or PerceptionFaults()
@@ -114,8 +125,9 @@ class World:
         #: `supports` (surface names) restricts where they may start.
         self.placements = random_scene(env, objects, seed, supports=supports) if objects else []
         if self.placements:
-            items = list(items or []) + [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw)
-                                         for p in self.placements]
+            items = list(items or []) + [
+                ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in self.placements
+            ]
         self.scene = build_scene(robot, items, offscreen_size, env)
         self.description = self.scene.description
         #: The environment's description (data: surfaces, containers, places, free floor).
@@ -133,8 +145,9 @@ class World:
         self.sim_time = Fluent(0.0, name="sim_time")
         self.base_pose = Fluent(eng.base_pose(), name="base_pose")
         self.joint_states = Fluent(eng.joint_states(), name="joint_states")
-        self.gripper_openings = {g: Fluent(eng.gripper_state(g).opening, name=f"{g}_gripper_opening")
-                                 for g in eng.grippers}
+        self.gripper_openings = {
+            g: Fluent(eng.gripper_state(g).opening, name=f"{g}_gripper_opening") for g in eng.grippers
+        }
         self.gripper_states = {g: Fluent(eng.gripper_state(g), name=f"{g}_gripper_state") for g in eng.grippers}
         self.tool_poses = Fluent(self._tool_poses(), name="tool_poses")
         self.item_poses = Fluent(self._item_poses(), name="item_poses")
@@ -163,7 +176,7 @@ class World:
         _LIVE_WORLDS.add(self)
 
     # ------------------------------------------------------------------ lifecycle
-    def __enter__(self) -> "World":
+    def __enter__(self) -> World:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -394,7 +407,7 @@ class World:
         """`drive_to` with a `Pose2D`."""
         return self.drive_to(pose.x, pose.y, pose.yaw, plan_path)
 
-    def prospection(self) -> "SimProspection":
+    def prospection(self) -> SimProspection:
         """The robot's prospection (`pycram.world.prospection.Prospection`) in this world: "what
         if" questions answered on scratch copies of the latest published state (thread-safe;
         never disturbs the simulation). The same object on every call."""
@@ -408,8 +421,9 @@ class World:
     def set_torso(self, height: float, duration: float | None = None) -> CommandHandle:
         """Move the torso lift joint to `height` [m]."""
         joint = self.description.TORSO["joint"]
-        return self.submit(JointTrajectory("torso", [joint], [height], duration, max_velocity=0.1,
-                                           tolerance=0.005), "set_torso")
+        return self.submit(
+            JointTrajectory("torso", [joint], [height], duration, max_velocity=0.1, tolerance=0.005), "set_torso"
+        )
 
     def move_arm(self, arm: str, positions: Sequence[float], duration: float | None = None) -> CommandHandle:
         """Move the joints of `arm` (order: `description.ARMS[arm]["joints"]`) to `positions` [rad]."""
@@ -425,16 +439,24 @@ class World:
             raise UnknownNameError("arm configuration", configuration, configs)
         return self.move_arm(arm, configs[configuration], duration)
 
-    def reach(self, arm: str, position: Sequence[float], orientation: Sequence[float] | None = None,
-              duration: float | None = None, tolerance: float = 0.01) -> CommandHandle:
+    def reach(
+        self,
+        arm: str,
+        position: Sequence[float],
+        orientation: Sequence[float] | None = None,
+        duration: float | None = None,
+        tolerance: float = 0.01,
+    ) -> CommandHandle:
         """Move the tool frame of `arm` to `position` [m] (and `orientation` (w, x, y, z) if given).
 
         Ends with "unreachable" when inverse kinematics finds no solution within the joint limits;
         value: the reached tool `Pose`.
         """
         self._check_arm(arm)
-        goal = Pose(tuple(map(float, position)),
-                    tuple(map(float, orientation)) if orientation is not None else (1.0, 0.0, 0.0, 0.0))
+        goal = Pose(
+            tuple(map(float, position)),
+            tuple(map(float, orientation)) if orientation is not None else (1.0, 0.0, 0.0, 0.0),
+        )
         return self.submit(Reach(arm, goal, orientation is not None, duration, tolerance), f"reach:{arm}")
 
     def point_head(self, point: Sequence[float]) -> CommandHandle:
@@ -482,8 +504,9 @@ class World:
             self._perception_renderers = Renderers(model)
         return self._perception_renderers
 
-    def request_image(self, camera: str | FollowView = HEAD_CAMERA, width: int = 320, height: int = 240,
-                      hide_objects: bool = False) -> CommandHandle:
+    def request_image(
+        self, camera: str | FollowView = HEAD_CAMERA, width: int = 320, height: int = 240, hide_objects: bool = False
+    ) -> CommandHandle:
         """Render an RGB image (height x width x 3, uint8) from `camera` (a camera name or a
         `FollowView`); also set `camera_image`.
 
@@ -511,8 +534,14 @@ class World:
         else:
             self.scene.camera(camera)
 
-    def snapshot(self, path: str | Path, camera: str | FollowView = "overview", width: int = 640,
-                 height: int = 480, timeout: float = 30.0) -> Path:
+    def snapshot(
+        self,
+        path: str | Path,
+        camera: str | FollowView = "overview",
+        width: int = 640,
+        height: int = 480,
+        timeout: float = 30.0,
+    ) -> Path:
         """Render `camera` (a camera name or a `FollowView`) and write a PNG to `path` (blocks up
         to `timeout` [s of wall time])."""
         handle = self.request_image(camera, width, height)
@@ -532,14 +561,22 @@ class World:
             for name, geoms in eng.item_part_geoms.items():
                 rows, cols = np.nonzero(np.isin(ids, geoms))
                 if len(rows) >= min_pixels:
-                    seen.append(VisibleItem(name, self.scene.item(name).type, eng.item_pose(name), len(rows),
-                                            (float(cols.mean()), float(rows.mean()))))
+                    seen.append(
+                        VisibleItem(
+                            name,
+                            self.scene.item(name).type,
+                            eng.item_pose(name),
+                            len(rows),
+                            (float(cols.mean()), float(rows.mean())),
+                        )
+                    )
             return sorted(seen, key=lambda v: -v.pixels)
 
         return self._call("perceive", fn)
 
-    def detect(self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS,
-               max_range: float = MAX_RANGE) -> CommandHandle:
+    def detect(
+        self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS, max_range: float = MAX_RANGE
+    ) -> CommandHandle:
         """One look of the head camera's object perception: value a
         `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
         colour images of `width` x `height` [px], most visible first; the camera view with its
@@ -559,27 +596,44 @@ class World:
         ids, depth = renderers.segmentation_and_depth(eng.data, HEAD_CAMERA, width, height)
         rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
         cam = eng.camera
-        view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]),
-                       depth, max_range)
+        view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]), depth, max_range)
         objects = {it.name: (it.type, eng.item_part_geoms[it.name]) for it in self.scene.items}
         states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
-        detections = measure_detections(ids, depth, rgb, view, objects, self.environment, states,
-                                        self.perception_faults, self._fault_rng, min_pixels)
+        detections = measure_detections(
+            ids,
+            depth,
+            rgb,
+            view,
+            objects,
+            self.environment,
+            states,
+            self.perception_faults,
+            self._fault_rng,
+            min_pixels,
+        )
         # the joint positions of the containers whose handle is in the image
-        in_view = {name: q for name, q in states.items()
-                   if view.in_image(self.environment.container(name).handle_position(q))}
+        in_view = {
+            name: q for name, q in states.items() if view.in_image(self.environment.container(name).handle_position(q))
+        }
         return PerceptionReport(eng.time, tuple(detections), view, in_view)
 
-    def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320,
-                             height: int = 240) -> CommandHandle:
+    def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
         """Render geom ids per pixel (height x width, -1: background) from `camera`."""
         self.scene.camera(camera)
-        return self._call(f"segmentation:{camera}",
-                          lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height))
+        return self._call(
+            f"segmentation:{camera}", lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height)
+        )
 
-    def start_recording(self, camera: str | FollowView = "overview", fps: float = 10.0, width: int = 320,
-                        height: int = 240, *, max_pending: int = DEFAULT_MAX_PENDING,
-                        caption: Callable[[], str] | None = None) -> CommandHandle:
+    def start_recording(
+        self,
+        camera: str | FollowView = "overview",
+        fps: float = 10.0,
+        width: int = 320,
+        height: int = 240,
+        *,
+        max_pending: int = DEFAULT_MAX_PENDING,
+        caption: Callable[[], str] | None = None,
+    ) -> CommandHandle:
         """Start recording frames of `camera` (width x height [px]) every 1/`fps` s of simulated
         time, from the simulated time at which the command runs; a recording already running is
         discarded.
@@ -596,8 +650,16 @@ class World:
         simulated time.
         """
         self._check_camera(camera)
-        recorder = FrameRecorder(self.scene.model, camera, fps, width, height, max_pending,
-                                 name=f"pycram-recorder-{self.robot}", caption=caption)
+        recorder = FrameRecorder(
+            self.scene.model,
+            camera,
+            fps,
+            width,
+            height,
+            max_pending,
+            name=f"pycram-recorder-{self.robot}",
+            caption=caption,
+        )
         with self._lock:
             self._recorders.append(recorder)
 
@@ -662,8 +724,9 @@ class World:
         return frames
 
     # ------------------------------------------------------------------ fault injection
-    def take_item(self, gripper: str | None = None, item: str | None = None,
-                  to: Sequence[float] | None = None) -> CommandHandle:
+    def take_item(
+        self, gripper: str | None = None, item: str | None = None, to: Sequence[float] | None = None
+    ) -> CommandHandle:
         """Take an item away, as a person would: out of `gripper` (the item it holds) or `item` by name.
 
         The item goes to `to` [m] or aside onto the floor beyond the environment. The gripper keeps
@@ -697,8 +760,9 @@ class World:
         arm = next(a for a, s in self.description.ARMS.items() if s["gripper"] == gripper)
         return self.submit(GiveItem(item, gripper, arm, close, timeout), "give_item")
 
-    def move_item(self, item: str, position: Sequence[float],
-                  orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)) -> CommandHandle:
+    def move_item(
+        self, item: str, position: Sequence[float], orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)
+    ) -> CommandHandle:
         """Put `item` at `position` [m] / `orientation` (w, x, y, z), releasing any grasp."""
         self.scene.item(item)
         return self._call("move_item", lambda eng: eng.set_item_pose(item, tuple(position), tuple(orientation)))
@@ -740,8 +804,9 @@ class World:
 
         return self._call("set_container_stuck", fn)
 
-    def push_container(self, container: str, force: Sequence[float], duration: float,
-                       point: Sequence[float] | None = None) -> CommandHandle:
+    def push_container(
+        self, container: str, force: Sequence[float], duration: float, point: Sequence[float] | None = None
+    ) -> CommandHandle:
         """A person's hand pushes or pulls `container` with `force` [N, map frame] for `duration`
         [s of simulated time], at its handle (default) or at `point` [m, map frame] on it.
 

@@ -18,8 +18,8 @@ Guarantees
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Iterator, Sequence
 
 from pycram.trace.query import TaskNode, TaskRecord
 

@@ -97,7 +97,8 @@ def _path_as_url(url: str) -> str:
             raise TraceDatabaseError(
                 f"invalid database URL {url!r}: a URL needs '://' after its kind {scheme.group(1)!r} "
                 "(sqlite:///relative/path.sqlite3 for a file below the current folder, "
-                "sqlite:////absolute/path.sqlite3 for an absolute one, or just the file's path)")
+                "sqlite:////absolute/path.sqlite3 for an absolute one, or just the file's path)"
+            )
         if url.endswith((".sqlite", ".sqlite3", ".db")) or os.sep in url:
             return f"sqlite:///{Path(url).expanduser().resolve()}"
     return url
@@ -149,7 +150,8 @@ metadata = sa.MetaData()
 
 #: One row per recorded run: plan, robot, start/end, outcome.
 runs_table = sa.Table(
-    "pycram_runs", metadata,
+    "pycram_runs",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("uuid", sa.String(36), nullable=False, unique=True),
     sa.Column("plan", sa.String(255)),
@@ -173,7 +175,8 @@ runs_table = sa.Table(
 
 #: One row per task of a run's task tree: name, parent, status, times, error.
 tasks_table = sa.Table(
-    "pycram_tasks", metadata,
+    "pycram_tasks",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("run_id", sa.Integer, sa.ForeignKey("pycram_runs.id", ondelete="CASCADE"), nullable=False),
     sa.Column("task_id", sa.Integer, nullable=False),  # Task.id, unique within the run
@@ -199,7 +202,8 @@ sa.Index("ix_pycram_tasks_name", tasks_table.c.name)
 
 #: One row per performed designator: its properties and what it resolved to.
 designators_table = sa.Table(
-    "pycram_designators", metadata,
+    "pycram_designators",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("run_id", sa.Integer, sa.ForeignKey("pycram_runs.id", ondelete="CASCADE"), nullable=False),
     sa.Column("task_id", sa.Integer),  # the task that performed it
@@ -215,7 +219,8 @@ sa.Index("ix_pycram_designators_run", designators_table.c.run_id)
 
 #: One row per process-module execution: module, designator, outcome, times.
 executions_table = sa.Table(
-    "pycram_executions", metadata,
+    "pycram_executions",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("run_id", sa.Integer, sa.ForeignKey("pycram_runs.id", ondelete="CASCADE"), nullable=False),
     sa.Column("task_id", sa.Integer),
@@ -233,7 +238,8 @@ sa.Index("ix_pycram_executions_run", executions_table.c.run_id)
 
 #: Sampled values of watched fluents, with the active clock's time [s].
 fluent_samples_table = sa.Table(
-    "pycram_fluent_samples", metadata,
+    "pycram_fluent_samples",
+    metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
     sa.Column("run_id", sa.Integer, sa.ForeignKey("pycram_runs.id", ondelete="CASCADE"), nullable=False),
     sa.Column("name", sa.String(255), nullable=False),
@@ -257,10 +263,11 @@ def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
         cursor.close()
 
 
-_HINT = ("expected e.g. sqlite:////absolute/path/runs.sqlite3 or "
-         "postgresql://user:password@host:5432/database")
-_SUPPORTED = ("run traces can be kept in SQLite (sqlite:///path/runs.sqlite3 or a file path) "
-              "or PostgreSQL (postgresql://user:password@host:5432/database)")
+_HINT = "expected e.g. sqlite:////absolute/path/runs.sqlite3 or postgresql://user:password@host:5432/database"
+_SUPPORTED = (
+    "run traces can be kept in SQLite (sqlite:///path/runs.sqlite3 or a file path) "
+    "or PostgreSQL (postgresql://user:password@host:5432/database)"
+)
 
 
 def _hide_password(url: str) -> str:
@@ -280,8 +287,9 @@ def _parse(url: str) -> URL:
     except ValueError:  # SQLAlchemy's int() of the port
         host = url.split("://", 1)[-1].split("/", 1)[0].rsplit("@", 1)[-1]
         port = host.rsplit(":", 1)[-1] if ":" in host else ""
-        raise TraceDatabaseError(f"invalid database URL {_hide_password(url)!r}: the port {port!r} is not a "
-                                 f"number; {_HINT}") from None
+        raise TraceDatabaseError(
+            f"invalid database URL {_hide_password(url)!r}: the port {port!r} is not a number; {_HINT}"
+        ) from None
     if parsed.drivername in ("postgresql", "postgres"):  # psycopg (3) is the driver we ship
         parsed = parsed.set(drivername="postgresql+psycopg")
     backend = parsed.get_backend_name()
@@ -290,8 +298,9 @@ def _parse(url: str) -> URL:
         try:
             parsed.get_dialect()
         except sa_exc.NoSuchModuleError:
-            raise TraceDatabaseError(f"unknown database kind {parsed.drivername!r} in URL {shown}; "
-                                     f"{_SUPPORTED}") from None
+            raise TraceDatabaseError(
+                f"unknown database kind {parsed.drivername!r} in URL {shown}; {_SUPPORTED}"
+            ) from None
         raise TraceDatabaseError(f"database kind {backend!r} (URL {shown}) is not supported: {_SUPPORTED}") from None
     return parsed
 
@@ -318,12 +327,12 @@ def create_engine(url: str | None) -> Engine:
     try:
         engine = sa.create_engine(parsed, **kwargs)
     except sa_exc.NoSuchModuleError:
-        raise TraceDatabaseError(
-            f"unknown database kind {parsed.drivername!r} in URL {shown}; {_HINT}") from None
+        raise TraceDatabaseError(f"unknown database kind {parsed.drivername!r} in URL {shown}; {_HINT}") from None
     except ModuleNotFoundError as e:
         raise TraceDatabaseError(
             f"the database driver for {shown} is not installed ({e}); the 'db' extra (pip install "
-            "'pycram[db]') ships the drivers for sqlite:// and postgresql:// (psycopg 3)") from None
+            "'pycram[db]') ships the drivers for sqlite:// and postgresql:// (psycopg 3)"
+        ) from None
     except sa_exc.ArgumentError as e:
         raise TraceDatabaseError(f"invalid database URL {shown}: {e}; {_HINT}") from None
     if parsed.get_backend_name() == "sqlite":
@@ -370,8 +379,7 @@ def empty_engine() -> Engine:
         if _empty is None:
             from sqlalchemy.pool import StaticPool
 
-            engine = sa.create_engine("sqlite://", poolclass=StaticPool,
-                                      connect_args={"check_same_thread": False})
+            engine = sa.create_engine("sqlite://", poolclass=StaticPool, connect_args={"check_same_thread": False})
             metadata.create_all(engine)
             _empty = engine
         return _empty
@@ -427,16 +435,26 @@ def _add_missing_columns(engine: Engine) -> None:
                 with engine.begin() as conn:
                     for column in missing:
                         kind = column.type.compile(dialect=engine.dialect)
-                        conn.exec_driver_sql(f"ALTER TABLE {table.name} ADD COLUMN "
-                                             f"{engine.dialect.identifier_preparer.quote(column.name)} {kind}")
-                log.info("trace database %s: added %s to %s", display_url(engine.url),
-                         ", ".join(c.name for c in missing), table.name)
+                        conn.exec_driver_sql(
+                            f"ALTER TABLE {table.name} ADD COLUMN "
+                            f"{engine.dialect.identifier_preparer.quote(column.name)} {kind}"
+                        )
+                log.info(
+                    "trace database %s: added %s to %s",
+                    display_url(engine.url),
+                    ", ".join(c.name for c in missing),
+                    table.name,
+                )
             except sa_exc.DBAPIError as e:
                 text = str(e).lower()
                 if attempt == 0 and ("duplicate" in text or "already exists" in text):
                     continue  # another process added them first: look again
-                log.warning("cannot add the columns %s to %s in %s (an older schema; reading still "
-                            "works): %s", ", ".join(c.name for c in missing), table.name,
-                            display_url(engine.url), str(getattr(e, "orig", e)).strip())
+                log.warning(
+                    "cannot add the columns %s to %s in %s (an older schema; reading still works): %s",
+                    ", ".join(c.name for c in missing),
+                    table.name,
+                    display_url(engine.url),
+                    str(getattr(e, "orig", e)).strip(),
+                )
                 break
         _present.get(engine, {}).pop(table.name, None)

@@ -9,7 +9,7 @@ that task (see `TaskRecord.error_origin`).
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 from rich.markup import escape
 from rich.tree import Tree
@@ -28,8 +28,7 @@ STATUS_STYLE = {
     "suspended": "magenta",
 }
 #: One-character mark per task status.
-STATUS_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·",
-               "suspended": "‖"}
+STATUS_MARK = {"succeeded": "✔", "failed": "✘", "evaporated": "~", "running": "▶", "created": "·", "suspended": "‖"}
 
 
 def format_duration(seconds: float | None) -> str:
@@ -66,8 +65,10 @@ def _label(node, names: dict[int, str]) -> str:
         return f"[bold]{escape(record.name)}[/bold] [grey50](thread)[/grey50]"
     style = STATUS_STYLE.get(record.status, "white")
     times = f" ×{node.count}" if node.count > 1 else ""
-    text = (f"[{style}]{STATUS_MARK.get(record.status, '?')}[/{style}] {escape(record.name)}{times} "
-            f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] ")
+    text = (
+        f"[{style}]{STATUS_MARK.get(record.status, '?')}[/{style}] {escape(record.name)}{times} "
+        f"[grey50]\\[{escape(record.kind or 'task')}][/grey50] [{style}]{record.status}[/{style}] "
+    )
     if node.count > 1:
         low, high = node.duration_range or (None, None)
         text += f"{format_duration(node.total_duration)} in all ({format_duration(low)} – {format_duration(high)} each)"

@@ -20,12 +20,13 @@ Records come from `pycram.trace.query.tasks` or `records_from_task` (no database
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any
 from xml.sax.saxutils import escape
 
-from pycram.trace.display import format_duration
 from pycram.trace.collapse import MIN_RUN, DisplayNode, collapse
+from pycram.trace.display import format_duration
 from pycram.trace.query import TaskRecord, build_tree
 
 log = logging.getLogger(__name__)
@@ -96,8 +97,9 @@ def _mean(node: DisplayNode) -> float | None:
     return total / known if total is not None and known else None
 
 
-def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label: int = 48,
-             min_run: int = MIN_RUN) -> str:
+def tree_svg(
+    records: Iterable[TaskRecord], title: str | None = None, max_label: int = 48, min_run: int = MIN_RUN
+) -> str:
     """An SVG document (string) drawing the task tree of `records`, left to right.
 
     Runs of at least `min_run` consecutive identical successful siblings are drawn as one
@@ -117,8 +119,10 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
             lines1[key] = _clip(node.record.name, max_label - len(suffix)) + suffix
             lines2[key] = _clip(_group_detail(node), max_label + 10)
     if not order:
-        return ('<svg xmlns="http://www.w3.org/2000/svg" width="300" height="60">'
-                '<text x="10" y="35" font-family="sans-serif" font-size="13">no tasks recorded</text></svg>\n')
+        return (
+            '<svg xmlns="http://www.w3.org/2000/svg" width="300" height="60">'
+            '<text x="10" y="35" font-family="sans-serif" font-size="13">no tasks recorded</text></svg>\n'
+        )
     # column widths per depth
     widths: dict[int, float] = {}
     for node in order:
@@ -166,7 +170,7 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
             y1 = y_of[id(child)] + _BOX_H / 2
             xm = x0 + _GAP_X / 2
             out.append(f'<path d="M{x0:.1f},{y0:.1f} H{xm:.1f} V{y1:.1f} H{x1:.1f}"/>')
-    out.append('</g>')
+    out.append("</g>")
     for node in order:
         r = node.record
         key = id(node)
@@ -177,9 +181,11 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
         fill = _LIGHT.get(status, "#ffffff")
         if node.count > 1:
             low, high = node.duration_range or (None, None)
-            tip = (f"{r.path or r.name} (and {node.count - 1} identical siblings)\n{status}, "
-                   f"{node.count} tasks, {format_duration(node.total_duration)} in all, "
-                   f"{format_duration(low)} – {format_duration(high)} each")
+            tip = (
+                f"{r.path or r.name} (and {node.count - 1} identical siblings)\n{status}, "
+                f"{node.count} tasks, {format_duration(node.total_duration)} in all, "
+                f"{format_duration(low)} – {format_duration(high)} each"
+            )
         else:
             tip = f"{r.path or r.name}\n{status}, {format_duration(r.duration)}"
             if r.error:
@@ -187,22 +193,32 @@ def tree_svg(records: Iterable[TaskRecord], title: str | None = None, max_label:
         css = f"task {status}" + (" group" if node.count > 1 else "")
         out.append(f'<g class="{escape(css)}"><title>{escape(tip)}</title>')
         if node.count > 1:  # a stack of cards
-            out.append(f'<rect x="{bx + 4:.1f}" y="{by + 4:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" '
-                       f'rx="4" fill="{fill}" stroke="{stroke}" stroke-width="1"/>')
-        out.append(f'<rect x="{bx:.1f}" y="{by:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" rx="4" '
-                   f'fill="{fill}" stroke="{stroke}" stroke-width="1.6"/>')
+            out.append(
+                f'<rect x="{bx + 4:.1f}" y="{by + 4:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" '
+                f'rx="4" fill="{fill}" stroke="{stroke}" stroke-width="1"/>'
+            )
+        out.append(
+            f'<rect x="{bx:.1f}" y="{by:.1f}" width="{widths[depth]:.1f}" height="{_BOX_H}" rx="4" '
+            f'fill="{fill}" stroke="{stroke}" stroke-width="1.6"/>'
+        )
         out.append(f'<rect x="{bx:.1f}" y="{by:.1f}" width="5" height="{_BOX_H}" rx="2" fill="{stroke}"/>')
-        out.append(f'<text x="{bx + 10:.1f}" y="{by + 13:.1f}" font-size="11" fill="#212121">{escape(lines1[key])}</text>')
-        out.append(f'<text x="{bx + 10:.1f}" y="{by + 25:.1f}" font-size="9" fill="#546e7a">{escape(lines2[key])}</text>')
-        out.append('</g>')
-    out.append('</svg>')
+        out.append(
+            f'<text x="{bx + 10:.1f}" y="{by + 13:.1f}" font-size="11" fill="#212121">{escape(lines1[key])}</text>'
+        )
+        out.append(
+            f'<text x="{bx + 10:.1f}" y="{by + 25:.1f}" font-size="9" fill="#546e7a">{escape(lines2[key])}</text>'
+        )
+        out.append("</g>")
+    out.append("</svg>")
     return "\n".join(out) + "\n"
 
 
 # -- timeline (PNG) -------------------------------------------------------------------------------
 
-def _rows_for_timeline(records: Sequence[TaskRecord], max_rows: int,
-                       min_run: int = MIN_RUN) -> tuple[list[tuple[DisplayNode, int]], int]:
+
+def _rows_for_timeline(
+    records: Sequence[TaskRecord], max_rows: int, min_run: int = MIN_RUN
+) -> tuple[list[tuple[DisplayNode, int]], int]:
     """Depth-first rows (without thread roots; identical successful siblings share a row), cut
     at the deepest level that fits `max_rows`. Returns the rows and the number of tasks left out."""
     rows: list[tuple[DisplayNode, int]] = []
@@ -224,8 +240,14 @@ def _rows_for_timeline(records: Sequence[TaskRecord], max_rows: int,
     return chosen, total - sum(n.count for n, _ in chosen)
 
 
-def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | None = None,
-                 max_rows: int = 200, end_time: float | None = None, min_run: int = MIN_RUN) -> Path:
+def timeline_png(
+    records: Sequence[TaskRecord],
+    path: str | Path,
+    title: str | None = None,
+    max_rows: int = 200,
+    end_time: float | None = None,
+    min_run: int = MIN_RUN,
+) -> Path:
     """Draw the Gantt chart of `records` into the PNG file `path`; returns the path.
 
     One row per task; a run of at least `min_run` identical successful siblings shares one row
@@ -263,9 +285,14 @@ def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | N
         for (status, open_ended), bars in by_style.items():
             color = STATUS_COLORS.get(status, "#607d8b")
             unfinished = unfinished or open_ended
-            ax.broken_barh(bars, (i - 0.35, 0.7), facecolors=color,
-                           edgecolors="#37474f" if open_ended else color,
-                           hatch="//" if open_ended else None, linewidth=0.5)
+            ax.broken_barh(
+                bars,
+                (i - 0.35, 0.7),
+                facecolors=color,
+                edgecolors="#37474f" if open_ended else color,
+                hatch="//" if open_ended else None,
+                linewidth=0.5,
+            )
         r = node.record
         label = "  " * depth + (r.name if r.name == r.kind or not r.kind else f"{r.name} [{r.kind}]")
         suffix = f" ×{node.count}" if node.count > 1 else ""
@@ -289,8 +316,15 @@ def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | N
     handles = [Patch(color=STATUS_COLORS.get(s, "#607d8b"), label=s) for s in present]
     if unfinished:
         handles.append(Patch(facecolor="white", edgecolor="#37474f", hatch="//", label="no end recorded"))
-    ax.legend(handles=handles, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=len(handles), fontsize=8,
-              frameon=False, borderaxespad=0.2)
+    ax.legend(
+        handles=handles,
+        loc="lower right",
+        bbox_to_anchor=(1.0, 1.0),
+        ncol=len(handles),
+        fontsize=8,
+        frameon=False,
+        borderaxespad=0.2,
+    )
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, format="png")
@@ -298,6 +332,7 @@ def timeline_png(records: Sequence[TaskRecord], path: str | Path, title: str | N
 
 
 # -- from the database / from memory ------------------------------------------------------------
+
 
 def _title(run: Any) -> str:
     parts = [f"run {run.id}"]
@@ -328,8 +363,9 @@ def write_tree_svg(run_id: int | None, path: str | Path, url: str | None = None,
     return path
 
 
-def write_timeline_png(run_id: int | None, path: str | Path, url: str | None = None, max_rows: int = 200,
-                       min_run: int = MIN_RUN) -> Path:
+def write_timeline_png(
+    run_id: int | None, path: str | Path, url: str | None = None, max_rows: int = 200, min_run: int = MIN_RUN
+) -> Path:
     """Write the timeline of run `run_id` (newest when None) as PNG to `path` (see `timeline_png`)."""
     from pycram.trace import query
 
@@ -340,8 +376,10 @@ def write_timeline_png(run_id: int | None, path: str | Path, url: str | None = N
 def write_run_pictures(run_id: int | None, folder: str | Path, url: str | None = None) -> list[Path]:
     """Write `task-tree.svg` and `timeline.png` of a recorded run into `folder`; returns the paths."""
     folder = Path(folder)
-    return [write_tree_svg(run_id, folder / "task-tree.svg", url),
-            write_timeline_png(run_id, folder / "timeline.png", url)]
+    return [
+        write_tree_svg(run_id, folder / "task-tree.svg", url),
+        write_timeline_png(run_id, folder / "timeline.png", url),
+    ]
 
 
 def write_task_pictures(task: Any, folder: str | Path, title: str | None = None) -> list[Path]:

@@ -27,15 +27,26 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any
 
 import sqlalchemy as sa
 from sqlalchemy import exc as sa_exc
 
-from pycram.trace.db import (TraceDatabaseError, connect, database_error, designators_table, empty_engine,
-                             executions_table, fluent_samples_table, present_columns, runs_table, sqlite_file,
-                             tasks_table)
+from pycram.trace.db import (
+    TraceDatabaseError,
+    connect,
+    database_error,
+    designators_table,
+    empty_engine,
+    executions_table,
+    fluent_samples_table,
+    present_columns,
+    runs_table,
+    sqlite_file,
+    tasks_table,
+)
 
 __all__ = [
     "RunInfo",
@@ -68,7 +79,7 @@ class RunNotFound(LookupError):
 
 def _utc(value: _dt.datetime | None) -> _dt.datetime | None:
     if value is not None and value.tzinfo is None:  # SQLite stores naive datetimes
-        value = value.replace(tzinfo=_dt.timezone.utc)
+        value = value.replace(tzinfo=_dt.UTC)
     return value
 
 
@@ -105,7 +116,7 @@ class RunInfo:
         if self.outcome is not None:
             return self.outcome
         seen = self.last_seen_at or self.started_at
-        age = (_dt.datetime.now(_dt.timezone.utc) - seen).total_seconds()
+        age = (_dt.datetime.now(_dt.UTC) - seen).total_seconds()
         return "running" if age < 10.0 else "unfinished"
 
     @property
@@ -154,7 +165,7 @@ class TaskRecord:
 
     @property
     def error(self) -> str | None:
-        """"Type: message" of the failure, if any."""
+        """ "Type: message" of the failure, if any."""
         if self.error_type is None:
             return None
         return f"{self.error_type}: {self.error_message}" if self.error_message else self.error_type
@@ -231,8 +242,11 @@ class _Reading:
             present = present_columns(self.engine, table)
         except sa_exc.SQLAlchemyError as e:
             raise database_error(self.engine.url, e, "read") from None
-        return [table.c[name] if name in present else sa.null().label(name)
-                for name in record.__dataclass_fields__ if name in table.c]
+        return [
+            table.c[name] if name in present else sa.null().label(name)
+            for name in record.__dataclass_fields__
+            if name in table.c
+        ]
 
     def has(self, column: sa.Column) -> bool:
         """Whether the database has `column` (an old, unmigrated one may lack it)."""
@@ -260,11 +274,24 @@ def _run_info(row: Any) -> RunInfo:
     except ValueError:
         info = {}
     return RunInfo(
-        id=m["id"], uuid=m["uuid"], plan=m["plan"], robot=m["robot"], host=m["host"], pid=m["pid"],
-        command=m["command"], started_at=_utc(m["started_at"]), ended_at=_utc(m["ended_at"]),
-        last_seen_at=_utc(m["last_seen_at"]), outcome=m["outcome"], duration=m["duration"],
-        clock_origin=m["clock_origin"], error=m["error"], info=info, clock=m["clock"],
-        lost_records=m["lost_records"])
+        id=m["id"],
+        uuid=m["uuid"],
+        plan=m["plan"],
+        robot=m["robot"],
+        host=m["host"],
+        pid=m["pid"],
+        command=m["command"],
+        started_at=_utc(m["started_at"]),
+        ended_at=_utc(m["ended_at"]),
+        last_seen_at=_utc(m["last_seen_at"]),
+        outcome=m["outcome"],
+        duration=m["duration"],
+        clock_origin=m["clock_origin"],
+        error=m["error"],
+        info=info,
+        clock=m["clock"],
+        lost_records=m["lost_records"],
+    )
 
 
 def runs(url: str | None = None, limit: int | None = None, plan: str | None = None) -> list[RunInfo]:
@@ -282,7 +309,9 @@ def get_run(run_id: int | None = None, url: str | None = None) -> RunInfo:
     """The run `run_id`, or the newest run when None. Raises `RunNotFound`."""
     db = _Reading(url)
     stmt = sa.select(*db.columns(runs_table, RunInfo))
-    stmt = stmt.where(runs_table.c.id == run_id) if run_id is not None else stmt.order_by(runs_table.c.id.desc()).limit(1)
+    stmt = (
+        stmt.where(runs_table.c.id == run_id) if run_id is not None else stmt.order_by(runs_table.c.id.desc()).limit(1)
+    )
     found = db.rows(stmt)
     if not found:
         if run_id is None:
@@ -296,8 +325,11 @@ def get_run(run_id: int | None = None, url: str | None = None) -> RunInfo:
 def tasks(run_id: int, url: str | None = None) -> list[TaskRecord]:
     """The tasks of run `run_id` in creation order (empty if it has none)."""
     db = _Reading(url)
-    stmt = (sa.select(*db.columns(tasks_table, TaskRecord)).where(tasks_table.c.run_id == run_id)
-            .order_by(tasks_table.c.task_id))
+    stmt = (
+        sa.select(*db.columns(tasks_table, TaskRecord))
+        .where(tasks_table.c.run_id == run_id)
+        .order_by(tasks_table.c.task_id)
+    )
     return db.records(stmt, TaskRecord)
 
 
@@ -324,14 +356,20 @@ def _by_start(children: list[TaskNode]) -> list[TaskNode]:
     """Tasks in creation order, each execution record before the first task that started
     after it (executions without start time last)."""
     tasks_ = [c for c in children if c.record.task_id >= 0]
-    executions_ = sorted((c for c in children if c.record.task_id < 0),
-                         key=lambda c: (c.record.start is None, c.record.start or 0.0, -c.record.task_id))
+    executions_ = sorted(
+        (c for c in children if c.record.task_id < 0),
+        key=lambda c: (c.record.start is None, c.record.start or 0.0, -c.record.task_id),
+    )
     out: list[TaskNode] = []
     i = 0
     for task in tasks_:
         start = task.record.start
-        while i < len(executions_) and start is not None and executions_[i].record.start is not None \
-                and executions_[i].record.start < start:
+        while (
+            i < len(executions_)
+            and start is not None
+            and executions_[i].record.start is not None
+            and executions_[i].record.start < start
+        ):
             out.append(executions_[i])
             i += 1
         out.append(task)
@@ -355,12 +393,24 @@ def execution_nodes(records: Sequence[TaskRecord], executions_: Iterable[Executi
         if kinds.get(x.task_id) == ("process-module", name):
             continue  # a non-blocking execution: its own task already stands for it
         status = _EXECUTION_STATUS.get(x.outcome or "", x.outcome or "unknown")
-        out.append(TaskRecord(
-            run_id=x.run_id, task_id=-(len(out) + 1), parent_id=x.task_id, name=name, kind="process-module",
-            path=None, thread=None, status=status, start=x.start, end=x.end, duration=x.duration,
-            error_type=x.error_type if status != "succeeded" else None,
-            error_message=x.error_message if status != "succeeded" else None,
-            error_origin=-(len(out) + 1) if x.error_type and status != "succeeded" else None))
+        out.append(
+            TaskRecord(
+                run_id=x.run_id,
+                task_id=-(len(out) + 1),
+                parent_id=x.task_id,
+                name=name,
+                kind="process-module",
+                path=None,
+                thread=None,
+                status=status,
+                start=x.start,
+                end=x.end,
+                duration=x.duration,
+                error_type=x.error_type if status != "succeeded" else None,
+                error_message=x.error_message if status != "succeeded" else None,
+                error_origin=-(len(out) + 1) if x.error_type and status != "succeeded" else None,
+            )
+        )
     return out
 
 
@@ -385,19 +435,36 @@ def records_from_task(task: Any, run_id: int = 0) -> list[TaskRecord]:
     for node in task.walk():
         status = node.status.get_value()
         error = node.exception if status.value != "succeeded" else None
-        records.append(TaskRecord(
-            run_id=run_id, task_id=node.id, parent_id=node.parent.id if node.parent is not None and node is not task else None,
-            name=str(node.name), kind=node.kind, path=node.path, thread=None, status=status.value,
-            start=node.start_time, end=node.end_time, duration=node.duration,
-            error_type=type(error).__name__ if error is not None else None,
-            error_message=str(error) if error is not None else None,
-            error_origin=error_origin(node) if error is not None else None,
-            location=node.location))
+        records.append(
+            TaskRecord(
+                run_id=run_id,
+                task_id=node.id,
+                parent_id=node.parent.id if node.parent is not None and node is not task else None,
+                name=str(node.name),
+                kind=node.kind,
+                path=node.path,
+                thread=None,
+                status=status.value,
+                start=node.start_time,
+                end=node.end_time,
+                duration=node.duration,
+                error_type=type(error).__name__ if error is not None else None,
+                error_message=str(error) if error is not None else None,
+                error_origin=error_origin(node) if error is not None else None,
+                location=node.location,
+            )
+        )
     return records
 
 
-def failed_tasks(name: str | None = None, kind: str | None = None, error_type: str | None = None,
-                 run_id: int | None = None, url: str | None = None, propagated: bool = False) -> list[TaskRecord]:
+def failed_tasks(
+    name: str | None = None,
+    kind: str | None = None,
+    error_type: str | None = None,
+    run_id: int | None = None,
+    url: str | None = None,
+    propagated: bool = False,
+) -> list[TaskRecord]:
     """Failed tasks across all runs (or one), newest run first -- each failure once.
 
     A failure re-raised by enclosing tasks fails each of them; by default only the task where
@@ -424,10 +491,15 @@ def failed_tasks(name: str | None = None, kind: str | None = None, error_type: s
     if not propagated:
         child = tasks_table.alias("child")
         passed_on = sa.exists().where(
-            child.c.run_id == t.run_id, child.c.parent_id == t.task_id, child.c.status == "failed",
+            child.c.run_id == t.run_id,
+            child.c.parent_id == t.task_id,
+            child.c.status == "failed",
             child.c.error_type == t.error_type,
-            sa.or_(child.c.error_message == t.error_message,
-                   sa.and_(child.c.error_message.is_(None), t.error_message.is_(None))))
+            sa.or_(
+                child.c.error_message == t.error_message,
+                sa.and_(child.c.error_message.is_(None), t.error_message.is_(None)),
+            ),
+        )
         if db.has(t.error_origin):
             stmt = stmt.where(sa.or_(t.error_origin == t.task_id, sa.and_(t.error_origin.is_(None), ~passed_on)))
         else:
@@ -436,8 +508,14 @@ def failed_tasks(name: str | None = None, kind: str | None = None, error_type: s
     return db.records(stmt, TaskRecord)
 
 
-def durations(name: str, kind: str | None = None, status: str | None = None, exact: bool = True,
-              run_id: int | None = None, url: str | None = None) -> list[float]:
+def durations(
+    name: str,
+    kind: str | None = None,
+    status: str | None = None,
+    exact: bool = True,
+    run_id: int | None = None,
+    url: str | None = None,
+) -> list[float]:
     """Durations [s] of the ended tasks called `name` (a substring if not `exact`), across
     runs (oldest first), optionally only of one `kind` / `status`."""
     t = tasks_table.c
@@ -453,8 +531,9 @@ def durations(name: str, kind: str | None = None, status: str | None = None, exa
     return [row[0] for row in _Reading(url).rows(stmt)]
 
 
-def designators(run_id: int | None = None, designator_type: str | None = None,
-                url: str | None = None) -> list[DesignatorRecord]:
+def designators(
+    run_id: int | None = None, designator_type: str | None = None, url: str | None = None
+) -> list[DesignatorRecord]:
     """Designators performed (in one run or all), with the solutions they resolved to."""
     db = _Reading(url)
     d = designators_table.c
@@ -466,8 +545,13 @@ def designators(run_id: int | None = None, designator_type: str | None = None,
     return db.records(stmt, DesignatorRecord)
 
 
-def executions(run_id: int | None = None, module: str | None = None, outcome: str | None = None,
-               designator_type: str | None = None, url: str | None = None) -> list[ExecutionRecord]:
+def executions(
+    run_id: int | None = None,
+    module: str | None = None,
+    outcome: str | None = None,
+    designator_type: str | None = None,
+    url: str | None = None,
+) -> list[ExecutionRecord]:
     """Process-module executions (in one run or all), optionally filtered."""
     db = _Reading(url)
     x = executions_table.c

@@ -51,8 +51,9 @@ import threading
 import time
 import uuid
 import weakref
+from collections.abc import Iterable
 from enum import Enum
-from typing import Any, Iterable, Literal
+from typing import Any, Literal
 
 from pycram import events
 from pycram.fluent import Fluent
@@ -61,8 +62,15 @@ from pycram.runtime.clock import Clock, add_clock_listener, remove_clock_listene
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Recorder", "start_recording", "recording_enabled", "watch", "active_recorders", "error_origin",
-           "BACKLOG_LIMIT"]
+__all__ = [
+    "Recorder",
+    "start_recording",
+    "recording_enabled",
+    "watch",
+    "active_recorders",
+    "error_origin",
+    "BACKLOG_LIMIT",
+]
 
 _TEXT_LIMIT = 4000
 #: Rows kept for a retry while the database fails; older ones are dropped (and counted) beyond.
@@ -80,7 +88,7 @@ def recording_enabled(default: bool) -> bool:
 
 
 def _now_utc() -> _dt.datetime:
-    return _dt.datetime.now(_dt.timezone.utc)
+    return _dt.datetime.now(_dt.UTC)
 
 
 def _short(text: str, limit: int = _TEXT_LIMIT) -> str:
@@ -212,10 +220,19 @@ class Recorder:
     can tell a quiet running plan (state "running") from a killed one ("unfinished").
     """
 
-    def __init__(self, url: str | None = None, *, plan: str | None = None, robot: str | None = None,
-                 scope: Task | None = None, flush_interval: float = 0.5, command: str | None = None,
-                 info: dict[str, Any] | None = None, fluent_rate_hz: float | None = 10.0,
-                 heartbeat_interval: float = 2.0) -> None:
+    def __init__(
+        self,
+        url: str | None = None,
+        *,
+        plan: str | None = None,
+        robot: str | None = None,
+        scope: Task | None = None,
+        flush_interval: float = 0.5,
+        command: str | None = None,
+        info: dict[str, Any] | None = None,
+        fluent_rate_hz: float | None = 10.0,
+        heartbeat_interval: float = 2.0,
+    ) -> None:
         from pycram.trace.db import resolve_url
 
         self.url = resolve_url(url)
@@ -271,11 +288,20 @@ class Recorder:
         now = _now_utc()
         try:
             with engine.begin() as conn:
-                result = conn.execute(runs_table.insert().values(
-                    uuid=self.run_uuid, plan=_short(self.plan or "", 255) or None, robot=self.robot,
-                    host=_short(socket.gethostname(), 255), pid=os.getpid(), command=_short(self.command),
-                    started_at=now, last_seen_at=now, clock_origin=self.clock_origin,
-                    info=json.dumps(self.info, default=str) if self.info else None))
+                result = conn.execute(
+                    runs_table.insert().values(
+                        uuid=self.run_uuid,
+                        plan=_short(self.plan or "", 255) or None,
+                        robot=self.robot,
+                        host=_short(socket.gethostname(), 255),
+                        pid=os.getpid(),
+                        command=_short(self.command),
+                        started_at=now,
+                        last_seen_at=now,
+                        clock_origin=self.clock_origin,
+                        info=json.dumps(self.info, default=str) if self.info else None,
+                    )
+                )
                 self.run_id = int(result.inserted_primary_key[0])
         except sa_exc.SQLAlchemyError as e:  # e.g. a read-only file: say so before the plan runs
             engine.dispose()
@@ -303,8 +329,9 @@ class Recorder:
         self.info.update(info)
         self._put(("r", self.plan, self.robot, dict(self.info)))
 
-    def watch(self, fluent: Fluent, name: str | None = None,
-              max_rate_hz: float | None | Literal["default"] = "default") -> None:
+    def watch(
+        self, fluent: Fluent, name: str | None = None, max_rate_hz: float | None | Literal["default"] = "default"
+    ) -> None:
         """Sample `fluent` under `name` (default: the fluent's name) whenever it is set, at most
         `max_rate_hz` times per second ("default": the recorder's `fluent_rate_hz`; None or 0:
         every change). The current value is recorded at once. O(1) per change, no thread.
@@ -378,7 +405,7 @@ class Recorder:
         return self.run_id
 
     def loss_report(self) -> str | None:
-        """"N trace records could not be written: why" once records were lost, else None."""
+        """ "N trace records could not be written: why" once records were lost, else None."""
         if not self.lost_records:
             return None
         records = "1 trace record" if self.lost_records == 1 else f"{self.lost_records} trace records"
@@ -399,8 +426,15 @@ class Recorder:
     def _on_designator(self, designator: Any, solution: Any = None, error: BaseException | None = None) -> None:
         self._put(("d", current_task(), current_clock().now(), designator, solution, error))
 
-    def _on_execution(self, module: Any, designator: Any, outcome: Any, start: float | None,
-                      end: float | None, error: BaseException | None = None) -> None:
+    def _on_execution(
+        self,
+        module: Any,
+        designator: Any,
+        outcome: Any,
+        start: float | None,
+        end: float | None,
+        error: BaseException | None = None,
+    ) -> None:
         self._put(("x", current_task(), module, designator, outcome, start, end, error))
 
     def _on_clock(self, clock: Clock) -> None:
@@ -450,8 +484,9 @@ class Recorder:
                     self.lost_records += state.give_up()
             else:
                 if self.last_error is not None and self.write_errors and state.failing:
-                    log.warning("trace writer: run %s is written again after %d failed attempts",
-                                self.run_id, self.write_errors)
+                    log.warning(
+                        "trace writer: run %s is written again after %d failed attempts", self.run_id, self.write_errors
+                    )
                 state.failing = False
             for done in flushes:
                 done.set()
@@ -461,18 +496,38 @@ class Recorder:
 
         self.write_errors += 1
         text = str(getattr(error, "orig", None) or error).strip()
-        self.last_error = (text.splitlines()[0] if text else type(error).__name__)
+        self.last_error = text.splitlines()[0] if text else type(error).__name__
         if not isinstance(error, sa_exc.SQLAlchemyError):
             log.exception("trace writer: could not write a batch of run %s", self.run_id)
         elif not state.failing:  # once per streak of failures: the writer retries every batch
-            log.warning("trace writer: cannot write to %s (%s); keeping %d rows of run %s for a retry",
-                        _display(self.url), self.last_error, state.backlog_size(), self.run_id)
+            log.warning(
+                "trace writer: cannot write to %s (%s); keeping %d rows of run %s for a retry",
+                _display(self.url),
+                self.last_error,
+                state.backlog_size(),
+                self.run_id,
+            )
         state.failing = True
         self.lost_records += state.trim(BACKLOG_LIMIT)
 
 
-_TASK_COLUMNS = ("run_id", "task_id", "parent_id", "name", "kind", "path", "thread", "status", "start", "end",
-                 "duration", "error_type", "error_message", "error_origin", "location")
+_TASK_COLUMNS = (
+    "run_id",
+    "task_id",
+    "parent_id",
+    "name",
+    "kind",
+    "path",
+    "thread",
+    "status",
+    "start",
+    "end",
+    "duration",
+    "error_type",
+    "error_message",
+    "error_origin",
+    "location",
+)
 
 
 class _WriterState:
@@ -502,10 +557,14 @@ class _WriterState:
         dialect = recorder._engine.dialect
         mark = "?" if dialect.paramstyle == "qmark" else "%s"
         q = dialect.identifier_preparer.quote
-        self.sql_insert = (f"INSERT INTO pycram_tasks ({', '.join(q(c) for c in _TASK_COLUMNS)}) "
-                           f"VALUES ({', '.join([mark] * len(_TASK_COLUMNS))})")
-        self.sql_update = (f"UPDATE pycram_tasks SET {', '.join(f'{q(c)} = {mark}' for c in _TASK_COLUMNS[7:])} "
-                           f"WHERE run_id = {mark} AND task_id = {mark}")
+        self.sql_insert = (
+            f"INSERT INTO pycram_tasks ({', '.join(q(c) for c in _TASK_COLUMNS)}) "
+            f"VALUES ({', '.join([mark] * len(_TASK_COLUMNS))})"
+        )
+        self.sql_update = (
+            f"UPDATE pycram_tasks SET {', '.join(f'{q(c)} = {mark}' for c in _TASK_COLUMNS[7:])} "
+            f"WHERE run_id = {mark} AND task_id = {mark}"
+        )
 
     def _task_row(self, task: Task) -> tuple:
         """The row of `task` in `_TASK_COLUMNS` order (hot path: kept cheap)."""
@@ -521,10 +580,23 @@ class _WriterState:
         thread = self.thread_names.get(runner.ident) if runner is not None else None
         name = task.name
         start, end = task.start_time, task.end_time
-        return (self.run_id, task.id, parent.id if parent is not None else None,
-                name if len(name) <= 512 else name[:511] + "…", task.kind, task.path, thread, status,
-                start, end, end - start if start is not None and end is not None else None,
-                error_type, error_message, origin, task.location)
+        return (
+            self.run_id,
+            task.id,
+            parent.id if parent is not None else None,
+            name if len(name) <= 512 else name[:511] + "…",
+            task.kind,
+            task.path,
+            thread,
+            status,
+            start,
+            end,
+            end - start if start is not None and end is not None else None,
+            error_type,
+            error_message,
+            origin,
+            task.location,
+        )
 
     def _wanted(self, task: Task) -> bool:
         scope = self.recorder.scope
@@ -567,37 +639,71 @@ class _WriterState:
             tag = item[0]
             if tag == "f":
                 _, name, value, t = item
-                rows.append((fluent_samples_table, {"run_id": run_id, "name": name, "time": t,
-                                                    "value": _text(value), "number": _number(value)}))
+                rows.append(
+                    (
+                        fluent_samples_table,
+                        {"run_id": run_id, "name": name, "time": t, "value": _text(value), "number": _number(value)},
+                    )
+                )
             elif tag == "d":
                 _, task, t, designator, solution, error = item
                 error_type, error_message = _error_fields(error)
-                rows.append((designators_table, {
-                    "run_id": run_id, "task_id": task.id if task is not None else None, "time": t,
-                    "designator_class": type(designator).__name__, "designator_type": _designator_type(designator),
-                    "designator": _text(designator), "solution": _text(_solution_text(solution)),
-                    "error_type": error_type, "error_message": error_message}))
+                rows.append(
+                    (
+                        designators_table,
+                        {
+                            "run_id": run_id,
+                            "task_id": task.id if task is not None else None,
+                            "time": t,
+                            "designator_class": type(designator).__name__,
+                            "designator_type": _designator_type(designator),
+                            "designator": _text(designator),
+                            "solution": _text(_solution_text(solution)),
+                            "error_type": error_type,
+                            "error_message": error_message,
+                        },
+                    )
+                )
             elif tag == "x":
                 _, task, module, designator, outcome, start, end, error = item
                 error_type, error_message = _error_fields(error)
-                rows.append((executions_table, {
-                    "run_id": run_id, "task_id": task.id if task is not None else None,
-                    "module": _short(str(getattr(module, "name", module)), 255),
-                    "designator_type": _designator_type(designator), "designator": _text(designator),
-                    "outcome": _text(outcome), "start": start, "end": end,
-                    "duration": (end - start) if start is not None and end is not None else None,
-                    "error_type": error_type, "error_message": error_message}))
+                rows.append(
+                    (
+                        executions_table,
+                        {
+                            "run_id": run_id,
+                            "task_id": task.id if task is not None else None,
+                            "module": _short(str(getattr(module, "name", module)), 255),
+                            "designator_type": _designator_type(designator),
+                            "designator": _text(designator),
+                            "outcome": _text(outcome),
+                            "start": start,
+                            "end": end,
+                            "duration": (end - start) if start is not None and end is not None else None,
+                            "error_type": error_type,
+                            "error_message": error_message,
+                        },
+                    )
+                )
                 self._saw_clock()
             elif tag == "clock":
                 self.clock_kind = item[1]
             elif tag == "r":
                 _, plan, robot, info = item
-                self.run_update.update(plan=_short(plan, 255) if plan else None, robot=robot,
-                                       info=json.dumps(info, default=str) if info else None)
+                self.run_update.update(
+                    plan=_short(plan, 255) if plan else None,
+                    robot=robot,
+                    info=json.dumps(info, default=str) if info else None,
+                )
             elif tag == "end":
                 _, outcome, duration, error = item
-                self.run_update.update(outcome=outcome, duration=duration, error=error, ended_at=_now_utc(),
-                                       lost_records=self.recorder.lost_records)
+                self.run_update.update(
+                    outcome=outcome,
+                    duration=duration,
+                    error=error,
+                    ended_at=_now_utc(),
+                    lost_records=self.recorder.lost_records,
+                )
 
     def commit(self) -> None:
         """Write every pending row in one transaction; raises what the database raised."""
@@ -698,8 +804,9 @@ def _finish_live_recorders() -> None:
             log.exception("could not finish recording run %s at exit", recorder.run_id)
 
 
-def start_recording(url: str | None = None, plan: str | None = None, robot: str | None = None,
-                    **kwargs: Any) -> Recorder:
+def start_recording(
+    url: str | None = None, plan: str | None = None, robot: str | None = None, **kwargs: Any
+) -> Recorder:
     """Create and start a `Recorder` (see its docstring); raises `TraceDatabaseError`."""
     return Recorder(url, plan=plan, robot=robot, **kwargs).start()
 
@@ -709,8 +816,7 @@ def active_recorders() -> list[Recorder]:
     return [r for r in list(_live_recorders) if r._engine is not None and not r._finished]
 
 
-def watch(fluent: Fluent, name: str | None = None,
-          max_rate_hz: float | None | Literal["default"] = "default") -> int:
+def watch(fluent: Fluent, name: str | None = None, max_rate_hz: float | None | Literal["default"] = "default") -> int:
     """Record `fluent` in every active recorder (see `Recorder.watch`); returns how many.
 
     For plan scripts run by `pycram run` (recorded by default): `pycram.trace.watch(pose,

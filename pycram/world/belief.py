@@ -77,8 +77,15 @@ def color_name(rgb: Iterable[float]) -> str:
         hue = 60.0 * (b - r) / (high - low) + 120.0
     else:
         hue = 60.0 * (r - g) / (high - low) + 240.0
-    for limit, name in ((18, "red"), (40, "orange"), (70, "yellow"), (165, "green"), (260, "blue"),
-                        (330, "purple"), (360, "red")):
+    for limit, name in (
+        (18, "red"),
+        (40, "orange"),
+        (70, "yellow"),
+        (165, "green"),
+        (260, "blue"),
+        (330, "purple"),
+        (360, "red"),
+    ):
         if hue < limit:
             return name
     return "red"
@@ -146,8 +153,11 @@ class CameraView:
             return False
         u, v, _ = projected
         width, height = self.size
-        return (border <= u < width - border and border <= v < height - border
-                and math.dist(tuple(point), self.position) <= self.max_range)
+        return (
+            border <= u < width - border
+            and border <= v < height - border
+            and math.dist(tuple(point), self.position) <= self.max_range
+        )
 
     def expects_visible(self, point: Iterable[float], border: float = 4.0, tolerance: float = 0.06) -> bool:
         """True when an object at `point` [m, map] should be seen: it projects into the image
@@ -223,8 +233,10 @@ class PerceivedObject(BelievedObject):
     def __repr__(self) -> str:
         pose = "?" if self.pose is None else "(" + ", ".join(f"{v:.2f}" for v in self.pose) + ")"
         where = self.properties.get("on")
-        return (f"<{self.name}: {self.properties.get('color')} {self.type} at {pose}"
-                f"{' on ' + where if where else ''}{' (gone)' if self.gone else ''}>")
+        return (
+            f"<{self.name}: {self.properties.get('color')} {self.type} at {pose}"
+            f"{' on ' + where if where else ''}{' (gone)' if self.gone else ''}>"
+        )
 
 
 @dataclass(frozen=True)
@@ -286,10 +298,15 @@ class BeliefState(Belief):
         with self._update_lock:
             self.container_states.update(report.container_states)
             known = [o for o in self.objects() if isinstance(o, PerceivedObject)]
-            pairs = sorted(((math.dist(d.position[:2], o.pose[:2]), i, j)
-                            for i, d in enumerate(report.detections)
-                            for j, o in enumerate(known) if o.type == d.type and o.pose is not None),
-                           key=lambda p: (p[0], known[p[2]].gone))
+            pairs = sorted(
+                (
+                    (math.dist(d.position[:2], o.pose[:2]), i, j)
+                    for i, d in enumerate(report.detections)
+                    for j, o in enumerate(known)
+                    if o.type == d.type and o.pose is not None
+                ),
+                key=lambda p: (p[0], known[p[2]].gone),
+            )
             detection_of: dict[int, int] = {}
             used: set[int] = set()
             for distance, i, j in pairs:
@@ -310,12 +327,19 @@ class BeliefState(Belief):
             if report.view is not None:
                 view = report.view
                 forward = -np.asarray(view.rotation, float).reshape(3, 3)[:, 2]
-                self.looks = [*self.looks[-(MAX_LOOKS - 1):],
-                              Look(report.stamp, tuple(view.position), tuple(float(v) for v in forward),
-                                   view.fovy, view.max_range)]
+                self.looks = [
+                    *self.looks[-(MAX_LOOKS - 1) :],
+                    Look(
+                        report.stamp, tuple(view.position), tuple(float(v) for v in forward), view.fovy, view.max_range
+                    ),
+                ]
                 for j, obj in enumerate(known):
-                    if j not in used and not obj.gone and obj.pose is not None \
-                            and report.view.expects_visible(obj.pose):
+                    if (
+                        j not in used
+                        and not obj.gone
+                        and obj.pose is not None
+                        and report.view.expects_visible(obj.pose)
+                    ):
                         obj.gone = True
                         gone.append(obj)
         self.updated.set_value(report.stamp)
@@ -344,29 +368,38 @@ class BeliefState(Belief):
 
     @staticmethod
     def _refresh(obj: PerceivedObject, detection: Detection, stamp: float) -> None:
-        obj.properties.update(color=detection.color, size=detection.size, on=detection.support,
-                              **{"in": detection.container}, last_seen=stamp, pixels=detection.pixels)
+        obj.properties.update(
+            color=detection.color,
+            size=detection.size,
+            on=detection.support,
+            **{"in": detection.container},
+            last_seen=stamp,
+            pixels=detection.pixels,
+        )
         obj.gone = False
         obj.times_seen += 1
         obj.pose = detection.position
         obj.pose_fluent.set_value(detection.position)
 
 
-def support_of(environment: Environment, x: float, y: float, bottom: float,
-               container_states: dict[str, float] | None = None,
-               tolerance: float = 0.04) -> Surface | None:
+def support_of(
+    environment: Environment,
+    x: float,
+    y: float,
+    bottom: float,
+    container_states: dict[str, float] | None = None,
+    tolerance: float = 0.04,
+) -> Surface | None:
     """The surface an object whose lowest seen point is at height `bottom` [m] rests on at
     (x, y) [m]: the highest surface under (x, y) not above `bottom` + `tolerance`, drawers'
     insides moved out by their measured opening (`container_states`). None on the floor."""
     states = container_states or {}
-    candidates: list[Surface] = [s for s in environment.surfaces
-                                 if s.height <= bottom + tolerance and s.contains(x, y)]
+    candidates: list[Surface] = [s for s in environment.surfaces if s.height <= bottom + tolerance and s.contains(x, y)]
     for container in environment.containers:
         dx = dy = 0.0
         if container.kind == "drawer":
             q = states.get(container.name, 0.0)
             dx, dy = q * container.opening_direction[0], q * container.opening_direction[1]
-        candidates += [s for s in container.interior
-                       if s.height <= bottom + tolerance and s.contains(x - dx, y - dy)]
+        candidates += [s for s in container.interior if s.height <= bottom + tolerance and s.contains(x - dx, y - dy)]
     # the highest; of equally high ones the smallest (a cooker on its counter)
     return min(candidates, key=lambda s: (-round(s.height, 3), s.area), default=None)

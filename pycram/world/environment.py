@@ -9,8 +9,9 @@ Polygons are convex and counter-clockwise (checked on construction).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable, Literal
+from typing import Literal
 
 from .errors import UnknownNameError
 
@@ -78,8 +79,9 @@ class Surface:
         return [(p[i], p[(i + 1) % len(p)]) for i in range(len(p))]
 
     @classmethod
-    def rectangle(cls, name: str, rect: Rect, height: float, kind: str = "counter",
-                  clearance: float = math.inf) -> "Surface":
+    def rectangle(
+        cls, name: str, rect: Rect, height: float, kind: str = "counter", clearance: float = math.inf
+    ) -> Surface:
         """A rectangular surface over `rect` (x_min, y_min, x_max, y_max)."""
         x0, y0, x1, y1 = rect
         return cls(name, ((x0, y0), (x1, y0), (x1, y1), (x0, y1)), height, kind, clearance)
@@ -269,8 +271,7 @@ class Environment:
     def plan_bounds(self) -> Rect:
         """The rectangle around the floor and everything standing on it (walls included)."""
         rects = list(self.floor) + [b.footprint for b in self.static] + [c.body.footprint for c in self.containers]
-        return (min(r[0] for r in rects), min(r[1] for r in rects), max(r[2] for r in rects),
-                max(r[3] for r in rects))
+        return (min(r[0] for r in rects), min(r[1] for r in rects), max(r[2] for r in rects), max(r[3] for r in rects))
 
     def obstacles(self) -> list[Box]:
         """Static boxes and closed container bodies that stand in the way of a driving base
@@ -281,8 +282,9 @@ class Environment:
     def is_free_floor(self, x: float, y: float, margin: float = 0.0) -> bool:
         """True when (x, y) lies on the floor, at least `margin` [m] away from the walls of the
         floor rectangles' union and from every obstacle's footprint."""
-        if not any(x0 + margin <= x <= x1 - margin and y0 + margin <= y <= y1 - margin
-                   for x0, y0, x1, y1 in self.floor):
+        if not any(
+            x0 + margin <= x <= x1 - margin and y0 + margin <= y <= y1 - margin for x0, y0, x1, y1 in self.floor
+        ):
             return False
         for b in self.obstacles():
             x0, y0, x1, y1 = b.footprint
@@ -308,5 +310,18 @@ def rect_around(center: XY, half: XY) -> Rect:
     return (center[0] - half[0], center[1] - half[1], center[0] + half[0], center[1] + half[1])
 
 
-__all__ = ["Box", "Surface", "Container", "Place", "Camera", "Environment", "Rect", "XY", "Vec3", "RGBA",
-           "FURNITURE_TOPS", "rect_around", "UnknownNameError"]
+__all__ = [
+    "Box",
+    "Surface",
+    "Container",
+    "Place",
+    "Camera",
+    "Environment",
+    "Rect",
+    "XY",
+    "Vec3",
+    "RGBA",
+    "FURNITURE_TOPS",
+    "rect_around",
+    "UnknownNameError",
+]

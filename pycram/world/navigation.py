@@ -38,8 +38,8 @@ from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
 
 import numpy as np
 
@@ -79,8 +79,7 @@ class NoPathError(GoalUnreachable):
     on the free floor), ``'goal_in_collision'`` (the robot does not fit at the goal pose) or
     ``'outside_map'`` (start or goal is off the map). ``start``/``goal`` are the poses asked."""
 
-    def __init__(self, reason: str, message: str, start: Optional[BasePose] = None,
-                 goal: Optional[BasePose] = None) -> None:
+    def __init__(self, reason: str, message: str, start: BasePose | None = None, goal: BasePose | None = None) -> None:
         super().__init__(f"{reason}: {message}")
         self.reason = reason
         self.start, self.goal = start, goal
@@ -103,8 +102,10 @@ class OccupancyGrid:
 
     def cell(self, x: float, y: float) -> tuple[int, int]:
         """(row, col) of the cell containing map point (x, y) [m] (may be outside the grid)."""
-        return (int(math.floor((y - self.origin[1]) / self.resolution)),
-                int(math.floor((x - self.origin[0]) / self.resolution)))
+        return (
+            int(math.floor((y - self.origin[1]) / self.resolution)),
+            int(math.floor((x - self.origin[0]) / self.resolution)),
+        )
 
     def center(self, row: int, col: int) -> tuple[float, float]:
         """Map point [m] at the centre of cell (row, col)."""
@@ -123,14 +124,18 @@ class Footprint:
     vertices: tuple[tuple[float, float], ...]
 
     @classmethod
-    def circle(cls, radius: float, sides: int = 16) -> "Footprint":
+    def circle(cls, radius: float, sides: int = 16) -> Footprint:
         """A regular polygon circumscribing a circle of ``radius`` [m]."""
         r = radius / math.cos(math.pi / sides)
-        return cls(tuple((r * math.cos(2 * math.pi * (i + 0.5) / sides),
-                          r * math.sin(2 * math.pi * (i + 0.5) / sides)) for i in range(sides)))
+        return cls(
+            tuple(
+                (r * math.cos(2 * math.pi * (i + 0.5) / sides), r * math.sin(2 * math.pi * (i + 0.5) / sides))
+                for i in range(sides)
+            )
+        )
 
     @classmethod
-    def rectangle(cls, x_min: float, y_min: float, x_max: float, y_max: float) -> "Footprint":
+    def rectangle(cls, x_min: float, y_min: float, x_max: float, y_max: float) -> Footprint:
         return cls(((x_min, y_min), (x_max, y_min), (x_max, y_max), (x_min, y_max)))
 
     @property
@@ -166,7 +171,7 @@ def dilate(mask: np.ndarray, radius_cells: float) -> np.ndarray:
     for dr in range(-r, r + 1):
         w = int(math.floor(math.sqrt(radius_cells * radius_cells - dr * dr)))
         # rows shifted by dr, then a horizontal run of half-width w (a 1D dilation by doubling)
-        src = mask[max(0, -dr):rows - max(0, dr)]
+        src = mask[max(0, -dr) : rows - max(0, dr)]
         run = src.copy()
         span = 1
         while span <= w:
@@ -176,7 +181,7 @@ def dilate(mask: np.ndarray, radius_cells: float) -> np.ndarray:
             shifted[:, :-step] |= run[:, step:]
             run |= shifted
             span += step
-        out[max(0, dr):rows - max(0, -dr)] |= run
+        out[max(0, dr) : rows - max(0, -dr)] |= run
     return out
 
 
@@ -189,8 +194,9 @@ class _Layer:
     the whole robot as it stands). The outline is one convex footprint or several (their
     union, e.g. the base and each arm); the first contains the base origin."""
 
-    def __init__(self, mask: np.ndarray, outline: "Footprint | Sequence[Footprint]", grid: OccupancyGrid,
-                 margin: float) -> None:
+    def __init__(
+        self, mask: np.ndarray, outline: Footprint | Sequence[Footprint], grid: OccupancyGrid, margin: float
+    ) -> None:
         parts = [outline] if isinstance(outline, Footprint) else list(outline)
         self.mask = mask
         self.edges = [part._edges() for part in parts]
@@ -199,8 +205,7 @@ class _Layer:
         self.grid = grid
         self.reach = self.circumscribed + margin
 
-    def hits(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float
-             ) -> tuple[np.ndarray, np.ndarray]:
+    def hits(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarray]:
         """Per pose: does the outline's first part (around the base), grown by `margin`, cover
         an occupied cell; does another part?"""
         base, other = np.zeros(len(xs), bool), np.zeros(len(xs), bool)
@@ -236,8 +241,8 @@ class _Query:
     """What one `PathPlanner.plan` call checks with: the start to move off unchecked (or None)
     and the backend's exact check (or None)."""
 
-    escape: Optional[BasePose]
-    exact: Optional["PoseCheck"]
+    escape: BasePose | None
+    exact: PoseCheck | None
 
 
 class PathPlanner:
@@ -252,9 +257,14 @@ class PathPlanner:
     of passing where the footprint fits only at some headings.
     """
 
-    def __init__(self, grid: OccupancyGrid, footprint: Footprint, clearance: float = 0.03,
-                 cost_weight: float = 2.0,
-                 layers: Sequence[tuple[np.ndarray, "Footprint | Sequence[Footprint]"]] = ()) -> None:
+    def __init__(
+        self,
+        grid: OccupancyGrid,
+        footprint: Footprint,
+        clearance: float = 0.03,
+        cost_weight: float = 2.0,
+        layers: Sequence[tuple[np.ndarray, Footprint | Sequence[Footprint]]] = (),
+    ) -> None:
         res = grid.resolution
         # a cell is marked when its centre is under an obstacle: the obstacle may reach half a
         # cell diagonal further, so checks add that to the clearance
@@ -282,13 +292,12 @@ class PathPlanner:
         self._turn_radius = max(layer.circumscribed for layer in self._layers)
 
     # ------------------------------------------------------------------ checks
-    def pose_free(self, x: float, y: float, yaw: float, exact_check: Optional["PoseCheck"] = None) -> bool:
+    def pose_free(self, x: float, y: float, yaw: float, exact_check: PoseCheck | None = None) -> bool:
         """Does the footprint at (x, y, yaw), grown by the clearance, stay off occupied cells?
         Off-map poses count as free (nothing is known there)."""
         return self._free(np.array([x], float), np.array([y], float), np.array([yaw], float), exact_check)
 
-    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray,
-              exact_check: Optional["PoseCheck"] = None) -> bool:
+    def _free(self, xs: np.ndarray, ys: np.ndarray, yaws: np.ndarray, exact_check: PoseCheck | None = None) -> bool:
         """Whether every pose (xs[i], ys[i], yaws[i]) is free (see `pose_free`)."""
         g = self.grid
         rows = np.floor((ys - g.origin[1]) / g.resolution).astype(int)
@@ -313,15 +322,15 @@ class PathPlanner:
         # only they are in the way, the backend's exact check decides
         return all(exact_check(float(xs[i]), float(ys[i]), float(yaws[i])) for i in np.nonzero(hit)[0])
 
-    def segment_free(self, a: BasePose, b: BasePose, escape: Optional[BasePose] = None,
-                     exact_check: Optional["PoseCheck"] = None) -> bool:
+    def segment_free(
+        self, a: BasePose, b: BasePose, escape: BasePose | None = None, exact_check: PoseCheck | None = None
+    ) -> bool:
         """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?
         Poses within `ESCAPE_RADIUS` of ``escape`` are not checked."""
         dist = math.hypot(b.x - a.x, b.y - a.y)
         dyaw = _wrap(b.yaw - a.yaw)
         # sample so that neither the centre nor a corner moves more than half a cell per step
-        n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius)
-                                 / (0.5 * self.grid.resolution))))
+        n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius) / (0.5 * self.grid.resolution))))
         s = np.linspace(0.0, 1.0, n + 1)
         xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
         if escape is not None:
@@ -330,7 +339,7 @@ class PathPlanner:
         return self._free(xs, ys, yaws, exact_check)
 
     # ------------------------------------------------------------------ planning
-    def plan(self, start: object, goal: object, exact_check: Optional[PoseCheck] = None) -> list[BasePose]:
+    def plan(self, start: object, goal: object, exact_check: PoseCheck | None = None) -> list[BasePose]:
         """Waypoints from ``start`` to ``goal`` (start excluded, goal last), each reached by a
         straight, footprint-checked drive from the one before. Raises :class:`NoPathError`.
 
@@ -341,8 +350,12 @@ class PathPlanner:
         a, b = as_base_pose(start), as_base_pose(goal)
         g = self.grid
         if not self.pose_free(b.x, b.y, b.yaw, exact_check):
-            raise NoPathError("goal_in_collision", f"the robot does not fit at the goal "
-                              f"(x={b.x:.2f}, y={b.y:.2f}, yaw={b.yaw:.2f})", a, b)
+            raise NoPathError(
+                "goal_in_collision",
+                f"the robot does not fit at the goal (x={b.x:.2f}, y={b.y:.2f}, yaw={b.yaw:.2f})",
+                a,
+                b,
+            )
         escape = None if self.pose_free(a.x, a.y, a.yaw, exact_check) else a
         ctx = _Query(escape, exact_check)
         if self.path_free(a, [b], exact_check):
@@ -350,14 +363,19 @@ class PathPlanner:
         sc, gc = g.cell(a.x, a.y), g.cell(b.x, b.y)
         for name, cell, pose in (("start", sc, a), ("goal", gc, b)):
             if not g.inside(*cell):
-                raise NoPathError("outside_map", f"the {name} (x={pose.x:.2f}, y={pose.y:.2f}) is off "
-                                  f"the map of the floor", a, b)
+                raise NoPathError(
+                    "outside_map", f"the {name} (x={pose.x:.2f}, y={pose.y:.2f}) is off the map of the floor", a, b
+                )
         bad: set[tuple[int, int]] = set()
         for _attempt in range(MAX_SEARCHES):
             cells = self._astar(sc, gc, bad, escape is None)
             if cells is None:
-                raise NoPathError("no_path", f"no collision-free path from (x={a.x:.2f}, y={a.y:.2f}) to "
-                                  f"(x={b.x:.2f}, y={b.y:.2f})", a, b)
+                raise NoPathError(
+                    "no_path",
+                    f"no collision-free path from (x={a.x:.2f}, y={a.y:.2f}) to (x={b.x:.2f}, y={b.y:.2f})",
+                    a,
+                    b,
+                )
             path, misfits = self._shorten(a, b, cells, ctx)
             if not misfits:
                 hit = self._exact_hit(a, path, escape, exact_check)
@@ -365,13 +383,16 @@ class PathPlanner:
                     return path
                 r, c = g.cell(*hit)  # the robot touches something there: keep its centre away
                 k = EXACT_BLOCK_CELLS
-                misfits = {(rr, cc) for rr in range(r - k, r + k + 1) for cc in range(c - k, c + k + 1)
-                           if g.inside(rr, cc) and (rr, cc) not in (sc, gc)}
+                misfits = {
+                    (rr, cc)
+                    for rr in range(r - k, r + k + 1)
+                    for cc in range(c - k, c + k + 1)
+                    if g.inside(rr, cc) and (rr, cc) not in (sc, gc)
+                }
             bad |= misfits  # the footprint fits there at no heading (or cannot turn there)
         raise NoPathError("no_path", "no path where the robot fits at the headings it needs", a, b)
 
-    def path_free(self, start: BasePose, waypoints: list[BasePose],
-                  exact_check: Optional[PoseCheck] = None) -> bool:
+    def path_free(self, start: BasePose, waypoints: list[BasePose], exact_check: PoseCheck | None = None) -> bool:
         """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?"""
         escape = None if self.pose_free(start.x, start.y, start.yaw, exact_check) else start
         prev = start
@@ -381,8 +402,9 @@ class PathPlanner:
             prev = w
         return self._exact_hit(start, waypoints, escape, exact_check) is None
 
-    def _exact_hit(self, start: BasePose, waypoints: list[BasePose], escape: Optional[BasePose],
-                   exact_check: Optional[PoseCheck]) -> Optional[tuple[float, float]]:
+    def _exact_hit(
+        self, start: BasePose, waypoints: list[BasePose], escape: BasePose | None, exact_check: PoseCheck | None
+    ) -> tuple[float, float] | None:
         """The first (x, y) along the path where ``exact_check`` fails, or None."""
         if exact_check is None:
             return None
@@ -401,15 +423,16 @@ class PathPlanner:
             prev = w
         return None
 
-    def _astar(self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]],
-               start_free: bool) -> Optional[list[tuple[int, int]]]:
+    def _astar(
+        self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]], start_free: bool
+    ) -> list[tuple[int, int]] | None:
         rows, cols = self.lethal.shape
         passable = ~self.lethal
         if not start_free:
             # the robot already touches something: let it move off through the cells nearby
             k = int(math.ceil(ESCAPE_RADIUS / self.grid.resolution))
             r, c = sc
-            passable[max(0, r - k):r + k + 1, max(0, c - k):c + k + 1] = True
+            passable[max(0, r - k) : r + k + 1, max(0, c - k) : c + k + 1] = True
         for cell in bad:
             passable[cell] = False
         passable[sc] = passable[gc] = True
@@ -418,8 +441,16 @@ class PathPlanner:
         w = self.cost_weight
         start, goal = sc[0] * cols + sc[1], gc[0] * cols + gc[1]
         gr, gcl = gc
-        neighbours = ((1, 0, 1.0), (-1, 0, 1.0), (0, 1, 1.0), (0, -1, 1.0),
-                      (1, 1, SQRT2), (1, -1, SQRT2), (-1, 1, SQRT2), (-1, -1, SQRT2))
+        neighbours = (
+            (1, 0, 1.0),
+            (-1, 0, 1.0),
+            (0, 1, 1.0),
+            (0, -1, 1.0),
+            (1, 1, SQRT2),
+            (1, -1, SQRT2),
+            (-1, 1, SQRT2),
+            (-1, -1, SQRT2),
+        )
         best = [math.inf] * (rows * cols)
         parent = [-1] * (rows * cols)
         best[start] = 0.0
@@ -455,8 +486,9 @@ class PathPlanner:
                     push(heap, (ncost + HEURISTIC_WEIGHT * h, ncost, n))
         return None
 
-    def _shorten(self, a: BasePose, b: BasePose, cells: list[tuple[int, int]],
-                 ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
+    def _shorten(
+        self, a: BasePose, b: BasePose, cells: list[tuple[int, int]], ctx: _Query
+    ) -> tuple[list[BasePose], set[tuple[int, int]]]:
         """Poses along the cell path, shortened greedily, or the cells to block and search again.
 
         Headings: the first of these profiles in which every step of the cell path is free --
@@ -471,7 +503,7 @@ class PathPlanner:
         total = lengths[-1] or 1.0
         dyaw = _wrap(b.yaw - a.yaw)
         profiles = (lambda s: a.yaw + dyaw * s, lambda s: a.yaw + dyaw, lambda s: a.yaw)
-        fewest: Optional[set[tuple[int, int]]] = None
+        fewest: set[tuple[int, int]] | None = None
         for profile in profiles:
             poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, ctx)
             if not bad:
@@ -480,9 +512,17 @@ class PathPlanner:
                 fewest = bad
         return [], fewest or set()
 
-    def _headed(self, a: BasePose, b: BasePose, pts: list[tuple[float, float]], lengths: list[float],
-                total: float, cells: list[tuple[int, int]], profile: Callable[[float], float],
-                ctx: "_Query") -> tuple[list[BasePose], set[tuple[int, int]]]:
+    def _headed(
+        self,
+        a: BasePose,
+        b: BasePose,
+        pts: list[tuple[float, float]],
+        lengths: list[float],
+        total: float,
+        cells: list[tuple[int, int]],
+        profile: Callable[[float], float],
+        ctx: _Query,
+    ) -> tuple[list[BasePose], set[tuple[int, int]]]:
         poses = [a]
         bad: set[tuple[int, int]] = set()
         for i in range(1, len(pts) - 1):
@@ -498,7 +538,7 @@ class PathPlanner:
                     bad.update(cells[j] for j in (i, i + 1) if 0 < j < len(cells) - 1)
         return poses, bad
 
-    def _greedy(self, poses: list[BasePose], ctx: "_Query") -> list[BasePose]:
+    def _greedy(self, poses: list[BasePose], ctx: _Query) -> list[BasePose]:
         """From each pose on, a far later pose reachable on a free straight segment: the last
         pose if it is, else one found by bisection (free, with the next one not free from
         there). Consecutive poses are known to be connected by free segments."""
@@ -518,14 +558,14 @@ class PathPlanner:
             i = lo
         return out
 
-    def _fitting_yaw(self, x: float, y: float, yaw: float, ctx: "_Query") -> Optional[float]:
+    def _fitting_yaw(self, x: float, y: float, yaw: float, ctx: _Query) -> float | None:
         """`yaw` if the footprint fits there at it, else the nearest heading (in steps of
         pi/16) that fits, else None."""
         escape = ctx.escape
         if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
             return yaw
         for k in range(17):
-            for sign in ((1,) if k == 0 else (1, -1)):
+            for sign in (1,) if k == 0 else (1, -1):
                 candidate = yaw + sign * k * math.pi / 16
                 if self.pose_free(x, y, candidate, ctx.exact):
                     return candidate

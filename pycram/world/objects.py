@@ -107,8 +107,14 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
         r = radius - wall / 2
         for i in range(n):
             a = 2 * math.pi * i / n
-            parts.append(Part("box", (r * math.cos(a), r * math.sin(a), half - wall_half),
-                              (wall / 2, r * math.tan(math.pi / n) + 0.001, wall_half), a))
+            parts.append(
+                Part(
+                    "box",
+                    (r * math.cos(a), r * math.sin(a), half - wall_half),
+                    (wall / 2, r * math.tan(math.pi / n) + 0.001, wall_half),
+                    a,
+                )
+            )
         return parts
     raise ValueError(f"shape {shape!r} is not one of: box, cylinder, bowl, plate")
 
@@ -116,28 +122,81 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
 _ANY_SURFACE = ("counter", "table", "shelf", "drawer")
 
 #: Every object type by name.
-OBJECT_TYPES: dict[str, ObjectType] = {t.name: t for t in (
-    ObjectType("cup", "cylinder", (0.035, 0.045), 0.2, (0.80, 0.18, 0.15, 1.0),
-               (Grasp("side", 0.07, 0.05),), _ANY_SURFACE, "a drinking cup, 7 cm wide, 9 cm tall"),
-    ObjectType("mug", "cylinder", (0.03, 0.05), 0.25, (1.0, 0.82, 0.05, 1.0),
-               (Grasp("side", 0.06, 0.05),), ("counter", "table", "shelf"),
-               "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)"),
-    ObjectType("bowl", "bowl", (0.07, 0.035, 0.008), 0.25, (0.95, 0.82, 0.25, 1.0),
-               (Grasp("top", 0.008, 0.06, radius=0.066, across="radial"),), _ANY_SURFACE,
-               "a cereal bowl, 14 cm wide, 7 cm tall; grasped at its rim"),
-    ObjectType("plate", "plate", (0.11, 0.012, 0.008), 0.35, (0.96, 0.96, 0.93, 1.0),
-               (Grasp("top", 0.008, 0.02, radius=0.106, across="radial"),), ("counter", "table", "shelf"),
-               "a dinner plate, 22 cm wide, with a 1 cm rim; grasped at its rim"),
-    ObjectType("spoon", "box", (0.075, 0.011, 0.005), 0.04, (0.70, 0.72, 0.75, 1.0),
-               (Grasp("top", 0.022, 0.005, across="y"),), ("counter", "table", "drawer"),
-               "a spoon (a flat bar, 15 cm long); grasped from above across its handle"),
-    ObjectType("cereal", "box", (0.035, 0.095, 0.14), 0.4, (0.92, 0.55, 0.12, 1.0),
-               (Grasp("+y", 0.07, 0.16), Grasp("-y", 0.07, 0.16), Grasp("top", 0.07, 0.26, across="x")),
-               ("counter", "table", "shelf"), "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side"),
-    ObjectType("milk", "box", (0.035, 0.035, 0.1), 0.5, (0.92, 0.94, 1.0, 1.0),
-               tuple(Grasp(a, 0.07, 0.1) for a in ("+x", "-x", "+y", "-y")),
-               ("counter", "table", "shelf"), "a milk carton, 7 x 7 x 20 cm"),
-)}
+OBJECT_TYPES: dict[str, ObjectType] = {
+    t.name: t
+    for t in (
+        ObjectType(
+            "cup",
+            "cylinder",
+            (0.035, 0.045),
+            0.2,
+            (0.80, 0.18, 0.15, 1.0),
+            (Grasp("side", 0.07, 0.05),),
+            _ANY_SURFACE,
+            "a drinking cup, 7 cm wide, 9 cm tall",
+        ),
+        ObjectType(
+            "mug",
+            "cylinder",
+            (0.03, 0.05),
+            0.25,
+            (1.0, 0.82, 0.05, 1.0),
+            (Grasp("side", 0.06, 0.05),),
+            ("counter", "table", "shelf"),
+            "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)",
+        ),
+        ObjectType(
+            "bowl",
+            "bowl",
+            (0.07, 0.035, 0.008),
+            0.25,
+            (0.95, 0.82, 0.25, 1.0),
+            (Grasp("top", 0.008, 0.06, radius=0.066, across="radial"),),
+            _ANY_SURFACE,
+            "a cereal bowl, 14 cm wide, 7 cm tall; grasped at its rim",
+        ),
+        ObjectType(
+            "plate",
+            "plate",
+            (0.11, 0.012, 0.008),
+            0.35,
+            (0.96, 0.96, 0.93, 1.0),
+            (Grasp("top", 0.008, 0.02, radius=0.106, across="radial"),),
+            ("counter", "table", "shelf"),
+            "a dinner plate, 22 cm wide, with a 1 cm rim; grasped at its rim",
+        ),
+        ObjectType(
+            "spoon",
+            "box",
+            (0.075, 0.011, 0.005),
+            0.04,
+            (0.70, 0.72, 0.75, 1.0),
+            (Grasp("top", 0.022, 0.005, across="y"),),
+            ("counter", "table", "drawer"),
+            "a spoon (a flat bar, 15 cm long); grasped from above across its handle",
+        ),
+        ObjectType(
+            "cereal",
+            "box",
+            (0.035, 0.095, 0.14),
+            0.4,
+            (0.92, 0.55, 0.12, 1.0),
+            (Grasp("+y", 0.07, 0.16), Grasp("-y", 0.07, 0.16), Grasp("top", 0.07, 0.26, across="x")),
+            ("counter", "table", "shelf"),
+            "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side",
+        ),
+        ObjectType(
+            "milk",
+            "box",
+            (0.035, 0.035, 0.1),
+            0.5,
+            (0.92, 0.94, 1.0, 1.0),
+            tuple(Grasp(a, 0.07, 0.1) for a in ("+x", "-x", "+y", "-y")),
+            ("counter", "table", "shelf"),
+            "a milk carton, 7 x 7 x 20 cm",
+        ),
+    )
+}
 
 
 def object_type(name: str) -> ObjectType:

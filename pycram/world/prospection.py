@@ -34,8 +34,9 @@ from __future__ import annotations
 
 import abc
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Optional, Sequence
+from typing import Any
 
 __all__ = [
     "BasePose",
@@ -70,7 +71,7 @@ class ToolPose:
     (any orientation)."""
 
     position: tuple[float, float, float]
-    orientation: Optional[tuple[float, float, float, float]] = None
+    orientation: tuple[float, float, float, float] | None = None
 
 
 def as_base_pose(pose: Any) -> BasePose:
@@ -105,8 +106,10 @@ def as_tool_pose(pose: Any) -> ToolPose:
         if len(p) != 3 or (q is not None and len(q) != 4):
             raise ValueError
     except (TypeError, ValueError):
-        raise ValueError("a tool pose is (position (x, y, z) [m], orientation (w, x, y, z) or None) "
-                         f"or has position/orientation; got {pose!r}") from None
+        raise ValueError(
+            "a tool pose is (position (x, y, z) [m], orientation (w, x, y, z) or None) "
+            f"or has position/orientation; got {pose!r}"
+        ) from None
     if not all(math.isfinite(v) for v in p + (q or ())):
         raise ValueError(f"tool pose must be finite, got {pose!r}")
     if q is not None:
@@ -130,8 +133,8 @@ class Reachability:
 
     arm: str
     solutions: tuple[tuple[float, ...], ...] = ()
-    reason: Optional[str] = None
-    failed_index: Optional[int] = None
+    reason: str | None = None
+    failed_index: int | None = None
     message: str = ""
 
     @property
@@ -170,8 +173,7 @@ class Prospection(abc.ABC):
         """The arm names :meth:`reachable` accepts."""
 
     @abc.abstractmethod
-    def in_collision(self, base_pose: Any,
-                     joint_configuration: Optional[Mapping[str, float]] = None) -> bool:
+    def in_collision(self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> bool:
         """Would the robot at ``base_pose`` collide with the environment?
 
         The robot keeps its current joint positions except those in ``joint_configuration``
@@ -180,13 +182,15 @@ class Prospection(abc.ABC):
         """
 
     @abc.abstractmethod
-    def collisions(self, base_pose: Any,
-                   joint_configuration: Optional[Mapping[str, float]] = None) -> list[tuple[str, str]]:
+    def collisions(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None
+    ) -> list[tuple[str, str]]:
         """Like :meth:`in_collision`, but the touching pairs (robot part, environment part)."""
 
     @abc.abstractmethod
-    def reachable(self, arm: str, poses: Sequence[Any], base_pose: Any,
-                  joint_configuration: Optional[Mapping[str, float]] = None) -> Reachability:
+    def reachable(
+        self, arm: str, poses: Sequence[Any], base_pose: Any, joint_configuration: Mapping[str, float] | None = None
+    ) -> Reachability:
         """Can ``arm`` put its tool frame at each of ``poses`` in turn, from ``base_pose``?
 
         Inverse kinematics for the sequence (each solution seeds the next, so the arm moves
@@ -197,8 +201,13 @@ class Prospection(abc.ABC):
         """
 
     @abc.abstractmethod
-    def visible(self, target: Any, base_pose: Any, threshold: float = 0.5,
-                joint_configuration: Optional[Mapping[str, float]] = None) -> Visibility:
+    def visible(
+        self,
+        target: Any,
+        base_pose: Any,
+        threshold: float = 0.5,
+        joint_configuration: Mapping[str, float] | None = None,
+    ) -> Visibility:
         """How much of ``target`` does the head camera see from ``base_pose``, pointed at it?
 
         ``target`` is the name of an object in the world or a point (x, y, z) [m]. The head

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from .environment import Environment, Surface
 from .objects import ObjectType, object_type
@@ -47,7 +47,7 @@ class Placement:
         half = object_type(self.type).half_height
         return (self.position[2] - half, self.position[2] + half)
 
-    def overlaps(self, other: "Placement", gap: float = 0.0) -> bool:
+    def overlaps(self, other: Placement, gap: float = 0.0) -> bool:
         """True when the two objects' footprint circles come closer than `gap` [m] at heights
         both objects occupy (a conservative test: the objects lie inside their circles)."""
         (a0, a1), (b0, b1) = self.z_range, other.z_range
@@ -74,8 +74,7 @@ def object_names(types: Sequence[str]) -> list[str]:
 def supports_for(environment: Environment, otype: ObjectType, supports: Sequence[str] | None = None) -> list[Surface]:
     """The surfaces an object of `otype` may start on: of a kind it is found on, high enough
     inside (clearance) and wide enough for its footprint; restricted to `supports` when given."""
-    candidates = ([environment.surface(s) for s in supports] if supports is not None
-                  else environment.all_surfaces())
+    candidates = [environment.surface(s) for s in supports] if supports is not None else environment.all_surfaces()
     out = []
     for s in candidates:
         if s.kind not in otype.found_on or s.clearance < otype.height + HEAD_ROOM:
@@ -87,8 +86,14 @@ def supports_for(environment: Environment, otype: ObjectType, supports: Sequence
     return out
 
 
-def random_scene(environment: Environment, types: Sequence[str], seed: int, *,
-                 supports: Sequence[str] | None = None, attempts: int = 300) -> list[Placement]:
+def random_scene(
+    environment: Environment,
+    types: Sequence[str],
+    seed: int,
+    *,
+    supports: Sequence[str] | None = None,
+    attempts: int = 300,
+) -> list[Placement]:
     """Place one object of each of `types` (object type names) at random, reproducibly from `seed`.
 
     Supports are chosen with probability proportional to their area; `supports` (surface names)
@@ -101,18 +106,28 @@ def random_scene(environment: Environment, types: Sequence[str], seed: int, *,
         otype = object_type(type_name)
         candidates = supports_for(environment, otype, supports)
         if not candidates:
-            raise PlacementError(f"no surface of {environment.name!r} fits a {type_name!r} (found on "
-                                 f"{', '.join(otype.found_on)}; {otype.height:.2f} m tall)")
+            raise PlacementError(
+                f"no surface of {environment.name!r} fits a {type_name!r} (found on "
+                f"{', '.join(otype.found_on)}; {otype.height:.2f} m tall)"
+            )
         placement = _place(environment, name, otype, candidates, placed, rng, attempts)
         if placement is None:
-            raise PlacementError(f"no free spot for {name!r} after {attempts} tries on "
-                                 f"{', '.join(s.name for s in candidates)}")
+            raise PlacementError(
+                f"no free spot for {name!r} after {attempts} tries on {', '.join(s.name for s in candidates)}"
+            )
         placed.append(placement)
     return placed
 
 
-def _place(environment: Environment, name: str, otype: ObjectType, candidates: list[Surface],
-           placed: list[Placement], rng: random.Random, attempts: int) -> Placement | None:
+def _place(
+    environment: Environment,
+    name: str,
+    otype: ObjectType,
+    candidates: list[Surface],
+    placed: list[Placement],
+    rng: random.Random,
+    attempts: int,
+) -> Placement | None:
     radius = otype.footprint_radius
     weights = [s.area for s in candidates]
     for _ in range(attempts):
@@ -123,8 +138,15 @@ def _place(environment: Environment, name: str, otype: ObjectType, candidates: l
         if not surface.contains(x, y, radius + EDGE_MARGIN):
             continue
         container = environment.container_of(surface.name)
-        candidate = Placement(name, otype.name, surface.name, None if container is None else container.name,
-                              (x, y, surface.height + otype.half_height + 0.001), yaw, radius)
+        candidate = Placement(
+            name,
+            otype.name,
+            surface.name,
+            None if container is None else container.name,
+            (x, y, surface.height + otype.half_height + 0.001),
+            yaw,
+            radius,
+        )
         if not any(candidate.overlaps(other, GAP) for other in placed):
             return candidate
     return None

@@ -54,8 +54,12 @@ class ScriptedProspection:
 
 
 def resolver_set(description=pr2, prospection=None, known=()):
-    reasoner = LocationReasoner(RobotGeometry.from_description(description), lambda: APARTMENT,
-                                lambda: prospection or ScriptedProspection(), lambda: list(known))
+    reasoner = LocationReasoner(
+        RobotGeometry.from_description(description),
+        lambda: APARTMENT,
+        lambda: prospection or ScriptedProspection(),
+        lambda: list(known),
+    )
     rs = ResolverSet("test locations")
     rs.location_generators.append(reasoner.generator)
     return rs, reasoner
@@ -148,8 +152,14 @@ def test_no_solution_names_the_arm_and_reason():
 
 def test_a_target_outside_the_floor_names_the_reach_layer():
     rs, _ = resolver_set()
-    with rs, pytest.raises(NoSolutionError, match=r"is outside the environment: no cell of the floor of "
-                                                   r"apartment lies within the layer 'reach'"):
+    with (
+        rs,
+        pytest.raises(
+            NoSolutionError,
+            match=r"is outside the environment: no cell of the floor of "
+            r"apartment lies within the layer 'reach'",
+        ),
+    ):
         LocationDesignator([("to_reach", (20.0, 20.0, 0.9))]).reference()
 
 
@@ -170,8 +180,12 @@ def test_on_spots_fit_the_type_and_keep_off_other_objects():
     bowl = KnownObject("bowl", "bowl", (4.0, 1.8, 0.785))
     rs, _ = resolver_set(known=[milk, bowl])
     with rs:
-        spots = [s for s, _ in zip(LocationDesignator([("on", "table"), ("for", "cup"), ("near", "milk")]).solutions(),
-                                   range(20))]
+        spots = [
+            s
+            for s, _ in zip(
+                LocationDesignator([("on", "table"), ("for", "cup"), ("near", "milk")]).solutions(), range(20)
+            )
+        ]
     table = APARTMENT.surface("table")
     assert all(isinstance(s, Spot) and s.surface == "table" for s in spots)
     for s in spots:
@@ -194,14 +208,28 @@ def test_in_a_container_checks_its_clearance():
 
 
 def test_a_full_surface_says_it_is_occupied():
-    cups = [KnownObject(f"cup {i}", "cup", (x, y, 0.945)) for i, (x, y) in
-            enumerate([(1.73, 4.65), (1.83, 4.65), (1.73, 4.75), (1.83, 4.75)])]
+    cups = [
+        KnownObject(f"cup {i}", "cup", (x, y, 0.945))
+        for i, (x, y) in enumerate([(1.73, 4.65), (1.83, 4.65), (1.73, 4.75), (1.83, 4.75)])
+    ]
     rs, _ = resolver_set(known=cups)
-    with rs, pytest.raises(NoSolutionError, match=r"no free spot for a cup .* on cooker #1: \d+ candidates: "
-                                                   r"\d+ too close to the edge, \d+ occupied \(cup 0 \d+"):
+    with (
+        rs,
+        pytest.raises(
+            NoSolutionError,
+            match=r"no free spot for a cup .* on cooker #1: \d+ candidates: "
+            r"\d+ too close to the edge, \d+ occupied \(cup 0 \d+",
+        ),
+    ):
         LocationDesignator([("on", "cooker #1"), ("for", "cup")]).reference()
-    with rs, pytest.raises(NoSolutionError, match=r"no free spot for a plate .* on cooker #1: \d+ candidates: "
-                                                   r"\d+ too close to the edge$"):
+    with (
+        rs,
+        pytest.raises(
+            NoSolutionError,
+            match=r"no free spot for a plate .* on cooker #1: \d+ candidates: "
+            r"\d+ too close to the edge$",
+        ),
+    ):
         LocationDesignator([("on", "cooker #1"), ("for", "plate")]).reference()
 
 
@@ -222,7 +250,9 @@ def test_to_open_stands_clear_of_the_opening_and_follows_the_handle():
     assert math.hypot(door.x - hx, door.y - hy) > 0.7 + 0.335  # outside the door's swing
     assert door.grasp == "front" and drawer.grasp == "front_vertical"  # how the fingers meet the handle
     handle_path = asked[0][1:]
-    assert handle_path[0] == pytest.approx(fridge.handle) and handle_path[-1] == pytest.approx(fridge.handle_position(1.2))
+    assert handle_path[0] == pytest.approx(fridge.handle) and handle_path[-1] == pytest.approx(
+        fridge.handle_position(1.2)
+    )
     assert drawer.x > 0.6 + 0.2 + 0.335  # in front of the drawer pulled out 0.2 m
     assert asked[-1][-1] == pytest.approx(APARTMENT.container("drawer 3").handle_position(0.2))
 

@@ -15,13 +15,19 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from pycram.designator import (GoalOutsideEnvironment, LocationDesignator,  # noqa: E402
-                               MotionDesignator, MotionPropertyError, NoSolutionError,
-                               PropertyError, ResolverError, perform)
+from pycram.designator import (  # noqa: E402
+    GoalOutsideEnvironment,
+    LocationDesignator,
+    MotionDesignator,
+    MotionPropertyError,
+    NoSolutionError,
+    PropertyError,
+    ResolverError,
+    perform,
+)
 from pycram.designators.motion_types import vocabulary_table  # noqa: E402
 from pycram.language import pursue  # noqa: E402
-from pycram.process_module import (NoProcessModuleError, ProcessModuleStatus,  # noqa: E402
-                                   UnknownMotionTypeError)
+from pycram.process_module import NoProcessModuleError, ProcessModuleStatus, UnknownMotionTypeError  # noqa: E402
 from pycram.robot import current_robot  # noqa: E402
 from pycram.runtime import sleep  # noqa: E402
 
@@ -78,10 +84,8 @@ def test_missing_required_key_names_it(robot):
 
 
 def test_invalid_value_lists_the_valid_values_of_this_robot(robot):
-    configurations = sorted({c for per_arm in robot.description.ARM_CONFIGURATIONS.values()
-                             for c in per_arm})
-    error = refused(MotionPropertyError, type="setting_arm_configuration", arm="right",
-                    configuration="wave")
+    configurations = sorted({c for per_arm in robot.description.ARM_CONFIGURATIONS.values() for c in per_arm})
+    error = refused(MotionPropertyError, type="setting_arm_configuration", arm="right", configuration="wave")
     assert ", ".join(repr(c) for c in configurations) in str(error) and "got 'wave'" in str(error)
     error = refused(MotionPropertyError, type="setting_torso", position=2.0)
     low, high = robot.description.TORSO["range"]
@@ -121,23 +125,32 @@ def test_the_vocabulary_table_documents_every_type_and_key(robot):
 # --------------------------------------------------------------------------- absurd goals
 
 
-@pytest.mark.parametrize("properties,key", [
-    (dict(type="moving", pose=(math.nan, 0.5, 0.0)), "pose"),
-    (dict(type="moving", pose=(1.0, math.inf, 0.0)), "pose"),
-    (dict(type="pointing_head", coordinates=(1.0, math.nan, 1.0)), "coordinates"),
-    (dict(type="reaching", arm="right", target=(math.inf, 0.0, 1.0)), "target"),
-    (dict(type="setting_arm_joints", arm="right", positions=[math.nan] * 7), "positions"),
-    (dict(type="setting_gripper", gripper="right", position=math.nan), "position"),
-])
+@pytest.mark.parametrize(
+    "properties,key",
+    [
+        (dict(type="moving", pose=(math.nan, 0.5, 0.0)), "pose"),
+        (dict(type="moving", pose=(1.0, math.inf, 0.0)), "pose"),
+        (dict(type="pointing_head", coordinates=(1.0, math.nan, 1.0)), "coordinates"),
+        (dict(type="reaching", arm="right", target=(math.inf, 0.0, 1.0)), "target"),
+        (dict(type="setting_arm_joints", arm="right", positions=[math.nan] * 7), "positions"),
+        (dict(type="setting_gripper", gripper="right", position=math.nan), "position"),
+    ],
+)
 def test_non_finite_goals_are_refused_before_anything_moves(robot, properties, key):
     error = refused(MotionPropertyError, **properties)
     assert f"key {key!r}" in str(error) and ("finite" in str(error) or "number in" in str(error))
     assert error.key == key
 
 
-@pytest.mark.parametrize("pose,frame", [((100.0, 0.0, 0.0), "map"), ((1e9, 1e9, 0.0), None),
-                                        ((50.0, 0.0, 0.0), "base_footprint"),
-                                        ((0.8, -1.3, 0.0), "map")])  # inside the back counter
+@pytest.mark.parametrize(
+    "pose,frame",
+    [
+        ((100.0, 0.0, 0.0), "map"),
+        ((1e9, 1e9, 0.0), None),
+        ((50.0, 0.0, 0.0), "base_footprint"),
+        ((0.8, -1.3, 0.0), "map"),
+    ],
+)  # inside the back counter
 def test_goals_outside_the_environment_are_refused(robot, pose, frame):
     properties = dict(type="moving", pose=pose)
     if frame is not None:

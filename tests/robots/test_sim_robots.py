@@ -15,12 +15,10 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from pycram.designator import (LocationDesignator, MotionDesignator,  # noqa: E402
-                               MotionPropertyError, perform)
+from pycram.designator import LocationDesignator, MotionDesignator, MotionPropertyError, perform  # noqa: E402
 from pycram.fluent import Fluent  # noqa: E402
 from pycram.language import State, pursue  # noqa: E402
-from pycram.process_module import (ProcessModule, ProcessModuleFailure,  # noqa: E402
-                                   ProcessModuleStatus)
+from pycram.process_module import ProcessModule, ProcessModuleFailure, ProcessModuleStatus  # noqa: E402
 from pycram.runtime import sleep  # noqa: E402
 
 T = 60.0  # generous time-out of one wait [s of simulated time]
@@ -71,8 +69,7 @@ def test_load_builds_the_robot_with_its_modules(robot):
 
     assert isinstance(robot, SimRobot)
     assert robot.world.robot == robot.name
-    expected = {"navigation", "base_stop", "head", "torso", "sensors", "perception",
-                "arm_right", "gripper_right"}
+    expected = {"navigation", "base_stop", "head", "torso", "sensors", "perception", "arm_right", "gripper_right"}
     if robot.name == "pr2":
         expected |= {"arm_left", "gripper_left"}
     assert set(robot.process_modules) == expected
@@ -94,6 +91,7 @@ def test_reasoning_reaches_the_worlds_prospection_through_the_active_robot(robot
 
 def test_arm_requests_go_to_the_right_module(robot):
     """Thesis ch. 4.2.2: PR2 dispatches on the arm; TIAGo serves any arm with its only one."""
+
     def module_for(**properties):
         return ProcessModule.resolve(MotionDesignator(**properties))
 
@@ -207,8 +205,11 @@ def test_location_to_reach_and_full_grasp_sequence(robot):
     for phase in ("pre_grasp", "grasp"):
         tool = motion(type="reaching", arm="right", target=target, phase=phase)
         back, up = d.APPROACH_OFFSETS[phase]
-        wanted = (target[0] - back * math.cos(base.yaw), target[1] - back * math.sin(base.yaw),
-                  target[2] + up)  # approach along the base's heading
+        wanted = (
+            target[0] - back * math.cos(base.yaw),
+            target[1] - back * math.sin(base.yaw),
+            target[2] + up,
+        )  # approach along the base's heading
         assert math.dist(tool.position, wanted) < 0.025, phase
     closed = motion(type="setting_gripper", gripper="right", position=0)
     assert closed > 0.01 and opening.get_value() > 0.01
@@ -249,8 +250,7 @@ def test_non_waited_drive_is_cancelled_by_cancelling_movement(robot):
     go_to_start(robot)
     start = world.base_pose.get_value()
     execution = motion(type="moving", pose=(START[0] + 1.5, START[1] + 1.5, 0.0), wait=False)
-    moved = wait_value(lambda: distance(world.base_pose.get_value(), start) > 0.2,
-                       [world.base_pose], timeout=10.0)
+    moved = wait_value(lambda: distance(world.base_pose.get_value(), start) > 0.2, [world.base_pose], timeout=10.0)
     assert moved
     assert not execution.done
     stopped_at = motion(type="cancelling_movement")

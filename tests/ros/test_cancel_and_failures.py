@@ -18,8 +18,9 @@ def motion(**properties):
 
 
 def _moved_from(fluent: Fluent, start, distance: float) -> Fluent:
-    network = Fluent(lambda: True if math.hypot(fluent.get_value().x - start.x,
-                                                fluent.get_value().y - start.y) > distance else None)
+    network = Fluent(
+        lambda: True if math.hypot(fluent.get_value().x - start.x, fluent.get_value().y - start.y) > distance else None
+    )
     fluent.add_child(network)
     return network
 
@@ -40,11 +41,15 @@ def test_evaporating_a_drive_cancels_the_move_base_goal_and_the_base_stops(pr2_o
     robot, _ = pr2_over_ros
     config = robot.config
     results = Fluent(None, name="move_base results")
-    subscription = transport.subscribe(f"{config.move_base_action}/result", "move_base_msgs/MoveBaseActionResult",
-                                       lambda message: results.set_value(message.status.status))
+    subscription = transport.subscribe(
+        f"{config.move_base_action}/result",
+        "move_base_msgs/MoveBaseActionResult",
+        lambda message: results.set_value(message.status.status),
+    )
     sim_time = Fluent(None, name="sim time")
-    clock = transport.subscribe(config.clock_topic, "rosgraph_msgs/Clock",
-                                lambda message: sim_time.set_value(message.clock.to_sec()))
+    clock = transport.subscribe(
+        config.clock_topic, "rosgraph_msgs/Clock", lambda message: sim_time.set_value(message.clock.to_sec())
+    )
     try:
         start = robot.state.base_pose.get_value()
         goal = (start.x + 2.0, start.y, start.yaw)

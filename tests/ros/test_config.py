@@ -73,8 +73,10 @@ def test_pycram_ros_imports_without_rospy():
     import subprocess
     import sys
 
-    code = ("import sys; import pycram.ros, pycram.ros.transport, pycram.ros.config, pycram.ros.launch; "
-            "assert 'rospy' not in sys.modules, 'rospy imported'")
+    code = (
+        "import sys; import pycram.ros, pycram.ros.transport, pycram.ros.config, pycram.ros.launch; "
+        "assert 'rospy' not in sys.modules, 'rospy imported'"
+    )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 

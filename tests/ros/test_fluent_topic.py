@@ -17,8 +17,9 @@ def test_pose_topic_drives_a_fluent_network_and_wakes_wait_for(transport):
     config = robot_config("pr2").replace(pose_topic="/test/fluent_pose", joint_states_topic="/test/fluent_joints")
     state = RosRobotState(transport, config)
     publisher = rospy.Publisher(config.pose_topic, PoseWithCovarianceStamped, queue_size=1, latch=True)
-    far_enough = Fluent(lambda: True if state.base_pose.get_value() is not None
-                        and state.base_pose.get_value().x > 1.0 else None)
+    far_enough = Fluent(
+        lambda: True if state.base_pose.get_value() is not None and state.base_pose.get_value().x > 1.0 else None
+    )
     state.base_pose.add_child(far_enough)
     woke = threading.Event()
     waiter = threading.Thread(target=lambda: far_enough.wait_for(30.0) and woke.set(), daemon=True)

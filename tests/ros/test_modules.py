@@ -42,8 +42,13 @@ def test_arm_configuration_reaches_its_joints(ros_robot):
     expected = ros_robot.description.ARM_CONFIGURATIONS[arm]["carry"]
     assert positions == pytest.approx(tuple(expected))
     joints = ros_robot.config.arms[arm].joint_names
-    there = Fluent(lambda: True if all(abs(ros_robot.state.joint_states.get_value()[j] - p) < 0.05
-                                       for j, p in zip(joints, expected)) else None)
+    there = Fluent(
+        lambda: (
+            True
+            if all(abs(ros_robot.state.joint_states.get_value()[j] - p) < 0.05 for j, p in zip(joints, expected))
+            else None
+        )
+    )
     ros_robot.state.joint_states.add_child(there)
     assert there.wait_for(10.0)
 
@@ -70,8 +75,9 @@ def test_navigation_reaches_the_goal_and_pose_fluent_follows(ros_robot):
     goal = (start.x + 0.3, start.y, start.yaw)
     reached = motion(type="moving", pose=goal, frame="map")
     assert math.hypot(reached.x - goal[0], reached.y - goal[1]) < 0.1
-    close = Fluent(lambda: True if math.hypot(pose.get_value().x - goal[0], pose.get_value().y - goal[1]) < 0.1
-                   else None)
+    close = Fluent(
+        lambda: True if math.hypot(pose.get_value().x - goal[0], pose.get_value().y - goal[1]) < 0.1 else None
+    )
     pose.add_child(close)
     assert close.wait_for(10.0)
     motion(type="moving", pose=(start.x, start.y, start.yaw), frame="map")
@@ -118,8 +124,9 @@ def test_tf_has_the_base_in_the_map_frame(ros_robot):
     buffer = tf2_ros.Buffer()
     listener = tf2_ros.TransformListener(buffer)
     try:
-        transform = buffer.lookup_transform(ros_robot.config.map_frame, ros_robot.config.base_frame,
-                                            rospy.Time(0), rospy.Duration(10.0))
+        transform = buffer.lookup_transform(
+            ros_robot.config.map_frame, ros_robot.config.base_frame, rospy.Time(0), rospy.Duration(10.0)
+        )
         here = ros_robot.state.base_pose.get_value()
         assert transform.transform.translation.x == pytest.approx(here.x, abs=0.05)
         assert transform.transform.translation.y == pytest.approx(here.y, abs=0.05)

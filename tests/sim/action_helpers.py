@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import math
 import threading
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any, Iterator
+from typing import Any
 
 from sim_helpers import ok, tilt
 
@@ -24,8 +25,9 @@ T = 60.0
 
 
 @contextmanager
-def apartment_with(robot_name: str, objects: dict[str, tuple[str, tuple[float, float]]],
-                   base_pose: tuple[float, float, float] = START) -> Iterator[tuple[World, Any]]:
+def apartment_with(
+    robot_name: str, objects: dict[str, tuple[str, tuple[float, float]]], base_pose: tuple[float, float, float] = START
+) -> Iterator[tuple[World, Any]]:
     """The apartment with `objects` (name -> (surface, (x, y))) standing upright, every other
     object of the scene taken aside, and the robot `robot_name` active on it."""
     names = list(objects)
@@ -49,8 +51,9 @@ def put(world: World, name: str, surface: str, xy: tuple[float, float]) -> None:
     ok(world.move_item(name, (xy[0], xy[1], height + object_type(name).half_height + 0.002)))
 
 
-def rests_upright_at(world: World, name: str, surface: str, xy: tuple[float, float] | None = None,
-                     tolerance: float = 0.05) -> bool:
+def rests_upright_at(
+    world: World, name: str, surface: str, xy: tuple[float, float] | None = None, tolerance: float = 0.05
+) -> bool:
     """True when `name` stands upright (< 20 deg) on `surface` (within `tolerance` [m] of `xy`)."""
     pose = world.item_poses.get_value()[name]
     x, y, z = pose.position
@@ -69,6 +72,7 @@ def run_as_task(body: Any) -> tuple[Any, Any]:
     """Run `body()` as a task of its own; returns (its result, the task), so that a test looks
     only at the tasks this body started. Re-raises what the body raised."""
     from pycram.runtime import current_task, run_subtask
+
     holder: list[Any] = []
 
     def scoped() -> Any:
@@ -97,6 +101,7 @@ class OnceHolding:
 
     def _run(self) -> None:
         from pycram.fluent import Fluent
+
         held = Fluent(lambda: True if self.item in holding(self.world) else None)
         for f in self.world.gripper_states.values():
             f.add_child(held)
@@ -104,9 +109,16 @@ class OnceHolding:
             self.done.set()
             return
         start = self.world.base_pose.get_value()
-        away = Fluent(lambda: True if math.hypot(self.world.base_pose.get_value().x - start.x,
-                                                  self.world.base_pose.get_value().y - start.y)
-                      > self.distance else None)
+        away = Fluent(
+            lambda: (
+                True
+                if math.hypot(
+                    self.world.base_pose.get_value().x - start.x, self.world.base_pose.get_value().y - start.y
+                )
+                > self.distance
+                else None
+            )
+        )
         self.world.base_pose.add_child(away)
         if away.wait_for(600.0):
             self.result = self.action(self.world)

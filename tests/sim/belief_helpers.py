@@ -50,5 +50,3 @@ def put(world: World, name: str, surface: str, xy, dx: float = 0.0) -> tuple[flo
 def look(world: World, point) -> object:
     ok(world.point_head(point))
     return ok(world.detect())
-
-

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import math
 import threading
-from typing import Any, Callable, Iterable
+from collections.abc import Callable, Iterable
+from typing import Any
 
 import numpy as np
 

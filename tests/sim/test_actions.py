@@ -10,15 +10,45 @@ from __future__ import annotations
 import math
 
 import pytest
-from action_helpers import (COUNTER, TABLE, OnceHolding, apartment_with, holding, put, rests_upright_at,
-                            run_as_task, tasks_named)
+from action_helpers import (
+    COUNTER,
+    TABLE,
+    OnceHolding,
+    apartment_with,
+    holding,
+    put,
+    rests_upright_at,
+    run_as_task,
+    tasks_named,
+)
 from sim_helpers import ok
 
-from pycram.actions import (ActionParameterError, Detect, Held, LookAt, MoveTorso, Navigate, ParkArms,
-                            PickUp, Place, Search, SetGripper, Transport, held_objects)
+from pycram.actions import (
+    ActionParameterError,
+    Detect,
+    Held,
+    LookAt,
+    MoveTorso,
+    Navigate,
+    ParkArms,
+    PickUp,
+    Place,
+    Search,
+    SetGripper,
+    Transport,
+    held_objects,
+)
 from pycram.designator import LocationDesignator, ObjectDesignator, perform
-from pycram.failures import (GoalUnreachable, GraspFailed, GripperEmpty, ObjectNotFound, ObjectNotVisible,
-                             ObjectOutOfReach, ObjectSlipped, PlanFailure)
+from pycram.failures import (
+    GoalUnreachable,
+    GraspFailed,
+    GripperEmpty,
+    ObjectNotFound,
+    ObjectNotVisible,
+    ObjectOutOfReach,
+    ObjectSlipped,
+    PlanFailure,
+)
 
 ROBOTS = ("pr2", "tiago")
 
@@ -162,8 +192,7 @@ def test_a_standing_pose_that_cannot_be_reached_gives_way_to_the_next():
         blocked, free = (3.0, 1.0, 0.0), (2.2, 1.0, 0.0)
         ok(world.place_obstacle(*blocked[:2]))
         poses = LocationDesignator([("named_for_test", "two poses")])
-        robot.location_generators.append(
-            lambda d: [blocked, free] if d.prop_value("named_for_test") else None)
+        robot.location_generators.append(lambda d: [blocked, free] if d.prop_value("named_for_test") else None)
         reached, task = run_as_task(lambda: perform(Navigate(poses)))
         assert math.hypot(reached.x - free[0], reached.y - free[1]) < 0.05
         drives = tasks_named(task, "drive to solution")

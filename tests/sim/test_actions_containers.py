@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from action_helpers import TABLE, apartment_with, put, run_as_task, tasks_named
+from action_helpers import TABLE, apartment_with, run_as_task, tasks_named
 from sim_helpers import ok
 
 from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, Search

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 
 import pytest
-
 from sim_helpers import T, ok
 
 NAN, INF = math.nan, math.inf

@@ -4,10 +4,10 @@ pulled hard enough at their handle, stay where they are left, and do not move wh
 from __future__ import annotations
 
 import pytest
+from sim_helpers import ok
 
 from pycram.sim import World
 from pycram.world.errors import UnknownNameError
-from sim_helpers import ok
 
 
 @pytest.fixture(scope="module")

@@ -117,9 +117,11 @@ def test_to_see_solutions_show_the_object_in_the_head_camera(robot_name):
                 outcome = world.request_segmentation().wait(T)
                 assert outcome is not None and outcome.succeeded, outcome
                 ids = outcome.value
-                cup_geoms = {g for g in range(world.scene.model.ngeom)
-                             if (mujoco.mj_id2name(world.scene.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "")
-                             .split(":")[0] == "cup"}
+                cup_geoms = {
+                    g
+                    for g in range(world.scene.model.ngeom)
+                    if (mujoco.mj_id2name(world.scene.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "").split(":")[0] == "cup"
+                }
                 pixels = int(sum((ids == g).sum() for g in cup_geoms))
                 assert pixels >= 20, f"the cup covers only {pixels} pixels seen from {location}"
     finally:
@@ -133,8 +135,11 @@ def test_on_spots_hold_the_object_upright(robot_name):
         with robot:
             # the robot knows the objects on the table only by looking at them
             table = world.environment.surface("table")
-            centre = (sum(p[0] for p in table.polygon) / len(table.polygon),
-                      sum(p[1] for p in table.polygon) / len(table.polygon), table.height)
+            centre = (
+                sum(p[0] for p in table.polygon) / len(table.polygon),
+                sum(p[1] for p in table.polygon) / len(table.polygon),
+                table.height,
+            )
             motion(type="moving", pose=LocationDesignator([("to_see", centre)]).reference())
             motion(type="pointing_head", coordinates=centre)
             motion(type="detecting")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from sim_helpers import T, Recorder, ok, wait_wall
+from sim_helpers import Recorder, T, ok, wait_wall
 
 OBSTACLE_HALF = 0.15  # [m] half width of `place_obstacle`'s box
 
@@ -46,8 +46,10 @@ def test_an_obstacle_appearing_mid_drive_is_driven_around(world):
         assert max(abs(p.y - start.y) for p in poses.samples) > OBSTACLE_HALF + 0.2
         # (a drive that touches anything ends with "collision"); the base's centre kept at least
         # its inscribed radius from the box
-        closest = min(math.hypot(max(abs(p.x - obstacle_x) - OBSTACLE_HALF, 0.0),
-                                 max(abs(p.y - start.y) - OBSTACLE_HALF, 0.0)) for p in poses.samples)
+        closest = min(
+            math.hypot(max(abs(p.x - obstacle_x) - OBSTACLE_HALF, 0.0), max(abs(p.y - start.y) - OBSTACLE_HALF, 0.0))
+            for p in poses.samples
+        )
         assert closest > _footprint_radius(world)
     finally:
         ok(world.remove_obstacle(obstacle))
@@ -64,7 +66,6 @@ def test_an_obstacle_on_the_goal_fails_with_no_path_and_the_base_stays(world):
         assert world.base_pose.get_value().distance_to(start) < 0.01
     finally:
         ok(world.remove_obstacle(obstacle))
-
 
 
 def _distance_to_segment(p, a, b) -> float:

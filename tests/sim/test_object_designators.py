@@ -68,8 +68,12 @@ def test_designators_resolve_by_type_colour_surface_container_and_name(table_sce
     assert ObjectDesignator([("type", "cup"), ("in", None)]).reference() is cup
     assert ObjectDesignator(name=cup.name).reference() is cup
     assert {o.type for o in ObjectDesignator(on="table").solutions()} == {"cup", "bowl", "milk"}
-    for wrong in ([("type", "cup"), ("color", "blue")], [("type", "cup"), ("on", "counter")],
-                  [("in", "fridge")], [("name", "cup")]):  # "cup" is the simulator's name, not the belief's
+    for wrong in (
+        [("type", "cup"), ("color", "blue")],
+        [("type", "cup"), ("on", "counter")],
+        [("in", "fridge")],
+        [("name", "cup")],
+    ):  # "cup" is the simulator's name, not the belief's
         with pytest.raises(NoSolutionError):
             ObjectDesignator(wrong).reference()
 

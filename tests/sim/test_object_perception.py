@@ -29,8 +29,11 @@ def test_every_object_type_is_detected_on_every_surface_kind(kind):
         if container == "fridge":
             open_container(world, container)
         s = world.environment.surface(surface)
-        types = [t for t in TYPES if kind == "cooker" or (kind in OBJECT_TYPES[t].found_on
-                                                          and OBJECT_TYPES[t].height < s.clearance)]
+        types = [
+            t
+            for t in TYPES
+            if kind == "cooker" or (kind in OBJECT_TYPES[t].found_on and OBJECT_TYPES[t].height < s.clearance)
+        ]
         assert len(types) >= 3
         for name in types:
             put(world, name, surface, spot, dx)
@@ -63,10 +66,13 @@ def test_an_object_behind_another_is_not_seen():
         assert "cup" in [d.type for d in look(world, (4.3, 2.0, 0.8)).detections]
 
 
-@pytest.mark.parametrize("container, surface, spot, base, look_at", [
-    ("drawer 2", "drawer 2 inside", (0.3, 2.9), (1.45, 2.9, math.pi), (0.6, 2.9, 0.4)),
-    ("fridge", "fridge middle shelf", (3.05, 4.62), (3.05, 3.2, math.pi / 2), (3.05, 4.6, 0.7)),
-])
+@pytest.mark.parametrize(
+    "container, surface, spot, base, look_at",
+    [
+        ("drawer 2", "drawer 2 inside", (0.3, 2.9), (1.45, 2.9, math.pi), (0.6, 2.9, 0.4)),
+        ("fridge", "fridge middle shelf", (3.05, 4.62), (3.05, 3.2, math.pi / 2), (3.05, 4.6, 0.7)),
+    ],
+)
 def test_objects_in_a_closed_container_are_invisible_until_it_opens(container, surface, spot, base, look_at):
     with apartment(base) as world:
         put(world, "cup", surface, spot)

@@ -9,10 +9,9 @@ import threading
 
 import numpy as np
 import pytest
+from sim_helpers import T, ok, to_map
 
 from pycram.world.prospection import Prospection, Reachability, Visibility
-
-from sim_helpers import T, ok, to_map
 
 MUG = (0.1, -1.15, 0.95)  # the default mug's centre on the back counter [m]
 MUG_FRONT = (0.1, -1.118, 0.95)  # a point on the mug's side facing the room (radius 0.03 m)
@@ -34,9 +33,18 @@ def _grasp_sequence(base) -> list:
 
 def _state(world) -> dict:
     """The simulation thread's own state arrays, copied in that thread."""
-    return ok(world._call("copy state", lambda eng: {
-        "qpos": eng.data.qpos.copy(), "qvel": eng.data.qvel.copy(), "ctrl": eng.data.ctrl.copy(),
-        "mocap": eng.data.mocap_pos.copy(), "time": eng.time}))
+    return ok(
+        world._call(
+            "copy state",
+            lambda eng: {
+                "qpos": eng.data.qpos.copy(),
+                "qvel": eng.data.qvel.copy(),
+                "ctrl": eng.data.ctrl.copy(),
+                "mocap": eng.data.mocap_pos.copy(),
+                "time": eng.time,
+            },
+        )
+    )
 
 
 def test_is_a_prospection_and_the_same_object_every_time(world):
@@ -198,16 +206,23 @@ def test_eight_threads_give_the_same_answers_as_one(world):
     for _ in range(6):
         base = (rng.uniform(-0.3, 2.5), rng.uniform(-0.9, 3.0), rng.uniform(-math.pi, math.pi))
         questions.append(("collision", base))
-    questions += [("collision", (0.2, -1.2, 0.0)), ("reach", cooker), ("reach", (0.29, -0.3, -1.5708)),
-                  ("reach", (0.8, 0.6, 0.0)), ("see", LOOK_AT_MUG), ("see", (1.0, -0.4, math.pi)),
-                  ("see", (2.0, 2.0, 0.5))]
+    questions += [
+        ("collision", (0.2, -1.2, 0.0)),
+        ("reach", cooker),
+        ("reach", (0.29, -0.3, -1.5708)),
+        ("reach", (0.8, 0.6, 0.0)),
+        ("see", LOOK_AT_MUG),
+        ("see", (1.0, -0.4, math.pi)),
+        ("see", (2.0, 2.0, 0.5)),
+    ]
 
     def ask(kind, base):
         if kind == "collision":
             return p.in_collision(base)
         if kind == "reach":
-            return p.reachable(arm, _grasp_sequence(type("B", (), {"yaw": base[2] if isinstance(base, tuple)
-                                                                   else base.yaw})), base)
+            return p.reachable(
+                arm, _grasp_sequence(type("B", (), {"yaw": base[2] if isinstance(base, tuple) else base.yaw})), base
+            )
         return p.visible("mug", base)
 
     alone = [ask(*q) for q in questions]

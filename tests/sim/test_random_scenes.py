@@ -7,11 +7,11 @@ from __future__ import annotations
 import math
 
 import pytest
+from sim_helpers import ok, settle, tilt
 
 from pycram.sim import ItemSpec, World
 from pycram.world.objects import object_type
 from pycram.world.scenes import random_scene
-from sim_helpers import ok, settle, tilt
 
 BREAKFAST = ["cup", "bowl", "spoon", "cereal", "milk", "plate"]
 
@@ -64,8 +64,10 @@ def test_objects_in_a_drawer_ride_out_with_it():
 
 
 def test_the_head_camera_sees_a_bowl_made_of_several_parts():
-    items = [ItemSpec.of(object_type("bowl"), "bowl", (4.3, 1.8, None)),
-             ItemSpec.of(object_type("plate"), "plate", (4.0, 1.8, None))]
+    items = [
+        ItemSpec.of(object_type("bowl"), "bowl", (4.3, 1.8, None)),
+        ItemSpec.of(object_type("plate"), "plate", (4.0, 1.8, None)),
+    ]
     with World("pr2", items, environment="apartment", base_pose=(4.3, 0.9, math.pi / 2)) as world:
         ok(world.point_head((4.15, 1.8, 0.75)))
         seen = {v.name: v for v in ok(world.perceive())}

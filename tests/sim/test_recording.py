@@ -14,13 +14,13 @@ import mujoco
 import numpy as np
 import pytest
 from PIL import Image
+from sim_helpers import ok, wait_wall
 
 from pycram.sim import World
 from pycram.sim.gif import TRANSPARENT, GifEncoder
 from pycram.sim.recording import FrameRecorder, RecordedFrames, StateSnapshot
 from pycram.sim.render import write_animation
 from pycram.sim.scene import build_scene, initial_state
-from sim_helpers import ok, wait_wall
 
 
 def recorder_threads() -> list[threading.Thread]:
@@ -39,6 +39,7 @@ def test_recording_runs_in_its_own_thread_and_ends_with_it(world, tmp_path, monk
             with lock:
                 calls.append((threading.get_ident(), args[data_position] is sim_data))
             return fn(*args, **kwargs)
+
         return wrapper
 
     monkeypatch.setattr(mujoco, "mj_kinematics", spy(mujoco.mj_kinematics, 1))
@@ -188,7 +189,7 @@ def test_write_animation_of_plain_and_recorded_frames(tmp_path):
     frames = []
     for i in range(6):
         f = np.full((48, 64, 3), 90, np.uint8)
-        f[10:20, 5 + 8 * i:15 + 8 * i] = (250, 200, 40)
+        f[10:20, 5 + 8 * i : 15 + 8 * i] = (250, 200, 40)
         f[30:, :] = rng.integers(0, 60, (18, 64, 3), dtype=np.uint8)  # static noise
         if i == 5:
             f[30:, :] = 0
@@ -274,8 +275,7 @@ def test_an_interrupted_stop_recording_leaves_no_thread_after_close(tmp_path):
     script = tmp_path / "probe.py"
     script.write_text(_INTERRUPT_PROBE)
     env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
-    done = subprocess.run([sys.executable, str(script), "1", "3"], capture_output=True, text=True, timeout=240,
-                          env=env)
+    done = subprocess.run([sys.executable, str(script), "1", "3"], capture_output=True, text=True, timeout=240, env=env)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-4000:]
     points = done.stdout.count("interrupted at ")
     assert points >= 10, done.stdout

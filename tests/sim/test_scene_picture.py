@@ -28,17 +28,21 @@ def test_scene_command_writes_a_labelled_picture(tmp_path):
 
 def test_scene_command_on_the_thesis_kitchen_without_objects(tmp_path):
     out = tmp_path / "kitchen.png"
-    result = runner.invoke(app, ["scene", "--env", "thesis-kitchen", "--objects", "", "--robot", "tiago",
-                                 "-o", str(out)])
+    result = runner.invoke(
+        app, ["scene", "--env", "thesis-kitchen", "--objects", "", "--robot", "tiago", "-o", str(out)]
+    )
     assert result.exit_code == 0, result.output
     assert out.stat().st_size > 10_000
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--env", "garage"], "environment 'garage' does not exist. Available: apartment, thesis-kitchen"),
-    (["--objects", "cup,fork"], "object type 'fork' does not exist. Available: bowl, cereal, cup"),
-    (["--env", "thesis-kitchen", "--objects", ",".join(["cereal"] * 40)], "no free spot for 'cereal"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--env", "garage"], "environment 'garage' does not exist. Available: apartment, thesis-kitchen"),
+        (["--objects", "cup,fork"], "object type 'fork' does not exist. Available: bowl, cereal, cup"),
+        (["--env", "thesis-kitchen", "--objects", ",".join(["cereal"] * 40)], "no free spot for 'cereal"),
+    ],
+)
 def test_scene_command_names_bad_input(tmp_path, args, message):
     result = runner.invoke(app, ["scene", *args, "-o", str(tmp_path / "x.png")])
     assert result.exit_code == 1
@@ -58,8 +62,9 @@ def test_costmap_command_draws_layers_and_chosen_poses(tmp_path):
 
 def test_costmap_of_an_impossible_location_says_why(tmp_path):
     out = tmp_path / "none.png"
-    result = runner.invoke(app, ["scene", "--seed", "3", "--objects", "cup", "-o", str(out),
-                                 "--costmap", "in drawer 1, for cereal"])
+    result = runner.invoke(
+        app, ["scene", "--seed", "3", "--objects", "cup", "-o", str(out), "--costmap", "in drawer 1, for cereal"]
+    )
     assert result.exit_code == 0, result.output
     assert "cereal (0.28 m tall) fits on none of" in " ".join(result.output.split())
     assert out.exists()

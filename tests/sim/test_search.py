@@ -81,6 +81,7 @@ def _tiago_apartment():
     from sim_helpers import ok
 
     from pycram.sim import World
+
     world = World("tiago", environment="apartment", objects=list(TYPES), seed=1, base_pose=START)
     for name in TYPES:
         ok(world.take_item(item=name))
@@ -108,6 +109,7 @@ def test_object_not_found_names_the_places_looked_at_and_the_closed_ones():
 
 def test_lookouts_come_from_the_environment_and_the_type():
     from pycram.environments import load
+
     apartment_env = load("apartment")
     cup_places = {lk.surface for lk in lookouts(apartment_env, "cup")}
     assert {"table", "counter", "cabinet top", "drawer 1 inside", "fridge middle shelf"} <= cup_places
@@ -121,6 +123,7 @@ def test_lookouts_come_from_the_environment_and_the_type():
 
 def test_search_needs_a_belief():
     from pycram.robot import ResolverSet
+
     with ResolverSet("no robot"), pytest.raises(ValueError, match="belief"):
         search_for(ObjectDesignator(type="cup"))
     with pytest.raises(TypeError, match="ObjectDesignator"):

@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from sim_helpers import T, facing_quat, ok
 
 from pycram.environments import load as load_environment
-from sim_helpers import T, facing_quat, ok
 
 KITCHEN = load_environment("thesis-kitchen")
 COUNTER_HEIGHT = KITCHEN.surface("counter_back").height

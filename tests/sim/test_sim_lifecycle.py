@@ -12,13 +12,13 @@ import time
 
 import mujoco
 import pytest
+from sim_helpers import Recorder, T, ok, wait_wall
 
 from pycram.fluent import Fluent
 from pycram.runtime import current_clock, sleep
 from pycram.sim import World
 from pycram.sim.errors import WorldClosedError
 from pycram.sim.world import REALTIME_SLACK
-from sim_helpers import T, Recorder, ok, wait_wall
 
 
 def test_plans_sleep_and_time_out_in_simulated_time():
@@ -69,6 +69,7 @@ def test_mujoco_is_only_touched_by_the_simulation_thread(monkeypatch):
             with lock:
                 calls.append((threading.get_ident(), name))
             return fn(*args, **kwargs)
+
         return wrapper
 
     for name in ("mj_step", "mj_forward", "mj_kinematics", "mj_comPos", "mj_jacSite", "mj_jacBody"):
@@ -90,8 +91,10 @@ def test_mujoco_is_only_touched_by_the_simulation_thread(monkeypatch):
         base = world.base_pose.get_value()
         left = world.tool_poses.get_value()["left"].position
         jobs = [
-            lambda: (ok(world.reach("left", (left[0], left[1], left[2] + 0.03))),  # map frame: before driving
-                     ok(world.drive_to(base.x + 0.3, base.y, base.yaw))),
+            lambda: (
+                ok(world.reach("left", (left[0], left[1], left[2] + 0.03))),  # map frame: before driving
+                ok(world.drive_to(base.x + 0.3, base.y, base.yaw)),
+            ),
             lambda: ok(world.move_arm_to(d.DEFAULT_ARM, "carry")),
             lambda: (ok(world.point_head((2.0, 0.6, 0.8))), ok(world.perceive())),
             lambda: (ok(world.request_image("head_camera")), ok(world.move_item("mug", (0.1, -1.15, 0.951)))),

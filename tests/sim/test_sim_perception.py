@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from sim_helpers import ViewMonitor, ok
 
 from pycram.environments import load as load_environment
 from pycram.sim import ItemSpec, World
-from sim_helpers import ViewMonitor, ok
 
 COUNTER_HEIGHT = load_environment("thesis-kitchen").surface("counter_back").height
 

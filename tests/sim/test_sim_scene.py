@@ -13,11 +13,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from sim_helpers import facing_quat, to_map
 
 from pycram.environments import load as load_environment
 from pycram.sim import DEFAULT_ITEMS, Pose, build_scene
 from pycram.sim.errors import UnknownNameError
-from sim_helpers import facing_quat, to_map
 
 ROBOTS = ("pr2", "tiago")
 REPO = Path(__file__).resolve().parents[2]
@@ -59,8 +59,11 @@ def test_counters_are_0_9_m_high_with_two_cooker_areas():
         x, y, z = model.site_pos[site.id] + model.body(int(site.bodyid[0])).pos
         assert abs(z - 0.9) < 0.01
         # each cooker area lies on the top of one counter, a different one for each cooker
-        on = [n for n in tops if all(abs(v - c) <= h for v, c, h in
-                                     zip((x, y), model.geom(n).pos[:2], model.geom(n).size[:2]))]
+        on = [
+            n
+            for n in tops
+            if all(abs(v - c) <= h for v, c, h in zip((x, y), model.geom(n).pos[:2], model.geom(n).size[:2]))
+        ]
         assert len(on) == 1
         assert tops[on[0]] is None
         tops[on[0]] = cooker.name
@@ -74,8 +77,9 @@ def test_models_come_from_installed_packages_not_the_repository():
     data = robot_data_dir().resolve()
     assert Path(sys.prefix).resolve() in data.parents  # the installed example-robot-data package
     suffixes = (".stl", ".dae", ".obj", ".urdf", ".srdf", ".xml", ".png")
-    tracked = subprocess.run(["git", "ls-files", "pycram"], cwd=REPO, capture_output=True, text=True,
-                             check=True).stdout.split()
+    tracked = subprocess.run(
+        ["git", "ls-files", "pycram"], cwd=REPO, capture_output=True, text=True, check=True
+    ).stdout.split()
     assert tracked and [f for f in tracked if f.lower().endswith(suffixes)] == []
 
 
@@ -98,15 +102,17 @@ def test_headless_gl_is_chosen_only_when_nothing_else_is(monkeypatch):
 
 def test_importing_the_simulation_without_display_renders_headless(tmp_path):
     """A fresh process with neither MUJOCO_GL nor DISPLAY set can render after `import pycram.sim`."""
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "DISPLAY", "WAYLAND_DISPLAY")}
-    code = ("import os, pycram.sim, mujoco\n"
-            "m = pycram.sim.build_scene('pr2').model\n"
-            "r = mujoco.Renderer(m, 48, 64); d = mujoco.MjData(m); mujoco.mj_forward(m, d)\n"
-            "r.update_scene(d, camera='overview'); img = r.render(); r.close()\n"
-            "print(os.environ['MUJOCO_GL'], img.std() > 1)\n")
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=REPO, capture_output=True, text=True,
-                         timeout=120)
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "DISPLAY", "WAYLAND_DISPLAY")
+    }
+    code = (
+        "import os, pycram.sim, mujoco\n"
+        "m = pycram.sim.build_scene('pr2').model\n"
+        "r = mujoco.Renderer(m, 48, 64); d = mujoco.MjData(m); mujoco.mj_forward(m, d)\n"
+        "r.update_scene(d, camera='overview'); img = r.render(); r.close()\n"
+        "print(os.environ['MUJOCO_GL'], img.std() > 1)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=REPO, capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split()[-2:] == ["egl", "True"]
 

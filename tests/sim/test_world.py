@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from sim_helpers import Recorder, T, facing_quat, ok, to_map
 
 from pycram.environments import load as load_environment
-from sim_helpers import T, Recorder, facing_quat, ok, to_map
 
 COUNTER_HEIGHT = load_environment("thesis-kitchen").surface("counter_back").height
 

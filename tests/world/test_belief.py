@@ -82,10 +82,19 @@ def test_container_states_and_supports():
     assert support_of(APARTMENT, 4.3, 2.0, 0.75).name == "table"
 
 
-@pytest.mark.parametrize("rgb, name", [((0.8, 0.18, 0.15), "red"), ((0.95, 0.82, 0.25), "yellow"),
-                                       ((0.92, 0.55, 0.12), "orange"), ((0.96, 0.96, 0.93), "white"),
-                                       ((0.5, 0.5, 0.52), "grey"), ((0.1, 0.1, 0.1), "black"),
-                                       ((0.1, 0.3, 0.9), "blue"), ((0.2, 0.7, 0.2), "green")])
+@pytest.mark.parametrize(
+    "rgb, name",
+    [
+        ((0.8, 0.18, 0.15), "red"),
+        ((0.95, 0.82, 0.25), "yellow"),
+        ((0.92, 0.55, 0.12), "orange"),
+        ((0.96, 0.96, 0.93), "white"),
+        ((0.5, 0.5, 0.52), "grey"),
+        ((0.1, 0.1, 0.1), "black"),
+        ((0.1, 0.3, 0.9), "blue"),
+        ((0.2, 0.7, 0.2), "green"),
+    ],
+)
 def test_colour_names(rgb, name):
     assert color_name(rgb) == name
 

@@ -22,8 +22,9 @@ def test_registry_looks_environments_up_by_name_and_lists_valid_names():
         env = environments.load(name)
         assert env.name == name
         assert environments.load(env) is env
-    with pytest.raises(UnknownNameError, match="environment 'kitchen2' does not exist. Available: apartment, "
-                                               "thesis-kitchen"):
+    with pytest.raises(
+        UnknownNameError, match="environment 'kitchen2' does not exist. Available: apartment, thesis-kitchen"
+    ):
         environments.load("kitchen2")
     with pytest.raises(KeyError):  # a plain KeyError for callers that catch that
         environments.load("kitchen2")
@@ -31,8 +32,10 @@ def test_registry_looks_environments_up_by_name_and_lists_valid_names():
 
 def test_unknown_parts_name_the_valid_choices():
     kitchen = environments.load("thesis-kitchen")
-    with pytest.raises(UnknownNameError, match="surface 'sink' does not exist. Available: cooker #1, cooker #2, "
-                                               "counter_back, counter_left"):
+    with pytest.raises(
+        UnknownNameError,
+        match="surface 'sink' does not exist. Available: cooker #1, cooker #2, counter_back, counter_left",
+    ):
         kitchen.surface("sink")
     with pytest.raises(UnknownNameError, match="container 'drawer'"):
         kitchen.container("drawer")
@@ -70,11 +73,19 @@ def test_surface_polygons_are_convex_and_counter_clockwise():
 
 
 def test_container_handle_follows_the_opening_trajectory():
-    drawer = Container("d", "drawer", Box("d", (0.3, 1.0, 0.5), (0.25, 0.2, 0.1)), (0.6, 1.0, 0.55),
-                       (1.0, 0.0), (0.0, 0.4))
+    drawer = Container(
+        "d", "drawer", Box("d", (0.3, 1.0, 0.5), (0.25, 0.2, 0.1)), (0.6, 1.0, 0.55), (1.0, 0.0), (0.0, 0.4)
+    )
     assert drawer.joint == "slide" and drawer.handle_position(0.3) == pytest.approx((0.9, 1.0, 0.55))
-    door = Container("f", "door", Box("f", (1.0, 0.0, 0.8), (0.02, 0.3, 0.8)), (1.05, 0.25, 1.0),
-                     (1.0, 0.0), (0.0, 2.0), hinge=(1.02, -0.3))
+    door = Container(
+        "f",
+        "door",
+        Box("f", (1.0, 0.0, 0.8), (0.02, 0.3, 0.8)),
+        (1.05, 0.25, 1.0),
+        (1.0, 0.0),
+        (0.0, 2.0),
+        hinge=(1.02, -0.3),
+    )
     assert door.joint == "hinge"
     opened = door.handle_position(math.pi / 2)  # a quarter turn: the handle swings out in front
     assert opened[0] > 1.5 and opened[1] == pytest.approx(-0.3, abs=0.05)
@@ -97,8 +108,9 @@ def _imports(path: Path) -> set[str]:
 
 
 def test_no_module_imports_an_environment_module_but_the_registry():
-    env_modules = {f"pycram.environments.{p.stem}" for p in (PACKAGE / "environments").glob("*.py")
-                   if p.stem != "__init__"}
+    env_modules = {
+        f"pycram.environments.{p.stem}" for p in (PACKAGE / "environments").glob("*.py") if p.stem != "__init__"
+    }
     assert "pycram.environments.thesis_kitchen" in env_modules
     offenders = []
     for path in PACKAGE.rglob("*.py"):
@@ -113,6 +125,9 @@ def test_no_module_imports_an_environment_module_but_the_registry():
 def test_the_world_model_and_environments_know_no_simulator():
     for folder in ("world", "environments"):
         for path in (PACKAGE / folder).glob("*.py"):
-            bad = {n for n in _imports(path) if n.split(".")[0] == "mujoco" or n.startswith("pycram.sim")
-                   or n.startswith("pycram.robots")}
+            bad = {
+                n
+                for n in _imports(path)
+                if n.split(".")[0] == "mujoco" or n.startswith("pycram.sim") or n.startswith("pycram.robots")
+            }
             assert not bad, f"{path.name} imports {sorted(bad)}"

@@ -74,7 +74,7 @@ def test_no_two_objects_overlap_and_all_rest_plausibly_over_200_seeds():
             assert p.z_range[0] == pytest.approx(surface.height, abs=0.002)  # standing on it
             assert otype.height < surface.clearance, (seed, p)  # fits inside a drawer or the fridge
             assert (p.container is None) == (surface.kind not in ("drawer", "shelf"))
-            for q in scene[i + 1:]:
+            for q in scene[i + 1 :]:
                 assert not p.overlaps(q, GAP), (seed, p, q)
     assert supports_used == {"counter", "table", "shelf", "drawer"}  # every kind of spot occurs
 

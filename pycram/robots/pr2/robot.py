@@ -11,13 +11,12 @@ Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``,
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 from pycram.process_module import ProcessModule
 from pycram.robots import sim_modules as sm
 from pycram.robots.pr2 import description
-from pycram.robots.sim_resolvers import (make_location_generator, make_motion_resolver,
-                                         physical_arm, physical_gripper)
+from pycram.robots.sim_resolvers import make_location_generator, make_motion_resolver, physical_arm, physical_gripper
 from pycram.robots.sim_vocabulary import motion_types
 
 __all__ = ["make_robot"]
@@ -26,17 +25,16 @@ __all__ = ["make_robot"]
 def make_robot(world: Any) -> sm.SimRobot:
     """The PR2 of ``world`` (a :class:`pycram.sim.World` built for ``'pr2'``), modules online."""
     if getattr(world, "robot", None) != description.NAME:
-        raise ValueError(f"make_robot for {description.NAME!r} needs a world with a "
-                         f"{description.NAME!r}, got {world!r}")
+        raise ValueError(
+            f"make_robot for {description.NAME!r} needs a world with a {description.NAME!r}, got {world!r}"
+        )
     robot = sm.SimRobot(description.NAME, world, description)
     navigation = robot.add_process_module("navigation", sm.NavigationModule(world))
     base_stop = robot.add_process_module("base_stop", sm.BaseStopModule(world, navigation))
     head = robot.add_process_module("head", sm.HeadModule(world))
     torso = robot.add_process_module("torso", sm.TorsoModule(world))
-    arms = {arm: robot.add_process_module(f"arm_{arm}", sm.ArmModule(world, arm))
-            for arm in description.ARMS}
-    grippers = {g: robot.add_process_module(f"gripper_{g}", sm.GripperModule(world, g))
-                for g in description.GRIPPERS}
+    arms = {arm: robot.add_process_module(f"arm_{arm}", sm.ArmModule(world, arm)) for arm in description.ARMS}
+    grippers = {g: robot.add_process_module(f"gripper_{g}", sm.GripperModule(world, g)) for g in description.GRIPPERS}
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
     perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
 
@@ -44,7 +42,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     robot.motion_resolvers.append(make_motion_resolver(world, description))
     robot.location_generators.append(make_location_generator(world, description, robot.belief))
 
-    def available_process_modules(desig: Any) -> Optional[ProcessModule]:
+    def available_process_modules(desig: Any) -> ProcessModule | None:
         """Thesis ch. 4.2.2: choose the PR2's module by the designator's type (and arm)."""
         if desig.check_constraints([("type", "moving")]):
             return navigation
@@ -56,14 +54,17 @@ def make_robot(world: Any) -> sm.SimRobot:
             return torso
         if desig.check_constraints([("type", "detecting")]):
             return perception
-        if (desig.check_constraints([("type", "subscribing_pose")])
-                or desig.check_constraints([("type", "subscribing_gripper")])):
+        if desig.check_constraints([("type", "subscribing_pose")]) or desig.check_constraints(
+            [("type", "subscribing_gripper")]
+        ):
             return sensors
         if desig.check_constraints([("type", "setting_gripper"), "gripper"]):
             return grippers[physical_gripper(description, desig.prop_value("gripper"))]
-        if (desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
-                or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
-                or desig.check_constraints([("type", "reaching"), "arm"])):
+        if (
+            desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
+            or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
+            or desig.check_constraints([("type", "reaching"), "arm"])
+        ):
             return arms[physical_arm(description, desig.prop_value("arm"))]
         return None
 

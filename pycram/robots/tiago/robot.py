@@ -12,12 +12,11 @@ Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``,
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 from pycram.process_module import ProcessModule
 from pycram.robots import sim_modules as sm
-from pycram.robots.sim_resolvers import (make_location_generator, make_motion_resolver,
-                                         physical_arm, physical_gripper)
+from pycram.robots.sim_resolvers import make_location_generator, make_motion_resolver, physical_arm, physical_gripper
 from pycram.robots.sim_vocabulary import motion_types
 from pycram.robots.tiago import description
 
@@ -27,8 +26,9 @@ __all__ = ["make_robot"]
 def make_robot(world: Any) -> sm.SimRobot:
     """The TIAGo of ``world`` (a :class:`pycram.sim.World` built for ``'tiago'``), modules online."""
     if getattr(world, "robot", None) != description.NAME:
-        raise ValueError(f"make_robot for {description.NAME!r} needs a world with a "
-                         f"{description.NAME!r}, got {world!r}")
+        raise ValueError(
+            f"make_robot for {description.NAME!r} needs a world with a {description.NAME!r}, got {world!r}"
+        )
     robot = sm.SimRobot(description.NAME, world, description)
     navigation = robot.add_process_module("navigation", sm.NavigationModule(world))
     base_stop = robot.add_process_module("base_stop", sm.BaseStopModule(world, navigation))
@@ -37,8 +37,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     (arm_name,) = description.ARMS
     (gripper_name,) = description.GRIPPERS
     arm = robot.add_process_module(f"arm_{arm_name}", sm.ArmModule(world, arm_name))
-    gripper = robot.add_process_module(f"gripper_{gripper_name}",
-                                       sm.GripperModule(world, gripper_name))
+    gripper = robot.add_process_module(f"gripper_{gripper_name}", sm.GripperModule(world, gripper_name))
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
     perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
 
@@ -46,7 +45,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     robot.motion_resolvers.append(make_motion_resolver(world, description))
     robot.location_generators.append(make_location_generator(world, description, robot.belief))
 
-    def available_process_modules(desig: Any) -> Optional[ProcessModule]:
+    def available_process_modules(desig: Any) -> ProcessModule | None:
         """Thesis ch. 4.2.2: choose TIAGo's module by the designator's type; any arm or gripper
         request goes to its only arm or gripper (unknown names still fail clearly)."""
         if desig.check_constraints([("type", "moving")]):
@@ -59,15 +58,18 @@ def make_robot(world: Any) -> sm.SimRobot:
             return torso
         if desig.check_constraints([("type", "detecting")]):
             return perception
-        if (desig.check_constraints([("type", "subscribing_pose")])
-                or desig.check_constraints([("type", "subscribing_gripper")])):
+        if desig.check_constraints([("type", "subscribing_pose")]) or desig.check_constraints(
+            [("type", "subscribing_gripper")]
+        ):
             return sensors
         if desig.check_constraints([("type", "setting_gripper"), "gripper"]):
             physical_gripper(description, desig.prop_value("gripper"))  # validates the name
             return gripper
-        if (desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
-                or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
-                or desig.check_constraints([("type", "reaching"), "arm"])):
+        if (
+            desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
+            or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
+            or desig.check_constraints([("type", "reaching"), "arm"])
+        ):
             physical_arm(description, desig.prop_value("arm"))  # validates the name
             return arm
         return None

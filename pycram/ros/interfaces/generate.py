@@ -75,10 +75,10 @@ def _expand_action(name: str, text: str) -> dict[str, str]:
         f"{name}Feedback": feedback + "\n",
         f"{name}ActionGoal": f"Header header\nactionlib_msgs/GoalID goal_id\n{name}Goal goal\n",
         f"{name}ActionResult": f"Header header\nactionlib_msgs/GoalStatus status\n{name}Result result\n",
-        f"{name}ActionFeedback": (f"Header header\nactionlib_msgs/GoalStatus status\n"
-                                  f"{name}Feedback feedback\n"),
-        f"{name}Action": (f"{name}ActionGoal action_goal\n{name}ActionResult action_result\n"
-                          f"{name}ActionFeedback action_feedback\n"),
+        f"{name}ActionFeedback": (f"Header header\nactionlib_msgs/GoalStatus status\n{name}Feedback feedback\n"),
+        f"{name}Action": (
+            f"{name}ActionGoal action_goal\n{name}ActionResult action_result\n{name}ActionFeedback action_feedback\n"
+        ),
     }
 
 
@@ -123,14 +123,14 @@ def generate(output: Path) -> list[str]:
         try:
             for package, (messages, services) in sources.items():
                 msg_files = [str(scratch_dir / "src" / package / "msg" / f"{n}.msg") for n in messages]
-                if MsgGenerator().generate_messages(package, msg_files, str(staging / package / "msg"),
-                                                    search_path):
+                if MsgGenerator().generate_messages(package, msg_files, str(staging / package / "msg"), search_path):
                     raise RuntimeError(f"genpy could not generate the messages of {package} (see above)")
                 _write_init(staging / package / "msg", list(messages))
                 generated += [f"{package}/{n}" for n in messages]
                 if services:
-                    if SrvGenerator().generate_messages(package, [str(s) for s in services],
-                                                        str(staging / package / "srv"), search_path):
+                    if SrvGenerator().generate_messages(
+                        package, [str(s) for s in services], str(staging / package / "srv"), search_path
+                    ):
                         raise RuntimeError(f"genpy could not generate the services of {package}")
                     _write_init(staging / package / "srv", [s.stem for s in services])
                     generated += [f"{package}/{s.stem}" for s in services]
