@@ -92,7 +92,8 @@ def demo_runs() -> None:
         for animation in (True, False):
             r = run_demo(DemoOptions(output=Path(tmp) / str(animation), quiet=True, record=False, animation=animation))
             print(
-                f"demo pr2, animation {'on ' if animation else 'off'}: exit {r.exit_code}, simulated {r.sim_time:.1f} s, "
+                f"demo pr2, animation {'on ' if animation else 'off'}: exit {r.exit_code}, simulated "
+                f"{r.sim_time:.1f} s, "
                 f"plan {r.plan_wall_time:.1f} s wall -> {r.speed_factor:.1f}x real time; whole run "
                 f"{r.wall_time:.1f} s (load average {os.getloadavg()[0]:.1f})",
                 flush=True,

@@ -9,7 +9,7 @@ abstraction), `pycram.sim` (the MuJoCo kitchen), `pycram.trace` (run recording).
 
 from typing import Any
 
-from pycram._version import __version__
+from pycram._version import __version__ as __version__
 
 _LAZY = {
     "perform": "pycram.designator",

@@ -581,11 +581,15 @@ class _Transformer:
                 if in_whenever:
                     raise self.error(
                         node,
-                        f"`return <value>` inside a `whenever` that is a branch of {what} cannot return from the enclosing function; use a bare `return` to leave the loop and end the branch, and pass results through a variable",
+                        f"`return <value>` inside a `whenever` that is a branch of {what} cannot return from the "
+                        f"enclosing function; use a bare `return` to leave the loop and end the branch, and pass "
+                        f"results through a variable",
                     )
                 raise self.error(
                     node,
-                    f"`return` is not allowed inside {what}: each statement runs as its own branch (a task), so it cannot return from the enclosing function. Assign a variable in the branch and return after the block",
+                    f"`return` is not allowed inside {what}: each statement runs as its own branch (a task), so it "
+                    f"cannot return from the enclosing function. Assign a variable in the branch and return after "
+                    f"the block",
                 )
             if isinstance(node, (ast.Yield, ast.YieldFrom, ast.Await)):
                 kind = "await" if isinstance(node, ast.Await) else "yield"
@@ -632,7 +636,8 @@ class _Transformer:
         if all(trivial(s) for s in form.node.body):
             raise self.error(
                 form.node,
-                f"`with {form.name}` block has no statements; each statement of the block is one {'step' if form.name in ('seq', 'try_in_order') else 'branch'}",
+                f"`with {form.name}` block has no statements; each statement of the block is one "
+                f"{'step' if form.name in ('seq', 'try_in_order') else 'branch'}",
             )
 
     # -- code generation --------------------------------------------------------------------------
@@ -859,7 +864,8 @@ class _Transformer:
             raise self.error(node, "`with whenever(fluent)` needs exactly one argument: the fluent to wait for")
         self.check_not_empty(form)
         out: list[ast.stmt] = self._parse(
-            f"import pycram.macros as _pycram_rt\nfor _pycram_pulse in _pycram_rt.whenever_loop(_pycram_fluent, {self.where(node)!r}):\n    pass"
+            f"import pycram.macros as _pycram_rt\nfor _pycram_pulse in _pycram_rt.whenever_loop(_pycram_fluent, "
+            f"{self.where(node)!r}):\n    pass"
         )
         loop = out[1]
         assert isinstance(loop, ast.For)
@@ -987,7 +993,8 @@ def plan(fn: F) -> F:
         return fn
     if getattr(fn, "__wrapped__", None) is not None:
         raise TypeError(
-            f"@plan must be the innermost decorator (directly above `def {fn.__name__}`): it re-compiles the function's source"
+            f"@plan must be the innermost decorator (directly above `def {fn.__name__}`): it re-compiles the "
+            f"function's source"
         )
     if fn.__name__ == "<lambda>":
         raise TypeError("@plan cannot be applied to a lambda; use `def`")
@@ -997,7 +1004,8 @@ def plan(fn: F) -> F:
         lines, start = inspect.getsourcelines(fn)
     except (OSError, TypeError) as exc:
         raise TypeError(
-            f"@plan cannot find the source of {fn.__qualname__} ({filename}); the block syntax needs source code. Use the functional forms (par(f1, f2, ...)) instead"
+            f"@plan cannot find the source of {fn.__qualname__} ({filename}); the block syntax needs source code. "
+            f"Use the functional forms (par(f1, f2, ...)) instead"
         ) from exc
     source = "".join(lines)
     indented = bool(lines) and lines[0][:1] in (" ", "\t")

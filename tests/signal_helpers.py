@@ -58,7 +58,7 @@ class Command:
                 line = self._lines.get(timeout=timeout)
             except queue.Empty:
                 self.process.kill()
-                raise AssertionError(f"no line matching {pattern!r} within {timeout} s:\n{self.output}")
+                raise AssertionError(f"no line matching {pattern!r} within {timeout} s:\n{self.output}") from None
             if line is None:
                 ended += 1
                 if ended == 2:
@@ -76,7 +76,7 @@ class Command:
             code = self.process.wait(timeout)
         except subprocess.TimeoutExpired:
             self.process.kill()
-            raise AssertionError(f"the process did not exit within {timeout} s:\n{self.output}")
+            raise AssertionError(f"the process did not exit within {timeout} s:\n{self.output}") from None
         for reader in self._readers:
             reader.join(10.0)
         return code

@@ -63,7 +63,8 @@ def test_each_statement_is_one_branch_and_state_is_bound_first() -> None:
 
 def test_thesis_macros_import_is_dropped(tmp_path: Path) -> None:
     ns = run(
-        "from pycram.language import macros, par\nfrom pycram.fluent import macros, Fluent\nwith par as s:\n    x = 1\n",
+        "from pycram.language import macros, par\nfrom pycram.fluent import macros, Fluent\nwith par as s:\n    x "
+        "= 1\n",
         tmp_path,
     )
     assert ns["s"].get_value() is State.SUCCEEDED and ns["x"] == 1

@@ -297,7 +297,7 @@ def test_evaporation_is_sticky_for_every_later_pycram_call():
 
     for name, call in calls.items():
         started.set_value(None)
-        pursue(lambda: stubborn(name, call), lambda: started.wait_for(timeout=WAIT))
+        pursue(lambda name=name, call=call: stubborn(name, call), lambda: started.wait_for(timeout=WAIT))
         assert last_expression_task().children[0].status.get_value() is TaskStatus.EVAPORATED
     assert raised == list(calls)
 

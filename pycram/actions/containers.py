@@ -24,6 +24,7 @@ from __future__ import annotations
 import logging
 import math
 import weakref
+from functools import partial
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
@@ -244,7 +245,7 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
             try:
                 measured = attempt(
                     f"{action} {container.name} from ({location.x:.2f}, {location.y:.2f}) with the {location.arm} arm",
-                    lambda: _move_handle(location, belief, container, goal),
+                    partial(_move_handle, location, belief, container, goal),
                 )
                 if action == "opening":
                     _opened_from.setdefault(current_robot(), {})[container.name] = location

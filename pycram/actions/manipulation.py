@@ -32,6 +32,7 @@ import logging
 import math
 import weakref
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
@@ -315,7 +316,7 @@ def picking_up(designator: ActionDesignator) -> Held:
                     held = attempt(
                         f"grasp {obj.name} from {_pose_text(location)} with the {location.arm} arm "
                         f"({location.grasp} grasp)",
-                        lambda: _grasp_from(location, obj, grasp),
+                        partial(_grasp_from, location, obj, grasp),
                     )
                 except RECOVERABLE as error:
                     cause = last = unwrap(error)
@@ -487,7 +488,7 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                     try:
                         return attempt(
                             f"place {held.object.name} at {_xyz(spot)} from {_pose_text(location)}",
-                            lambda: _place_at(location, held, spot, point),
+                            partial(_place_at, location, held, spot, point),
                         )
                     except RECOVERABLE as error:
                         cause = last = unwrap(error)

@@ -107,7 +107,8 @@ def as_target(value: Any, environment: Environment | None = None, known_objects:
     """`value` as a `Target` (see the module docstring).
 
     A string names, in this order, a place, a surface or a container of `environment`, or one of
-    `known_objects` (by name, else the first of that object type). Raises ``ValueError`` naming the value and what a target may be.
+    `known_objects` (by name, else the first of that object type). Raises ``ValueError`` naming the
+    value and what a target may be.
     """
     if isinstance(value, Target):
         return value

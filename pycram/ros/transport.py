@@ -161,5 +161,5 @@ class Transport(ABC):
     def time_to_seconds(self, stamp: Any) -> float:
         """A message time stamp in [s]."""
 
-    def shutdown(self) -> None:
-        """Close every client and subscription of this transport."""
+    def shutdown(self) -> None:  # noqa: B027 -- optional hook: transports without clients keep it
+        """Close every client and subscription of this transport (default: nothing to close)."""

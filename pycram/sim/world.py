@@ -91,7 +91,8 @@ class World:
     there and none elsewhere) and/or as object type names (`objects`, e.g. ``["cup", "bowl",
     "cup"]``), which are placed at random, non-overlapping spots on the environment's surfaces
     and inside its containers (only on the surfaces named in `supports`, when given), the same
-    for the same `seed` (see `pycram.world.scenes`); they are named after their type ("cup", "cup 2") and `placements` says where each started.
+    for the same `seed` (see `pycram.world.scenes`); they are named after their type ("cup", "cup
+    2") and `placements` says where each started.
 
     Construction builds the scene (< 1 s) and starts the thread. `close()` (or leaving the
     `with` block) stops it and joins it; every command still running ends with reason "closed".
@@ -249,7 +250,7 @@ class World:
             while not self._stop.is_set():
                 self._drain_inbox()
                 t = eng.time
-                for channel, (ctrl, handle) in list(self._active.items()):
+                for channel, (ctrl, _handle) in list(self._active.items()):
                     out = ctrl.update(eng, t)
                     if out is not None:
                         self._end(channel, out, stop=not out.succeeded)
@@ -313,7 +314,7 @@ class World:
             except queue.Empty:
                 return
             if kind == "cancel":
-                for channel, (c, h) in list(self._active.items()):
+                for channel, (_ctrl, h) in list(self._active.items()):
                     if h is handle:
                         self._end(channel, Outcome(False, "cancelled", "cancelled"), stop=True)
                 continue

@@ -75,7 +75,8 @@ PoseCheck = Callable[[float, float, float], bool]
 
 
 class NoPathError(GoalUnreachable):
-    """No collision-free path exists (a `pycram.failures.GoalUnreachable`). ``reason``: ``'no_path'`` (start and goal are not connected
+    """No collision-free path exists (a `pycram.failures.GoalUnreachable`). ``reason``:
+    ``'no_path'`` (start and goal are not connected
     on the free floor), ``'goal_in_collision'`` (the robot does not fit at the goal pose) or
     ``'outside_map'`` (start or goal is off the map). ``start``/``goal`` are the poses asked."""
 

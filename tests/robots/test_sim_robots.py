@@ -282,7 +282,6 @@ def test_evaporating_a_running_drive_stops_the_base(robot):
 
 
 def test_evaporating_a_queued_drive_leaves_the_running_one_alone(robot):
-    world = robot.world
     go_to_start(robot)
     goal = (START[0] + 1.0, START[1] + 1.0, 0.0)
     running = ProcessModule.perform(MotionDesignator(type="moving", pose=goal, wait=False))

@@ -118,6 +118,7 @@ APPROACH_OFFSETS = {
 REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place": 0.02, "default": 0.01}
 
 #: Location reasoning: a grasp pose counts as reachable only if the tool also reaches this much
-#: [m] lower without touching anything (its fingers pass close above the surface; executed motions pass through configurations IK
+#: [m] lower without touching anything (its fingers pass close above the surface; executed motions
+#: pass through configurations IK
 #: did not check).
 GRASP_CONTACT_MARGIN = 0.005
