@@ -17,12 +17,13 @@ robot or world by an action resolver of its own (asked before the library's).
 """
 
 from pycram.designators.action import ActionDesignator
+from pycram.failures import ObjectNotFound
 
 from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
 from .containers import Close, Open
 from .core import ACTION_PLANS, ActionParameterError, resolve_action
 from .manipulation import Held, PickUp, Place, held_objects
-from .search import Lookout, ObjectNotFound, look_around, lookouts, search_for
+from .search import Lookout, look_around, lookouts, search_for
 from .transport import Transport
 
 if resolve_action not in ActionDesignator.resolvers:

@@ -23,6 +23,7 @@ constructor        plan does                                 raises (after its a
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
@@ -128,7 +129,7 @@ def navigating(designator: ActionDesignator) -> Any:
             if pose is None:
                 break
             try:
-                return attempt(f"drive to solution {number}", lambda p=pose: motion(type="moving", pose=p))
+                return attempt(f"drive to solution {number}", partial(motion, type="moving", pose=pose))
             except RECOVERABLE as error:
                 if not isinstance(unwrap(error), NavigationFailure) and not _is_motion_failure(error):
                     raise
@@ -173,7 +174,7 @@ def point_of(target: Any) -> tuple[float, float, float]:
     values = tuple(float(v) for v in target)
     if len(values) != 3:
         raise ValueError(f"{target!r} is not a point (x, y, z)")
-    return values  # type: ignore[return-value]
+    return values
 
 
 @action_plan("looking_at")
@@ -190,7 +191,7 @@ def looking_at(designator: ActionDesignator) -> Any:
 
 @action_plan("parking_arms")
 def parking_arms(designator: ActionDesignator) -> None:
-    errors: list = []
+    errors: list[BaseException] = []
     branches = [lambda a=a: motion(type="setting_arm_configuration", arm=a, configuration="park") for a in arms()]
     state = par(*branches, errors=errors, name="park every arm")
     if state.get_value() is not State.SUCCEEDED:

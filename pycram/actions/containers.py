@@ -39,6 +39,7 @@ from .core import (
     arm_name,
     attempt,
     base_pose_fluent,
+    best_effort,
     gripper_of,
     make_action,
     motion,
@@ -111,7 +112,8 @@ def _measure(belief: Any, container: Any) -> float | None:
     q = belief.container_states.get(container.name, 0.0)
     motion(type="pointing_head", coordinates=list(container.handle_position(q)))
     motion(type="detecting")
-    return belief.container_states.get(container.name)
+    measured = belief.container_states.get(container.name)
+    return None if measured is None else float(measured)
 
 
 def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> float:
@@ -176,15 +178,12 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
 
 def _release(arm: str, gripper: str, handle: list[float], grasp: str) -> None:
     """Let go of the handle and back off (best effort), the arm up for driving."""
-    for step in (
+    best_effort(
+        "letting go of a handle",
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
         lambda: motion(type="reaching", arm=arm, target=handle, phase="retreat", grasp=grasp),
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
-    ):
-        try:
-            step()
-        except RECOVERABLE as error:
-            log.info("letting go of a handle: %s", unwrap(error))
+    )
 
 
 #: Per robot: container name -> the standing pose it was last opened from (valid for closing:
@@ -249,7 +248,7 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
                 )
                 if action == "opening":
                     _opened_from.setdefault(current_robot(), {})[container.name] = location
-                return measured
+                return float(measured)
             except RECOVERABLE as error:
                 last = unwrap(error)
                 attempts.append(f"from ({location.x:.2f}, {location.y:.2f}): {last}")

@@ -52,6 +52,7 @@ __all__ = [
     "base_pose_fluent",
     "unwrap",
     "attempt",
+    "best_effort",
     "solutions",
 ]
 
@@ -199,6 +200,16 @@ def solutions(designator: Any) -> Iterator[Any]:
         except NoSolutionError:
             return
         yield solution
+
+
+def best_effort(what: str, *steps: Callable[[], Any]) -> None:
+    """Run each step in turn; a step's recoverable failure is logged (`what`: of what) and the
+    next step runs. For clean-up after a failed attempt (let go, back off, arm up)."""
+    for step in steps:
+        try:
+            step()
+        except RECOVERABLE as error:
+            log.info("%s: %s", what, unwrap(error))
 
 
 def attempt(name: str, body: Callable[[], Any]) -> Any:

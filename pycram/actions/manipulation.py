@@ -61,6 +61,7 @@ from .core import (
     arm_name,
     attempt,
     base_pose_fluent,
+    best_effort,
     gripper_of,
     gripper_opening,
     make_action,
@@ -181,12 +182,14 @@ def _search(description: ObjectDesignator) -> PerceivedObject:
 
     from .containers import Open
 
-    return search_for(description, open_container=lambda name: perform(Open(name)))
+    found: PerceivedObject = search_for(description, open_container=lambda name: perform(Open(name)))
+    return found
 
 
 def _search_again(wanted: Any, obj: PerceivedObject) -> PerceivedObject:
     """Search for the object again (a fresh designator: the old one is equated to what was lost)."""
     description = wanted.copy() if isinstance(wanted, ObjectDesignator) else ObjectDesignator(type=obj.type)
+    assert isinstance(description, ObjectDesignator)
     return _search(description)
 
 
@@ -207,27 +210,22 @@ class _ObjectMoved(PlanFailure):
 
 def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None) -> None:
     """Best effort after a failed grasp: open the gripper, back off, arm up for driving."""
-    for step in (
+    best_effort(
+        "clean-up after a failed grasp",
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
         lambda: point and motion(type="reaching", arm=arm, target=point, phase="retreat"),
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
-    ):
-        try:
-            step()
-        except RECOVERABLE as error:
-            log.info("clean-up after a failed grasp: %s", unwrap(error))
+    )
 
 
-def _look_again(obj: PerceivedObject) -> None:
-    """Point the head at the believed object and look: the belief is refreshed, or the object is
-    believed gone when it was not seen there."""
+def _look_again(obj: PerceivedObject) -> bool:
+    """Point the head at the believed object and look; True when it was seen. The belief is
+    refreshed, or marks the object gone when it should have been seen (not hidden, e.g. by the
+    robot's own arm) and was not."""
     seen_before = obj.times_seen
     motion(type="pointing_head", coordinates=list(obj.pose))
     motion(type="detecting", object=obj.type)
-    if obj.times_seen == seen_before and not obj.gone:
-        belief = getattr(current_robot(), "belief", None)
-        if belief is not None:
-            belief.lost(obj)
+    return obj.times_seen > seen_before
 
 
 def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
@@ -254,8 +252,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     held = Held(obj, arm, gripper, grasp)
     if opening < held.held_opening:
         _let_go_and_retract(arm, gripper, point)
-        _look_again(obj)
-        if obj.gone:
+        if not _look_again(obj):  # closed on nothing where it was believed, and not seen there: gone
+            belief = getattr(current_robot(), "belief", None)
+            if belief is not None:
+                belief.lost(obj)
             raise ObjectNotVisible(
                 f"the {gripper} gripper closed on nothing: {obj.name} is no longer at {_xyz(planned)}", obj, "lost"
             )
@@ -313,7 +313,7 @@ def picking_up(designator: ActionDesignator) -> Held:
                     continue
                 tried += 1
                 try:
-                    held = attempt(
+                    held: Held = attempt(
                         f"grasp {obj.name} from {_pose_text(location)} with the {location.arm} arm "
                         f"({location.grasp} grasp)",
                         partial(_grasp_from, location, obj, grasp),
@@ -420,7 +420,7 @@ def _drive_watching(location: Any, held: Held) -> None:
     """Drive to `location`; raise `ObjectSlipped` as soon as the gripper is measured empty."""
     fluent = opening_fluent(held.gripper)
     dropped = fluent < held.held_opening
-    errors: list = []
+    errors: list[BaseException] = []
 
     def watch() -> None:
         dropped.wait_for()
@@ -486,7 +486,7 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                     if pose_number > PLACE_STANDING_POSES:
                         break
                     try:
-                        return attempt(
+                        placed: PerceivedObject = attempt(
                             f"place {held.object.name} at {_xyz(spot)} from {_pose_text(location)}",
                             partial(_place_at, location, held, spot, point),
                         )
@@ -501,6 +501,8 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                                 designator,
                                 attempts=attempts,
                             ) from error
+                    else:
+                        return placed
             except NoSolutionError as error:
                 attempts.append(f"at {_xyz(spot)}: {error}")
                 last = error

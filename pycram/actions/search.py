@@ -217,6 +217,8 @@ def _look_around(
     """Look at each place within `look_range` of `here`; stop at the first match of a
     `description` (None: look at every place and return everything seen)."""
     environment = belief.environment
+    if environment is None:
+        raise ValueError("looking around needs a belief with an environment description")
     seen: list[PerceivedObject] = []
     for lookout in places:
         target = _target(lookout, environment, belief)
@@ -288,16 +290,16 @@ def search_for(
     skipped: dict[str, str] = {}
     close: set[str] = set()
     # 1. look around from where it stands
-    found = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
-    if found:
-        return found[0]
+    around = _look_around(description, places, (here.x, here.y), belief, look_range, looked, close)
+    if around:
+        return around[0]
 
     # 2. visit the likely places, nearest first -- those behind a closed door or drawer last
     #    (opening is slow, and an opened drawer stands in the way)
-    def closed_first_last(lookout: Lookout) -> bool:
+    def closed_last(lookout: Lookout) -> bool:
         return lookout.container is not None and belief.container_open(lookout.container) is not True
 
-    for lookout in sorted(places, key=closed_first_last):
+    for lookout in sorted(places, key=closed_last):
         if lookout.name in close:
             continue
         found = _visit(description, lookout, environment, belief, open_container, looked, skipped)

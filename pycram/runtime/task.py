@@ -19,7 +19,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from enum import Enum
-from typing import Any, Protocol
+from typing import Any, ParamSpec, Protocol, TypeVar, overload
 
 import pycram.fluent as _fluent  # imported as a module: pycram.fluent imports this package
 from pycram.runtime.clock import current_clock
@@ -33,6 +33,9 @@ from pycram.runtime.evaporation import (
     wait_until,
 )
 from pycram.runtime.workers import submit
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 __all__ = [
     "Task",
@@ -406,6 +409,16 @@ def _back_to_plan_code(runner: Runner, in_plan: bool) -> None:
         raise Evaporated()
 
 
+@overload
+def as_task(fn: Callable[_P, _R], *, name: str | None = None, kind: str = "plan") -> Callable[_P, _R]: ...
+
+
+@overload
+def as_task(
+    fn: None = None, *, name: str | None = None, kind: str = "plan"
+) -> Callable[[Callable[_P, _R]], Callable[_P, _R]]: ...
+
+
 def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, kind: str = "plan") -> Any:
     """Decorator: each call of the function runs as a child task named after it (`run_subtask`).
 
@@ -415,12 +428,13 @@ def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, ki
     Returns what the function returns and raises what it raises.
     """
 
-    def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
+    def decorate(function: Callable[_P, _R]) -> Callable[_P, _R]:
         task_name = name or function.__name__
 
         @functools.wraps(function)
-        def run(*args: Any, **kwargs: Any) -> Any:
-            return run_subtask(task_name, function, *args, kind=kind, **kwargs)
+        def run(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+            result: _R = run_subtask(task_name, function, *args, kind=kind, **kwargs)  # type: ignore[arg-type]  # the function's keywords pass through
+            return result
 
         return run
 

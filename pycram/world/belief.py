@@ -354,8 +354,8 @@ class BeliefState(Belief):
             obj.pose_fluent.set_value(obj.pose)
 
     def lost(self, obj: PerceivedObject) -> None:
-        """The robot looked straight at where `obj` was believed and did not see it (its own arm
-        may have hidden the spot from the depth check): believe it gone."""
+        """The robot has evidence that `obj` is not where it was believed (e.g. its gripper
+        closed on nothing there and a look did not see it): believe it gone."""
         with self._update_lock:
             obj.gone = True
 
