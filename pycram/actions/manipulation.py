@@ -50,6 +50,7 @@ from pycram.failures import (
     PlanFailure,
 )
 from pycram.language import State, pursue
+from pycram.locations.targets import KnownObject
 from pycram.robot import current_robot
 from pycram.world.belief import PerceivedObject
 from pycram.world.objects import Grasp, object_type
@@ -150,14 +151,28 @@ def Place(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
 
 
 def executable_grasps(type_name: str, requested: str | None = None) -> list[Grasp]:
-    """The grasps of an object type that picking up executes: the horizontal approaches. Top
-    grasps are left out: the ``reaching`` motion can point the tool down (``grasp='top'``), but
-    a rim grasp (bowls, plates) needs the rim's point and a spoon the object's yaw, which
-    perception does not measure yet."""
-    grasps = [g for g in object_type(type_name).grasps if g.approach != "top"]
+    """The grasps of an object type that picking up can execute with the active robot: the
+    horizontal approaches, and ``top`` when its ``reaching`` motion takes a tool orientation
+    (then the tool follows the poses location reasoning validated)."""
+    types = getattr(current_robot(), "motion_types", None) or {}
+    reaching = types.get("reaching")
+    top_ok = reaching is not None and any(k.name == "orientation" for k in reaching.all_keys())
+    grasps = [g for g in object_type(type_name).grasps if top_ok or g.approach != "top"]
     if requested is not None:
         grasps = [g for g in grasps if g.approach == requested]
     return grasps
+
+
+def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None) -> None:
+    """Reach phase `phase` of a sequence: the `index`-th validated tool pose of `location` when
+    it has them (top grasps: the tool's orientation matters), else `point` with the phase's
+    offset along the base's heading."""
+    poses = getattr(location, "tool_poses", ())
+    if location.grasp == "top" and len(poses) > index:
+        position, orientation = poses[index]
+        motion(type="reaching", arm=arm, target=list(position), orientation=list(orientation), phase=phase)
+    else:
+        motion(type="reaching", arm=arm, target=point, phase=phase)
 
 
 def believed_object(action: str, wanted: Any) -> PerceivedObject:
@@ -208,12 +223,19 @@ class _ObjectMoved(PlanFailure):
     default_reason = "object_moved"
 
 
-def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None) -> None:
+def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None, location: Any = None) -> None:
     """Best effort after a failed grasp: open the gripper, back off, arm up for driving."""
+
+    def retreat() -> None:
+        if location is not None and location.grasp == "top":
+            _reach(arm, location, 0, "pre_grasp", point)  # straight up, as it came
+        elif point:
+            motion(type="reaching", arm=arm, target=point, phase="retreat")
+
     best_effort(
         "clean-up after a failed grasp",
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
-        lambda: point and motion(type="reaching", arm=arm, target=point, phase="retreat"),
+        retreat,
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
     )
 
@@ -243,15 +265,15 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
     point = _grasp_point(obj, grasp)
     try:
-        motion(type="reaching", arm=arm, target=point, phase="pre_grasp")
-        motion(type="reaching", arm=arm, target=point, phase="grasp")
+        _reach(arm, location, 0, "pre_grasp", point)
+        _reach(arm, location, 1, "grasp", point)
         opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
     except RECOVERABLE:
-        _let_go_and_retract(arm, gripper, point)
+        _let_go_and_retract(arm, gripper, point, location)
         raise
     held = Held(obj, arm, gripper, grasp)
     if opening < held.held_opening:
-        _let_go_and_retract(arm, gripper, point)
+        _let_go_and_retract(arm, gripper, point, location)
         if not _look_again(obj):  # closed on nothing where it was believed, and not seen there: gone
             belief = getattr(current_robot(), "belief", None)
             if belief is not None:
@@ -262,7 +284,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         raise GraspFailed(
             f"the {gripper} gripper closed on nothing at {_xyz(point)} (opening {opening * 1000:.1f} mm)", obj
         )
-    motion(type="reaching", arm=arm, target=point, phase="lift")
+    _reach(arm, location, 2, "lift", point)
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     opening = gripper_opening(gripper)
     if opening < held.held_opening:
@@ -290,8 +312,8 @@ def picking_up(designator: ActionDesignator) -> Held:
         available = [g.approach for g in object_type(obj.type).grasps]
         raise GraspFailed(
             f"the robot cannot execute a grasp {requested_grasp or ''} of a {obj.type} "
-            f"(its grasps: {', '.join(available)}; the reaching motion approaches "
-            f"horizontally only)",
+            f"(its grasps: {', '.join(available)}; from the top only when the robot's reaching "
+            f"motion takes a tool orientation)",
             designator,
             "no_executable_grasp",
         )
@@ -431,15 +453,25 @@ def _drive_watching(location: Any, held: Held) -> None:
         raise errors[0] if errors else PlanFailure("driving with the object did not succeed")
 
 
+def _place_locations(held: Held, spot: tuple[float, float, float], point: list[float]) -> LocationDesignator:
+    """Standing poses to put the held object at `spot`: for an object held from the top, the
+    place sequence of that top grasp for the object standing at the spot (the tool keeps
+    pointing down); else the tool point `point`, approached along the base's heading."""
+    if held.grasp.approach == "top":
+        standing = KnownObject(f"{held.object.name} at the spot", held.object.type, spot)
+        return LocationDesignator([("to_reach", standing), ("arm", held.arm), ("grasp", "top"), ("action", "place")])
+    return LocationDesignator([("to_reach", tuple(point)), ("arm", held.arm), ("action", "place")])
+
+
 def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
     arm, gripper, obj = held.arm, held.gripper, held.object
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:
         raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)
-    motion(type="reaching", arm=arm, target=point, phase="pre_place")
+    _reach(arm, location, 0, "pre_place", point)
     try:
-        motion(type="reaching", arm=arm, target=point, phase="place")
+        _reach(arm, location, 1, "place", point)
     except RECOVERABLE as error:
         if getattr(unwrap(error), "reason", None) != "blocked":
             raise
@@ -450,7 +482,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     if belief is not None:
         belief.put_down(obj, spot)
     try:
-        motion(type="reaching", arm=arm, target=point, phase="retreat")
+        _reach(arm, location, 2, "retreat", point)
     except RECOVERABLE as error:  # the object is down: backing off is best effort
         log.info("placing %s: retreat: %s", obj.name, unwrap(error))
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
@@ -480,7 +512,7 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                 break
             spot = tuple(float(v) for v in spot)
             point = [spot[0], spot[1], spot[2] - half + held.grasp.height]
-            locations = LocationDesignator([("to_reach", tuple(point)), ("arm", held.arm), ("action", "place")])
+            locations = _place_locations(held, spot, point)
             try:
                 for pose_number, location in enumerate(solutions(locations), start=1):
                     if pose_number > PLACE_STANDING_POSES:

@@ -258,6 +258,8 @@ class LocationReasoner:
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
                 point = self._grasp_point(target, grasp)
+                if grasp.approach == "top":
+                    point, heading = self._top_grasp(target, grasp, x, y)
                 poses = grasp_sequence(
                     self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
                 )
@@ -268,7 +270,8 @@ class LocationReasoner:
                 answer = prosp.reachable(arm, poses, (x, y, yaw), raised)
                 if answer:
                     joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
-                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints), None
+                    tool = tuple(p for i, p in enumerate(poses) if not (margin and i == 2))
+                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints, tool_poses=tool), None
                 failure = (f"unreachable for arm {arm!r}", answer.reason)
             return None, failure or ("no fitting grasp", None)
 
@@ -297,6 +300,24 @@ class LocationReasoner:
         if target.type is None:
             return (x, y, z)
         return (x, y, z - target.type.half_height + grasp.height)
+
+    @staticmethod
+    def _top_grasp(target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
+        """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at
+        (x, y): a rim (``radius``) is taken at its point nearest the base, the fingers closing
+        across the wall; otherwise at the centre, the fingers closing across the object's
+        ``across`` axis. The tool points down; its fingers open along heading + 90 deg."""
+        cx, cy, cz = target.position
+        half = target.type.half_height if target.type is not None else 0.0
+        z = cz - half + grasp.height
+        if grasp.radius > 0.0:
+            toward = math.atan2(y - cy, x - cx)
+            point = (cx + grasp.radius * math.cos(toward), cy + grasp.radius * math.sin(toward), z)
+            fingers = toward
+        else:
+            point = (cx, cy, z)
+            fingers = target.yaw + (math.pi / 2 if grasp.across == "y" else 0.0)
+        return point, _wrap(fingers - math.pi / 2)
 
     @staticmethod
     def _grasp_heading(grasp: Grasp, target: Target) -> float | None:

@@ -16,7 +16,8 @@ class BaseLocation:
     say which arm and which grasp (approach, see `pycram.world.objects.APPROACHES`) the
     solution was validated for (None where they do not apply); `joints` the arm's joint
     solutions of the validated sequence; `cost` its rank in the costmap (lower is better);
-    `visible` the fraction of the target the head camera sees (``to_see``).
+    `visible` the fraction of the target the head camera sees (``to_see``); `tool_poses` the
+    validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order.
     """
 
     x: float
@@ -27,6 +28,7 @@ class BaseLocation:
     cost: float = 0.0
     visible: float | None = None
     joints: tuple = field(default=(), repr=False, compare=False)
+    tool_poses: tuple = field(default=(), repr=False, compare=False)
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))

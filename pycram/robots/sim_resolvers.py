@@ -288,9 +288,15 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
             arm = physical_arm(d, desig.prop_value("arm"))
             phase = desig.prop_value("phase")
             target = _point(desig.prop_value("target"))
-            position, orientation = approach_target(
-                d, world.base_pose.get_value(), target, phase, desig.prop_value("grasp")
-            )
+            explicit = desig.prop_value("orientation")
+            if explicit is not None:
+                if len(explicit) != 4:
+                    raise ValueError(f"reaching: orientation must be a quaternion (w, x, y, z), got {explicit!r}")
+                position, orientation = target, tuple(float(v) for v in explicit)
+            else:
+                position, orientation = approach_target(
+                    d, world.base_pose.get_value(), target, phase, desig.prop_value("grasp")
+                )
             tolerance = d.REACH_TOLERANCE.get(phase, d.REACH_TOLERANCE["default"])
             solutions.append(
                 desig.make_dictionary(

@@ -137,6 +137,13 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                     required=False,
                     choices=REACH_GRASPS,
                 ),
+                MotionKey(
+                    "orientation",
+                    "the tool's orientation (w, x, y, z) [map]: then `target` is the tool's position "
+                    "itself (no phase offset; the phase sets only the tolerance)",
+                    form="numbers",
+                    required=False,
+                ),
             ),
         ),
         MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)", (fluent,)),

@@ -33,8 +33,17 @@ from pycram.world.objects import object_type  # noqa: E402
 T = 60.0
 #: (robot, seed, object): scenes of `random_scene(apartment, ["cup", "milk", "bowl"], seed)` with
 #: the object on the counter (0.22 m deep: seed 3; milk, a directional grasp: seed 13) or the
-#: table (seed 9).
-GRASPS = [("pr2", 3, "cup"), ("pr2", 9, "cup"), ("pr2", 13, "milk"), ("tiago", 9, "cup"), ("tiago", 13, "milk")]
+#: table (seed 9); the bowl, grasped at its rim from the top, on the counter (seeds 5, 8).
+GRASPS = [
+    ("pr2", 3, "cup"),
+    ("pr2", 9, "cup"),
+    ("pr2", 13, "milk"),
+    ("tiago", 9, "cup"),
+    ("tiago", 13, "milk"),
+    ("pr2", 5, "bowl"),
+    ("pr2", 8, "bowl"),
+    ("tiago", 8, "bowl"),
+]
 
 
 def motion(**properties):
@@ -80,11 +89,21 @@ def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, nam
             grasp = next(g for g in otype.grasps if g.approach == location.grasp)
             x, y, z = target.position
             point = (x, y, z - otype.half_height + grasp.height)
-            motion(type="reaching", arm=location.arm, target=point, phase="pre_grasp")
-            motion(type="reaching", arm=location.arm, target=point, phase="grasp")
-            motion(type="setting_gripper", gripper=gripper, position=0)
-            assert world.gripper_states[gripper].get_value().holding == name
-            motion(type="reaching", arm=location.arm, target=point, phase="lift")
+            for index, phase in enumerate(("pre_grasp", "grasp", "lift")):
+                if phase == "lift":
+                    motion(type="setting_gripper", gripper=gripper, position=0)
+                    assert world.gripper_states[gripper].get_value().holding == name
+                if location.grasp == "top":  # the tool follows the validated poses, pointing down
+                    position, orientation = location.tool_poses[index]
+                    motion(
+                        type="reaching",
+                        arm=location.arm,
+                        target=list(position),
+                        orientation=list(orientation),
+                        phase=phase,
+                    )
+                else:
+                    motion(type="reaching", arm=location.arm, target=point, phase=phase)
             assert world.item_poses.get_value()[name].position[2] > z + 0.05
     finally:
         robot.shutdown()
