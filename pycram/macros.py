@@ -76,6 +76,7 @@ import sys
 import tokenize
 import traceback
 import types
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -1142,7 +1143,9 @@ def opts_in(source: str) -> bool:
     if "pycram" not in source:
         return False
     try:
-        tree = ast.parse(source)
+        with warnings.catch_warnings():  # only sniffing: the module's own compile warns, if at all
+            warnings.simplefilter("ignore")
+            tree = ast.parse(source)
     except SyntaxError:
         return False  # let the regular loader report it
     stack: list[ast.stmt] = list(tree.body)
