@@ -1,7 +1,7 @@
 """Opening and closing drawers: grasp the handle, pull (or push) it along the drawer's slide.
 
-`Open("drawer 2")`: ``('to_open', container)`` chooses where to stand and which arm (when no
-standing pose is found with the torso up, the torso is lowered and the reasoning asked again).
+`Open("drawer 2")`: ``('to_open', container)`` chooses where to stand, which arm and -- for a
+handle too low or too high for the torso as it is -- the torso height.
 One attempt drives there, looks at the handle (perception measures how far the drawer is open),
 grasps the handle (fingers closing vertically on its horizontal bar), pulls it along the opening
 trajectory in steps, lets go, backs off and looks again: the drawer must be measured open (within
@@ -110,7 +110,10 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
 def _measure(belief: Any, container: Any) -> float | None:
     """Look at the handle; the opening [m] perception measured (None when it could not)."""
     q = belief.container_states.get(container.name, 0.0)
-    motion(type="pointing_head", coordinates=list(container.handle_position(q)))
+    # standing close, the head may not turn all the way: it looks as near as it can
+    best_effort(
+        "looking at a handle", lambda: motion(type="pointing_head", coordinates=list(container.handle_position(q)))
+    )
     motion(type="detecting")
     measured = belief.container_states.get(container.name)
     return None if measured is None else float(measured)
@@ -125,6 +128,8 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
         motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     except RECOVERABLE as error:  # e.g. close to the furniture after a failed attempt
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
+    if location.torso is not None:  # the handle is too low or too high for the torso as it was
+        motion(type="setting_torso", position=location.torso)
     here = base_pose_fluent().get_value()
     if (
         here is None
@@ -192,8 +197,8 @@ _opened_from: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDi
 
 
 def _standing_poses(container: Any, arm: str | None, travel: float, closing: bool = False) -> Any:
-    """Solutions of ``('to_open', container)`` for a travel of `travel` [m]; with the torso
-    lowered when there is none with it up. For closing, the pose the drawer was opened from
+    """Solutions of ``('to_open', container)`` for a travel of `travel` [m] (a solution may
+    need another torso height: `_move_handle` sets it). For closing, the pose the drawer was opened from
     comes first (the reasoning checks the slide against the drawer as it is: open, in the way)."""
     remembered = _opened_from.get(current_robot(), {}).get(container.name)
     if closing and remembered is not None and (arm is None or remembered.arm == arm):
@@ -205,12 +210,6 @@ def _standing_poses(container: Any, arm: str | None, travel: float, closing: boo
     properties: list[tuple[str, Any]] = [("to_open", container.name), ("opening", travel)]
     if arm is not None:
         properties.append(("arm", arm))
-    try:
-        yield from solutions(LocationDesignator(properties))
-        return
-    except RECOVERABLE as error:
-        log.info("%s: no standing pose with the torso as it is (%s); lowering it", container.name, error)
-    motion(type="setting_torso", position="down")
     yield from solutions(LocationDesignator(properties))
 
 

@@ -459,14 +459,31 @@ class LocationReasoner:
                 grip, hold = _quat_yaw(headings[0]), None
             poses = [((hx - c0 * back, hy - s0 * back, hz), grip), (trajectory[0], grip)]
             poses += [(p, hold) for p in trajectory[1:]]
+            handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
             answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
             if answer:
-                handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
                 return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions), None
+            # a handle too low or too high for the torso as it is: another named torso height
+            for torso, height in self._other_torso_heights():
+                configuration = {**self.geometry.tucked, self.geometry.torso_joint: height}
+                if prosp.in_collision((x, y, yaw), configuration):
+                    continue
+                other = prosp.reachable(arm, poses, (x, y, yaw), configuration)
+                if other:
+                    return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=other.solutions, torso=torso), None
             return None, (f"unreachable for arm {arm!r}", answer.reason)
 
         target = Target(container.handle, "container", container.name, thing=container)
         return self._search(desig, heapq.merge(*streams), validate, "to_open", target, maps)
+
+    def _other_torso_heights(self) -> list[tuple[str, float]]:
+        """The robot's named torso heights other than the one it has now, nearest first."""
+        joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
+        if joint is None or not named:
+            return []
+        now = self.prospection().joint_position(joint) if hasattr(self.prospection(), "joint_position") else None
+        options = [(name, h) for name, h in named.items() if now is None or abs(h - now) > 0.01]
+        return sorted(options, key=lambda o: 0.0 if now is None else abs(o[1] - now))
 
     @staticmethod
     def _pull_heading(container: Container, q: float) -> float:

@@ -29,7 +29,8 @@ class RobotGeometry:
     `ready` per arm: the configuration the arm is raised to before it approaches (``carry``: over
     the furniture), joint name -> position. `contact_margin` [m]: how far below a grasp pose the
     arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
-    pass through configurations IK did not check).
+    pass through configurations IK did not check). `torso_joint` and `torso_positions` (name ->
+    height [m]): the torso lift, for solutions that need another torso height.
     """
 
     name: str
@@ -44,6 +45,8 @@ class RobotGeometry:
     arm_joints: Mapping[str, tuple[str, ...]]
     ready: Mapping[str, Mapping[str, float]] = None  # type: ignore[assignment]
     contact_margin: float = 0.0
+    torso_joint: str | None = None
+    torso_positions: Mapping[str, float] = None  # type: ignore[assignment]
 
     @classmethod
     def from_description(cls, d: Any) -> RobotGeometry:
@@ -71,6 +74,8 @@ class RobotGeometry:
                 if "carry" in d.ARM_CONFIGURATIONS[a]
             },
             contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)),
+            torso_joint=getattr(d, "TORSO", {}).get("joint"),
+            torso_positions={k: float(v) for k, v in getattr(d, "TORSO_POSITIONS", {}).items()},
         )
 
     def arm(self, name: Any) -> str:

@@ -17,7 +17,8 @@ class BaseLocation:
     solution was validated for (None where they do not apply); `joints` the arm's joint
     solutions of the validated sequence; `cost` its rank in the costmap (lower is better);
     `visible` the fraction of the target the head camera sees (``to_see``); `tool_poses` the
-    validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order.
+    validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order;
+    `torso` the named torso position the solution needs (None: the torso as it is).
     """
 
     x: float
@@ -29,6 +30,7 @@ class BaseLocation:
     visible: float | None = None
     joints: tuple = field(default=(), repr=False, compare=False)
     tool_poses: tuple = field(default=(), repr=False, compare=False)
+    torso: str | None = None
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))
