@@ -23,7 +23,10 @@ blocked), lets go, retreats, and looks: the object must be seen within
 slipping out raises `ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
 
-Every attempt is a task of its own (kind ``attempt``), so the task tree shows each recovery.
+Top grasps (bowls and plates, by the rim) follow the tool poses location reasoning validated,
+the tool pointing down; an object held from the top is put down with the same grasp's place
+sequence. Every attempt is a task of its own (kind ``attempt``), so the task tree shows each
+recovery.
 """
 
 from __future__ import annotations
