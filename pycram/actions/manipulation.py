@@ -42,6 +42,7 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
+from pycram.designators.perform import perform
 from pycram.failures import (
     GraspFailed,
     GripperEmpty,
@@ -102,6 +103,9 @@ MOVED = 0.03
 #: poses per spot.
 PLACE_SPOTS = 8
 PLACE_STANDING_POSES = 2
+#: Picking from a drawer that is not far enough out: it is pulled to this much [m] short of its
+#: slide's end.
+WIDE_MARGIN = 0.03
 #: A surface named as a placing target: spots near the side facing the robot, this far in [m].
 NEAR_SIDE_INSET = 0.15
 #: A placed object must be seen this close [m] (horizontally) to its spot.
@@ -196,8 +200,6 @@ def believed_object(action: str, wanted: Any) -> PerceivedObject:
 
 def _search(description: ObjectDesignator) -> PerceivedObject:
     """`search_for`, opening closed drawers with the `Open` action."""
-    from pycram.designators.perform import perform
-
     from .containers import Open
 
     found: PerceivedObject = search_for(description, open_container=lambda name: perform(Open(name)))
@@ -304,6 +306,39 @@ def _xyz(p: Any) -> str:
 
 @action_plan("picking_up")
 def picking_up(designator: ActionDesignator) -> Held:
+    try:
+        return _pick_up(designator)
+    except ObjectOutOfReach:
+        # in a drawer pulled out only part of the way, the object may still be under the furniture
+        obj = believed_object("picking_up", designator.prop_value("object"))
+        wider = _wider_opening(obj)
+        if wider is None:
+            raise
+        from .containers import Open
+
+        log.info("%s is out of reach in %s: opening it further", obj.name, obj.properties["in"])
+        perform(Open(obj.properties["in"], opening=wider))
+        _look_again(obj)
+        return _pick_up(designator)
+
+
+def _wider_opening(obj: PerceivedObject) -> float | None:
+    """How far to pull out the drawer `obj` lies in so that it comes out from under the
+    furniture (near the slide's end); None when it is in no drawer or the drawer is that far out."""
+    name = obj.properties.get("in")
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if not name or environment is None:
+        return None
+    container = environment.container(name)
+    if container.kind != "drawer":
+        return None
+    wide = container.limits[1] - WIDE_MARGIN
+    now = belief.container_states.get(name, 0.0)
+    return wide if now < wide - WIDE_MARGIN else None
+
+
+def _pick_up(designator: ActionDesignator) -> Held:
     wanted = designator.prop_value("object")
     if wanted is None:
         raise ActionParameterError("picking_up", "object", "missing: what to pick up")

@@ -41,7 +41,7 @@ import heapq
 import logging
 import math
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -165,7 +165,9 @@ class LocationReasoner:
 
     `environment()` returns the environment's description, `prospection()` the robot's
     `Prospection` in the current world, `known_objects()` the objects believed to be around
-    (`KnownObject`s; used for free spots and to look up targets by name). All are called at
+    (`KnownObject`s; used for free spots and to look up targets by name), `container_states()`
+    how far each container is believed open (``to_open`` moves the handle on from there). All are
+    called at
     resolution time, so answers reflect the world as it is then. `last_costmaps` holds the
     costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
     """
@@ -177,11 +179,14 @@ class LocationReasoner:
         prospection: Callable[[], Any],
         known_objects: Callable[[], Sequence[KnownObject]] = lambda: (),
         max_candidates: int = MAX_CANDIDATES,
+        container_states: Callable[[], Mapping[str, float]] = dict,
     ) -> None:
         self.geometry = geometry
         self.environment = environment
         self.prospection = prospection
         self.known_objects = known_objects
+        #: How far each container is believed open [m or rad] (perceived; missing: closed).
+        self.container_states = container_states
         self.max_candidates = max_candidates
 
     @property
@@ -222,7 +227,7 @@ class LocationReasoner:
         grasps = self._grasps(target, desig.prop_value("grasp"))
         env = self.environment()
         grid = FloorGrid.of(env)
-        occupancy = occupancy_layer(env, grid, self._base_radius)
+        occupancy = occupancy_layer(env, grid, self._base_radius, self._open_drawers(env))
         facing = self._facing_yaws(env, target)
         streams = []
         maps = {}
@@ -412,7 +417,10 @@ class LocationReasoner:
         )
         if not lo <= opening <= hi:
             raise ValueError(f"opening {opening} of {container.name!r} is outside its limits {container.limits}")
-        steps = [opening * k / 3 for k in range(4)]
+        # from where the handle is believed to be now (a drawer already partly open moves on
+        # from there, or back to `opening`)
+        start = float(self.container_states().get(container.name, 0.0))
+        steps = [start + (opening - start) * k / 3 for k in range(4)]
         trajectory = [container.handle_position(q) for q in steps]
         headings = [self._pull_heading(container, q) for q in steps]
         arms = self._arms(desig.prop_value("arm"))
@@ -493,6 +501,17 @@ class LocationReasoner:
             a = container.hinge_sign * q
             dx, dy = math.cos(a) * dx - math.sin(a) * dy, math.sin(a) * dx + math.cos(a) * dy
         return math.atan2(-dy, -dx)
+
+    def _open_drawers(self, env: Environment) -> list[tuple[float, float, float, float]]:
+        """Floor rectangles of the drawers believed open (where they stick out now)."""
+        rects: list[tuple[float, float, float, float]] = []
+        for name, q in self.container_states().items():
+            if abs(q) > 0.01:
+                try:
+                    rects += self._swept_rects(env.container(name), float(q))
+                except KeyError:
+                    continue
+        return rects
 
     @staticmethod
     def _swept_rects(container: Container, opening: float) -> list[tuple[float, float, float, float]]:

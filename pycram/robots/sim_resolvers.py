@@ -467,6 +467,7 @@ def make_location_generator(world: Any, description: Any, belief: Any) -> Callab
         lambda: world.environment,
         prospection,
         lambda: known_objects_of(belief),
+        container_states=lambda: dict(getattr(belief, "container_states", {})),
     )
 
     def locations(desig: Any) -> Any:
