@@ -204,7 +204,7 @@ class _BlockUse(BlockForm):
 
 
 def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
-    with task_scope(name, "seq", plan_code=False) as scope:
+    with task_scope(name, "seq") as scope:
         result = None
         for index, fn in enumerate(fns):
             try:
@@ -221,7 +221,7 @@ def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> N
 
 
 def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
-    with task_scope(name, "try_in_order", plan_code=False) as scope:
+    with task_scope(name, "try_in_order") as scope:
         for index, fn in enumerate(fns):
             try:
                 label, location = _label(fn, index)
@@ -251,8 +251,11 @@ class RetryRequested(BaseException):
 class _Concurrent:
     """Shared engine of par, try_all and pursue: outcome rules differ, guarantees do not."""
 
-    def __init__(self, kind: str, errors: list, state: Fluent) -> None:
+    def __init__(
+        self, kind: str, errors: list, state: Fluent, branch_ended: Callable[[int, Task], None] | None = None
+    ) -> None:
         self.kind = kind
+        self.branch_ended = branch_ended  # called with (index, task) as each branch ends
         self.errors = errors
         self.state = state
         self.outcome: State | None = None
@@ -267,6 +270,8 @@ class _Concurrent:
     def on_end(self, task: Task) -> None:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
         status = task.status.get_value()
+        if self.branch_ended is not None:
+            self.branch_ended(self.group.tasks.index(task), task)
         if status is TaskStatus.FAILED:
             if isinstance(task.exception, RetryRequested):
                 self.retry = self.retry or task.exception
@@ -332,10 +337,16 @@ class _Concurrent:
         return in_time
 
 
-def _concurrent_runner(kind: str) -> Callable[[Sequence[Branch], list, Fluent, str], None]:
-    def run(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
-        engine = _Concurrent(kind, errors, state)
-        with task_scope(name, kind, plan_code=False) as scope:
+def _concurrent_runner(kind: str) -> Callable[..., None]:
+    def run(
+        fns: Sequence[Branch],
+        errors: list,
+        state: Fluent,
+        name: str,
+        branch_ended: Callable[[int, Task], None] | None = None,
+    ) -> None:
+        engine = _Concurrent(kind, errors, state, branch_ended)
+        with task_scope(name, kind) as scope:
             if not fns:
                 engine._decide(State.SUCCEEDED if kind in ("par", "pursue") else State.FAILED)
             else:
@@ -442,7 +453,7 @@ def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: s
     label = name or f"with_timeout({seconds:g} s)"
     state = StateFluent(name=label)
     engine = _Concurrent("pursue", errors, state)
-    with task_scope(label, "with_timeout", plan_code=False) as scope:
+    with task_scope(label, "with_timeout") as scope:
         if not engine.run([fn], label, deadline=seconds):
             error = TimeoutError(f"{label}: {getattr(fn, '__name__', 'body')} did not end within {seconds:g} s")
             errors.append(error)
@@ -478,7 +489,7 @@ def _run_failure_handling(body: Branch, max_retries: int, name: str | None) -> A
         current_task().info["retry_handler"] = handler
         return body()
 
-    with task_scope(name or "failure_handling", "failure_handling", plan_code=False) as scope:
+    with task_scope(name or "failure_handling", "failure_handling") as scope:
         number = 0
         while True:
             number += 1

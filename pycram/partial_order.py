@@ -23,7 +23,8 @@ from collections.abc import Hashable, Iterable, Mapping, Sequence
 from typing import Any
 
 from pycram.fluent import Fluent
-from pycram.language import Branch, _BlockUse, par
+from pycram.language import Branch, StateFluent, _BlockUse, par
+from pycram.runtime.task import Task, TaskStatus
 
 __all__ = ["partial_order"]
 
@@ -117,26 +118,30 @@ def partial_order(
         )
     ended = [Fluent(name=f"{label}: step {labels[i]} ended") for i in range(len(fns))]
 
+    def branch_ended(index: int, task: Task) -> None:
+        # runtime bookkeeping (the branch's thread, after its code): no evaporation lands here.
+        # Succeeded, or evaporated from outside: the later steps may go. Failed: par evaporates
+        # the waiting steps, which must not start meanwhile.
+        if task.status.get_value() is not TaskStatus.FAILED:
+            ended[index].set_value(True)
+
     def constrained(index: int) -> Branch:
         fn = fns[index]
 
         def step() -> Any:
-            failed = False
-            try:
-                for prev in sorted(after[index]):
-                    ended[prev].wait_for()
-                for fluent in fluents[index]:
-                    fluent.wait_for()
-                return fn()
-            except Exception:
-                failed = True  # par evaporates the waiting steps: they must not start meanwhile
-                raise
-            finally:
-                if not failed:  # succeeded, or evaporated from outside: the later steps may go
-                    ended[index].set_value(True)
+            for prev in sorted(after[index]):
+                ended[prev].wait_for()
+            for fluent in fluents[index]:
+                fluent.wait_for()
+            return fn()
 
         given = getattr(fn, "__pycram_name__", None) or getattr(fn, "__name__", None)
         step.__pycram_name__ = labels[index] if keys or not given or given == "<lambda>" else given  # type: ignore[attr-defined]
         return step
 
-    return par(*(constrained(i) for i in range(len(fns))), errors=errors, state=state, name=label)
+    if state is None:
+        state = StateFluent(name=label)
+    par._run(
+        [constrained(i) for i in range(len(fns))], errors if errors is not None else [], state, label, branch_ended
+    )
+    return state

@@ -27,7 +27,7 @@ from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.runtime.evaporation import Evaporated
-from pycram.runtime.task import Task, current_task, task_scope
+from pycram.runtime.task import Task, current_task, run_subtask
 from pycram.runtime.task_variables import TaskVariable
 
 __all__ = ["Tags", "with_tags", "tag", "find_task", "find_tasks"]
@@ -115,18 +115,21 @@ def _tagged(name: str, fn: Callable[[], Any], tags: Tags | None) -> Callable[[],
             if registry is not None:
                 registry.register(name, here)
             return fn()
-        scope = task_scope(name, "tag")
-        task = scope.task
-        task.info["tag"] = name
-        if registry is not None:
-            registry.register(name, task)
+        started: list[Task] = []
+
+        def tagged_body() -> Any:
+            task = current_task()
+            started.append(task)
+            task.info["tag"] = name
+            if registry is not None:
+                registry.register(name, task)
+            return fn()
+
         try:
-            with scope:
-                task.result = fn()
-                return task.result
+            return run_subtask(name, tagged_body, kind="tag")
         except Evaporated:
-            parent = task.parent
-            if task.evaporating and parent is not None and not parent.evaporating:
+            task = started[0] if started else None
+            if task is not None and task.evaporating and not here.evaporating:
                 return None  # only the tagged task was evaporated: the code around it goes on
             raise
 

@@ -358,7 +358,7 @@ def run_subtask(
     task._start(runner)
     runner.task = task
     try:
-        runner.in_plan = True
+        _enter_plan_code(runner)
         result = fn(*args, **kwargs)
         runner.in_plan = False
         if runner._injected:
@@ -401,12 +401,28 @@ def _leave_plan_code(runner: Runner) -> None:
             pass
 
 
+def _enter_plan_code(runner: Runner) -> None:
+    """Mark the thread as running plan code from here on, where an asynchronous `Evaporated`
+    may land; raise `Evaporated` instead if an evaporation became due while the runtime's
+    bookkeeping held it back (an interrupt finding `in_plan` false injects nothing).
+
+    Atomic with `Runner.interrupt` (both under the runner's lock): an evaporation is either
+    raised here or injected into the plan code, never lost in between, never both."""
+    with runner._lock:
+        if not runner.evaporation_due():
+            runner.in_plan = True
+            return
+        runner._mark_delivered()
+    raise Evaporated()
+
+
 def _back_to_plan_code(runner: Runner, in_plan: bool) -> None:
     """Hand back to the caller; raise `Evaporated` here if an evaporation became due while the
     runtime's bookkeeping held it back (as if it had landed right after the call)."""
-    runner.in_plan = in_plan
-    if in_plan and runner.evaporation_due():
-        raise Evaporated()
+    if in_plan:
+        _enter_plan_code(runner)
+    else:
+        runner.in_plan = False
 
 
 @overload
@@ -442,25 +458,29 @@ def as_task(fn: Callable[..., Any] | None = None, *, name: str | None = None, ki
 
 
 class task_scope:
-    """Run the block as a child task of the current task, in the calling thread.
+    """Run the block as a child task of the current task, in the calling thread (runtime
+    internal: the language's expressions use it for their own bookkeeping).
 
     Usage: `with task_scope("par", "par") as scope: ...; scope.fail(error)`. The task ends
     EVAPORATED if `Evaporated` leaves the block while it is evaporating, FAILED if another
     exception leaves it or `scope.fail()` was called, SUCCEEDED otherwise. Raises `Evaporated`
-    on entry if the caller is evaporating. `plan_code=False` (the language's expressions) says
-    the block is runtime bookkeeping: no asynchronous `Evaporated` lands in it; it is raised
-    after the block instead if it became due meanwhile.
+    on entry if the caller is evaporating. The block is runtime bookkeeping: no asynchronous
+    `Evaporated` lands in it (it is raised after the block instead if it became due
+    meanwhile); plan code inside it runs through `run_subtask`, which marks it as plan code.
+
+    Why not plan code directly in the block: an asynchronous exception can land at the entry
+    of `__exit__` (a Python frame, where the interpreter checks for it) and would leave the
+    task unended for good; `run_subtask` receives it inside its own `try`.
     """
 
-    __slots__ = ("task", "error", "_parent", "_runner", "_in_plan", "_plan_code")
+    __slots__ = ("task", "error", "_parent", "_runner", "_in_plan")
 
-    def __init__(self, name: str, kind: str = "task", *, plan_code: bool = True) -> None:
+    def __init__(self, name: str, kind: str = "task") -> None:
         runner = current_runner()
         parent = runner.task if runner.task is not None else _root_task_for_this_thread(runner)
         if parent._evaporating and not runner._protected:
             raise runner.evaporated()
         self._in_plan, runner.in_plan = runner.in_plan, False  # none in the bookkeeping
-        self._plan_code = plan_code
         self._runner = runner
         self._parent = parent
         self.task = Task(name, kind, parent)
@@ -473,16 +493,10 @@ class task_scope:
     def __enter__(self) -> task_scope:
         self.task._start(self._runner)
         self._runner.task = self.task
-        self._runner.in_plan = self._plan_code
         return self
 
     def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
         task = self.task
-        if self._plan_code:
-            try:
-                _leave_plan_code(self._runner)
-            except Evaporated:
-                pass
         self._runner.task = self._parent
         if exc is None:
             if self.error is None:
@@ -550,9 +564,7 @@ class TaskGroup:
         try:
             try:
                 task._start(runner)
-                if task._evaporating:  # evaporated before this thread got to run it
-                    raise Evaporated()
-                runner.in_plan = True
+                _enter_plan_code(runner)  # raises if evaporated before this thread got to run it
                 result = fn()
                 runner.in_plan = False
                 status = TaskStatus.SUCCEEDED
