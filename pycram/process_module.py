@@ -63,6 +63,7 @@ from pycram.designators.motion_types import active_motion_types, check_motion, d
 from pycram.fluent import Fluent
 from pycram.robot import current_robot, describe_active_robot, gather
 from pycram.runtime import Evaporated, current_clock, no_evaporation, wait_until
+from pycram.runtime.evaporation import call_plan_code, runtime_code
 from pycram.runtime.suspension import on_suspension, retry_after_suspension
 
 __all__ = [
@@ -188,6 +189,7 @@ class Execution:
         assert self.exception is not None
         raise self.exception
 
+    @runtime_code
     def cancel(self) -> None:
         """Stop the execution: leave the queue, or evaporate the running ``_execute`` (the
         module's cancel hook runs). Returns at once; idempotent; no effect once done."""
@@ -323,6 +325,7 @@ class ProcessModule:
     def _resume(self, designator: Any) -> None:
         """Wake-up hook (override; "pause" modules): the executing task was woken up."""
 
+    @runtime_code
     def execute(self, designator: Any) -> Any:
         """Queue ``designator``, wait for its turn, run ``_execute`` and return its result.
 
@@ -349,6 +352,7 @@ class ProcessModule:
             f"execution of {designator!r} on {self.name} was cancelled", designator=designator, module=self
         )
 
+    @runtime_code
     def execute_nowait(self, designator: Any) -> Execution:
         """Queue ``designator`` and return its :class:`Execution` handle at once.
 
@@ -377,6 +381,7 @@ class ProcessModule:
 
     # -- administration ----------------------------------------------------------------------
 
+    @runtime_code
     def shutdown(self) -> None:
         """Take the module offline: queued designators fail with :class:`ProcessModuleOffline`,
         new ones are refused; a running one finishes. Status becomes ``OFFLINE``."""
@@ -398,6 +403,7 @@ class ProcessModule:
                 self.status.set_value(ProcessModuleStatus.OFFLINE)
             self._cond.notify_all()
 
+    @runtime_code
     def start(self) -> None:
         """Bring an offline module back online (status ``WAITING``)."""
         with self._cond:
@@ -407,6 +413,7 @@ class ProcessModule:
             self._cond.notify_all()
 
     @property
+    @runtime_code
     def queue_length(self) -> int:
         """Number of designators waiting (not counting the running one)."""
         with self._cond:
@@ -418,6 +425,7 @@ class ProcessModule:
         return self._current
 
     @property
+    @runtime_code
     def _designators(self) -> list[Any]:
         """Thesis attribute: the designators still to be processed (running one first)."""
         with self._cond:
@@ -440,6 +448,7 @@ class ProcessModule:
             self.queued.set_value(len(self._queue))
         return execution
 
+    @runtime_code
     def _abandon(self, execution: Execution) -> None:
         """Remove a queued ``execution`` whose owner gave up (cancelled, or its task ended)."""
         with self._cond:
@@ -469,6 +478,7 @@ class ProcessModule:
             return True
         return False
 
+    @runtime_code
     def _run(self, execution: Execution) -> None:
         """Wait for the turn of ``execution``, then execute it; records the outcome in it.
 
@@ -488,7 +498,7 @@ class ProcessModule:
                 logger.debug("%s: executing %r", self.name, designator)
                 try:
                     with on_suspension(lambda: self._pause(designator), lambda: self._resume(designator)):
-                        result = self._execute(designator)
+                        result = call_plan_code(self._execute, designator)
                     outcome = ProcessModuleStatus.SUCCEEDED
                 except Exception as e:
                     failure = ProcessModuleFailure(

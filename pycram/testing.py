@@ -19,6 +19,7 @@ from typing import Any
 
 from pycram.process_module import ProcessModule
 from pycram.runtime import wait_until
+from pycram.runtime.evaporation import runtime_code
 
 __all__ = ["ScriptedProcessModule", "CountingGenerator"]
 
@@ -60,6 +61,7 @@ class ScriptedProcessModule(ProcessModule):
 
     # -- test control -------------------------------------------------------------------------
 
+    @runtime_code
     def release(self, n: int = 1) -> None:
         """Let ``n`` more held executions finish."""
         with self._double_cv:
@@ -76,12 +78,17 @@ class ScriptedProcessModule(ProcessModule):
 
     # -- process module -----------------------------------------------------------------------
 
+    # The double's own bookkeeping is runtime code: an evaporation landing inside
+    # `Condition.__enter__` would otherwise leave its lock held.
+
+    @runtime_code
     def _record(self, event: str, designator: Any) -> None:
         with self._double_cv:
             self.log.append((event, designator))
             self._double_cv.notify_all()
 
-    def _execute(self, designator: Any) -> Any:
+    @runtime_code
+    def _record_start(self, designator: Any) -> None:
         with self._double_cv:
             self._active += 1
             self.max_concurrency = max(self.max_concurrency, self._active)
@@ -89,6 +96,14 @@ class ScriptedProcessModule(ProcessModule):
             self.executed.append(designator)
             self.log.append(("start", designator))
             self._double_cv.notify_all()
+
+    @runtime_code
+    def _record_inactive(self) -> None:
+        with self._double_cv:
+            self._active -= 1
+
+    def _execute(self, designator: Any) -> Any:
+        self._record_start(designator)
         try:
             if self.hold:
                 wait_until(self._double_cv, self._take_release)
@@ -104,8 +119,7 @@ class ScriptedProcessModule(ProcessModule):
             self._record("end", designator)
             return result
         finally:
-            with self._double_cv:
-                self._active -= 1
+            self._record_inactive()
 
     def _take_release(self) -> bool:  # predicate under _double_cv: consume one release
         if self._releases > self._consumed:

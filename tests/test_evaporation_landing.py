@@ -24,6 +24,7 @@ from typing import Any
 import pytest
 
 import pycram
+from pycram.designator import MotionDesignator, perform
 from pycram.language import (
     State,
     TaskVariable,
@@ -43,8 +44,10 @@ from pycram.language import (
     with_policy,
     with_timeout,
 )
+from pycram.process_module import ProcessModule, ProcessModuleStatus
 from pycram.runtime import Task, as_task, current_task
 from pycram.runtime.evaporation import _USER, Evaporated, current_runner, shielded
+from pycram.testing import ScriptedProcessModule
 
 MAX_POINTS = 400  # more than any scenario below executes
 
@@ -183,3 +186,31 @@ SCENARIOS: dict[str, Callable[[], Any]] = {
 def test_an_evaporation_landing_anywhere_ends_every_task(scenario: str) -> None:
     points = _assert_every_point(SCENARIOS[scenario])
     assert points > 5  # the scenario really ran through the runtime's bookkeeping
+
+
+@pytest.fixture()
+def scripted_module() -> Any:
+    saved = list(ProcessModule.resolvers), list(MotionDesignator.resolvers)
+    ProcessModule.resolvers.clear()
+    MotionDesignator.resolvers.clear()
+    module = ScriptedProcessModule("landing-test module")
+    ProcessModule.resolvers.append(lambda designator: module)
+    yield module
+    ProcessModule.resolvers[:] = saved[0]
+    MotionDesignator.resolvers[:] = saved[1]
+
+
+@pytest.mark.parametrize("wait", [True, False])
+def test_an_evaporation_landing_anywhere_in_a_process_module_execution_frees_the_module(
+    scripted_module: ScriptedProcessModule, wait: bool
+) -> None:
+    def body() -> None:
+        execution = perform(MotionDesignator([("type", "moving"), ("wait", wait)]))
+        if not wait:
+            execution.wait()
+
+    points = _assert_every_point(body)
+    assert points > 5
+    # the module is free again: a plain execution after all those evaporations goes through
+    perform(MotionDesignator([("type", "moving")]))
+    assert scripted_module.status.get_value() is ProcessModuleStatus.SUCCEEDED

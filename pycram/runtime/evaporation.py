@@ -27,14 +27,18 @@ interrupt it. This module knows tasks only through two attributes: `_evaporating
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, ParamSpec, TypeVar
 
 from pycram.runtime.clock import current_clock
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 __all__ = [
     "Evaporated",
@@ -176,6 +180,21 @@ class Runner:
                 took_back, self._missed = took_back or self._missed, False
         return took_back and self.evaporation_due()
 
+    def enter_plan_code(self) -> None:
+        """Mark the thread as running plan code from here on, where an asynchronous
+        `Evaporated` may land; raise `Evaporated` instead if an evaporation became due while
+        the runtime's bookkeeping held it back (an interrupt finding `in_plan` false injects
+        nothing).
+
+        Atomic with `interrupt` (both under the runner's lock): an evaporation is either raised
+        here or injected into the plan code, never lost in between, never both."""
+        with self._lock:
+            if not self.evaporation_due():
+                self.in_plan = True
+                return
+            self._mark_delivered()
+        raise Evaporated()
+
     def take_back_pending(self) -> None:
         """Cancel an asynchronous `Evaporated` still pending for the calling thread (the runtime
         calls it after setting `in_plan` False, when `_injected` says one may be pending). The
@@ -263,6 +282,50 @@ def install_runner(runner: Runner) -> None:
     with runner._lock:
         runner.ident = threading.get_ident()
     _local.runner = runner
+
+
+def runtime_code(fn: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Decorator: calls of `fn` are runtime bookkeeping, also when plan code makes them (e.g. a
+    process module's queue): no asynchronous `Evaporated` lands inside (one still pending is
+    taken back, or lands at the call); one that became due meanwhile is raised when `fn`
+    returns, as if it had landed right after the call. Waits inside stay evaporable.
+
+    Why: an asynchronous exception landing in bookkeeping — e.g. inside `Condition.__enter__`
+    right after the lock was taken, or at the entry of a `finally` clause's clean-up call —
+    would leave a lock held or a queue entry behind for good."""
+
+    @functools.wraps(fn)
+    def run(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        runner = current_runner()
+        in_plan = runner.in_plan
+        runner.in_plan = False
+        try:
+            if runner._injected:
+                runner.take_back_pending()  # (or it lands right here: as at the call)
+            result = fn(*args, **kwargs)
+        except BaseException:
+            runner.in_plan = in_plan
+            raise
+        if in_plan:
+            runner.enter_plan_code()
+        return result
+
+    return run
+
+
+def call_plan_code(fn: Callable[..., _R], *args: Any, **kwargs: Any) -> _R:
+    """Call `fn` (plan code, e.g. a process module's `_execute`) from runtime code: an
+    asynchronous `Evaporated` may land inside it; one still pending when it ends is taken back
+    (or lands at the end of it, as `fn`'s). Raises `Evaporated` before calling if one is due."""
+    runner = current_runner()
+    in_plan = runner.in_plan
+    runner.enter_plan_code()
+    try:
+        return fn(*args, **kwargs)
+    finally:
+        runner.in_plan = in_plan
+        if runner._injected and not in_plan:
+            runner.take_back_pending()
 
 
 def is_evaporating() -> bool:

@@ -402,18 +402,9 @@ def _leave_plan_code(runner: Runner) -> None:
 
 
 def _enter_plan_code(runner: Runner) -> None:
-    """Mark the thread as running plan code from here on, where an asynchronous `Evaporated`
-    may land; raise `Evaporated` instead if an evaporation became due while the runtime's
-    bookkeeping held it back (an interrupt finding `in_plan` false injects nothing).
-
-    Atomic with `Runner.interrupt` (both under the runner's lock): an evaporation is either
-    raised here or injected into the plan code, never lost in between, never both."""
-    with runner._lock:
-        if not runner.evaporation_due():
-            runner.in_plan = True
-            return
-        runner._mark_delivered()
-    raise Evaporated()
+    """Plan code runs from here on (see `Runner.enter_plan_code`): raises `Evaporated` if one
+    became due while the runtime's bookkeeping held it back."""
+    runner.enter_plan_code()
 
 
 def _back_to_plan_code(runner: Runner, in_plan: bool) -> None:
