@@ -62,8 +62,10 @@ def test_evaporating_a_drive_cancels_the_move_base_goal_and_the_base_stops(pr2_o
         preempted = Fluent(lambda: True if results.get_value() == 2 else None)  # actionlib PREEMPTED
         results.add_child(preempted)
         assert preempted.wait_for(10.0), f"move_base result status {results.get_value()}"
-        # the base comes to rest: after a second of simulated time to brake, it moves less than
-        # 1 cm over the next second
+        # the base comes to rest: within 5 s of simulated time there is a second over which it
+        # moves less than 1 cm (pose and clock arrive on separate topics, published at a wall-time
+        # rate while the simulation runs faster: a pose read right after a clock message can be a
+        # batch old, so no single window is judged)
         assert sim_time.wait_for(10.0)
 
         def after(seconds: float) -> Fluent:
@@ -72,11 +74,15 @@ def test_evaporating_a_drive_cancels_the_move_base_goal_and_the_base_stops(pr2_o
             sim_time.add_child(later)
             return later
 
-        assert after(1.0).wait_for(10.0)
-        stopped_at = robot.state.base_pose.get_value()
-        assert after(1.0).wait_for(10.0)
-        now = robot.state.base_pose.get_value()
-        assert math.hypot(now.x - stopped_at.x, now.y - stopped_at.y) < 0.01
+        movements = []
+        for _ in range(5):
+            before = robot.state.base_pose.get_value()
+            assert after(1.0).wait_for(10.0)
+            now = robot.state.base_pose.get_value()
+            movements.append(math.hypot(now.x - before.x, now.y - before.y))
+            if movements[-1] < 0.01:
+                break
+        assert movements[-1] < 0.01, f"the base still moved after the cancel: {movements} m per second"
         assert math.hypot(now.x - goal[0], now.y - goal[1]) > 0.5  # it stopped on the way
     finally:
         subscription.close()
