@@ -65,10 +65,14 @@ def test_item_at_position_3_fails_two_grasps_then_succeeds(tmp_path):
 
 
 def test_two_thefts_are_recovered(tmp_path):
+    from pycram.demos import kitchen_plan
+
     result = demo(tmp_path, steal=2, seed=3)
     assert result.exit_code == 0, result.message
     assert result.recoveries == 2
     assert result.item_on_cooker_1
+    # the head tracking was suspended (not ended) while the robot asked for help, each time
+    assert kitchen_plan.head_suspensions.get_value() == 2
 
 
 def test_no_item_ends_with_a_clear_failure(tmp_path):

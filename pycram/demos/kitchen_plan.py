@@ -12,7 +12,8 @@ Structure (as in the thesis):
   a `seq` of the task: a `try_in_order` over three positions in front of cooker #2 (each an
   `if True:` group that sets the goal and calls `grab_item()`), a clear failure when no grasp
   succeeded, the transport under `failure_handling` (recovering when the item is taken from the
-  gripper), and `place_item()` on cooker #1.
+  gripper: the robot asks for help with the head tracking suspended, `with_task_suspended`),
+  and `place_item()` on cooker #1.
 
 Where the thesis polled (`while True: ... rospy.sleep(0.1)`), this plan waits on fluent
 networks: `within(0.1).wait_for()` wakes exactly when the robot gets close.
@@ -25,8 +26,8 @@ import math
 
 from pycram.designator import LocationDesignator, MotionDesignator, perform
 from pycram.fluent import Fluent, whenever
-from pycram.language import State, failure_handling, par, plan, retry, seq, try_in_order
-from pycram.runtime import as_task, sleep
+from pycram.language import State, failure_handling, par, plan, retry, seq, try_in_order, with_task_suspended
+from pycram.runtime import as_task, current_task, sleep
 
 log = logging.getLogger("pycram.demo")
 
@@ -64,15 +65,18 @@ r_gripper_state = Fluent(name="r_gripper_state")  # opening of the gripper [m]
 goal = Fluent(name="goal")  # where the base goes next
 look_goal = Fluent(name="look_goal")  # the point the head keeps looking at
 phase = Fluent("initialising", name="phase")  # for people watching the run
+head_tracking = Fluent(name="head tracking")  # the task pointing the head at `look_goal`
+head_suspensions = Fluent(0, name="head suspensions")  # times it was suspended to ask for help
 
 item_lost = r_gripper_state < EMPTY_GRIPPER
 
 
 def forget_state() -> None:
     """Clear goals and phase before a new run in the same process."""
-    for fluent in (goal, look_goal):
+    for fluent in (goal, look_goal, head_tracking):
         fluent.set_value(None)
     phase.set_value("initialising")
+    head_suspensions.set_value(0)
 
 
 def within(tolerance: float) -> Fluent:
@@ -188,6 +192,8 @@ def fetch_and_place() -> None:
     errors = []
     with par(errors) as s:
         with whenever(pose.pulsed()):
+            if head_tracking.get_value() is None:
+                head_tracking.set_value(current_task())  # so that asking for help can suspend it
             if phase.get_value() == "done":
                 return  # the task succeeded: leave the loop, so that the par can end
             if look_goal.get_value() is not None:
@@ -232,6 +238,20 @@ def fetch_and_place() -> None:
         raise errors[0]  # what stopped the task, e.g. NoItemGrasped
 
 
+def ask_for_help(request: str) -> None:
+    """Ask a person for help and wait until it came, with the head tracking suspended meanwhile
+    (CRAM's `with-task-suspended`): the head stops following the look goal while the robot
+    faces the person, and goes on after the wake-up."""
+    tracker = head_tracking.get_value()
+    if tracker is None or tracker.done:
+        motion(type="waiting_for_help", request=request, gripper=GRIPPER)
+        return
+    with with_task_suspended(tracker, timeout=5.0):
+        head_suspensions.set_value(head_suspensions.get_value() + 1)
+        log.info("head tracking suspended while asking for help")
+        motion(type="waiting_for_help", request=request, gripper=GRIPPER)
+
+
 @as_task
 @plan
 def transport() -> None:
@@ -247,7 +267,7 @@ def transport() -> None:
                 log.warning("the item was taken from the gripper: stopping")
                 motion(type="cancelling_movement")
                 motion(type="setting_gripper", gripper=GRIPPER, position=1)
-                motion(type="waiting_for_help", request="Put the item back into the gripper", gripper=GRIPPER)
+                ask_for_help("Put the item back into the gripper")
                 motion(type="setting_gripper", gripper=GRIPPER, position=0)
                 raise ItemLost("the item was taken from the gripper")
             drive.wait()  # the last 10 cm
