@@ -86,7 +86,7 @@ class Fluent:
         self._changes_only = changes_only
         self._name = name
         self._cv: threading.Condition | None = None
-        self._children: list[weakref.ref] = []  # replaced, never shrunk in place (see add_child)
+        self._children: list[weakref.ref[Fluent]] = []  # replaced, never shrunk in place (see add_child)
         self._live = 0  # number of children after the last pruning of dead references
         self._pulses = 0
         self._handle_missed = Behavior.NEVER
