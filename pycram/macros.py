@@ -675,7 +675,7 @@ class _Transformer:
         scope: _Scope,
         where: ast.AST,
         prelude: list[ast.stmt] = (),
-    ) -> ast.FunctionDef:  # type: ignore[assignment]
+    ) -> ast.FunctionDef:
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
         if scope.first_param is not None:
@@ -987,7 +987,7 @@ def plan(fn: F) -> F:
     SyntaxError (with the user's file and line) for misuse of the block forms.
     """
     if isinstance(fn, (staticmethod, classmethod)):
-        return type(fn)(plan(fn.__func__))  # type: ignore[return-value]
+        return type(fn)(plan(fn.__func__))
     if not isinstance(fn, types.FunctionType):
         raise TypeError(f"@plan needs a function defined with `def`, got {type(fn).__name__}")
     if fn.__globals__.get(_TRANSFORMED_MARK):

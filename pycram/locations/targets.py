@@ -78,7 +78,7 @@ def _point(value: Any) -> tuple[float, float, float] | None:
         p = tuple(float(v) for v in value)
     except (TypeError, ValueError):
         return None
-    return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None  # type: ignore[return-value]
+    return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None
 
 
 def _object_like(value: Any) -> Target | None:
