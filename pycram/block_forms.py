@@ -9,6 +9,8 @@ the syntax on.
 
 from __future__ import annotations
 
+from typing import Literal
+
 __all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE", "BRANCHES"]
 
 #: The error text when block syntax is used without being switched on; ``{form}`` is the block's form.
@@ -38,7 +40,7 @@ class BlockForm:
     def __enter__(self) -> None:
         raise BlockSyntaxNotEnabled(self._block_form_name)
 
-    def __exit__(self, *exc_info: object) -> bool:
+    def __exit__(self, *exc_info: object) -> Literal[False]:
         return False
 
 

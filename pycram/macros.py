@@ -622,8 +622,8 @@ class _Transformer:
                 for child in node.orelse:
                     visit(child, loops, in_whenever)
                 return
-            for child in ast.iter_child_nodes(node):
-                visit(child, loops, in_whenever)
+            for sub in ast.iter_child_nodes(node):
+                visit(sub, loops, in_whenever)
 
         for stmt in stmts:
             visit(stmt, 0, False)
@@ -674,7 +674,7 @@ class _Transformer:
         body: list[ast.stmt],
         scope: _Scope,
         where: ast.AST,
-        prelude: list[ast.stmt] = (),
+        prelude: Sequence[ast.stmt] = (),
     ) -> ast.FunctionDef:
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
