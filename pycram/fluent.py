@@ -381,7 +381,7 @@ STOP = object()
 """Return this from a `whenever` body (function form) to leave the loop."""
 
 
-class Whenever(BlockForm):
+class Whenever(BlockForm[None]):
     """Iterating over `whenever(fluent)` waits for the fluent before each pass.
 
     `for _ in whenever(f): body` runs `body` each time `f` is not None (a pulse fluent: each

@@ -39,7 +39,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Sequence
 from enum import Enum
-from typing import Any
+from typing import Any, TypeVar, overload
 
 from pycram.block_forms import BRANCHES, BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
@@ -156,7 +156,7 @@ def _decide(state: Fluent, outcome: State) -> None:
         state.set_value(outcome)
 
 
-class _Expression(BlockForm):
+class _Expression(BlockForm["StateFluent"]):
     """Callable expression object; refuses `with expr:` unless the block syntax rewrote it."""
 
     def __init__(self, kind: str, run: Callable[..., None], doc: str) -> None:
@@ -167,9 +167,21 @@ class _Expression(BlockForm):
         self.__qualname__ = kind
         self.__doc__ = doc
 
+    @overload
+    def __call__(self, errors: list[BaseException], /) -> _BlockUse[StateFluent]: ...
+
+    @overload
     def __call__(
         self,
         *fns: Branch,
+        errors: list[BaseException] | None = None,
+        state: Fluent | None = None,
+        name: str | None = None,
+    ) -> Any: ...
+
+    def __call__(
+        self,
+        *fns: Branch | list[BaseException],
         errors: list[BaseException] | None = None,
         state: Fluent | None = None,
         name: str | None = None,
@@ -195,7 +207,12 @@ class _Expression(BlockForm):
         return f"<pycram expression {self.kind}>"
 
 
-class _BlockUse(BlockForm):
+_Bound = TypeVar("_Bound")
+
+
+class _BlockUse(BlockForm[_Bound]):
+    """The head of a block form called with its arguments (`par(errors)`, `failure_handling(3)`)."""
+
     def __init__(self, form: str) -> None:
         self._block_form_name = form
 
@@ -489,7 +506,7 @@ class _FailureHandler:
         self.retries = 0
 
 
-def _failure_handling_block(max_retries: int | None) -> _BlockUse:
+def _failure_handling_block(max_retries: int | None) -> _BlockUse[None]:
     form = "failure_handling()" if max_retries is None else f"failure_handling({max_retries})"
     return _BlockUse(form)
 
@@ -513,7 +530,7 @@ def _run_failure_handling(body: Branch, max_retries: int, name: str | None) -> A
                     raise
 
 
-class _FailureHandling(BlockForm):
+class _FailureHandling(BlockForm[None]):
     """The `failure_handling` expression object (callable; refuses a bare `with` without the
     block syntax, as the thesis' `with failure_handling:` would otherwise fail obscurely)."""
 
