@@ -9,6 +9,8 @@ the syntax on.
 
 from __future__ import annotations
 
+from typing import Generic, Literal, TypeVar
+
 __all__ = ["BlockSyntaxNotEnabled", "BlockForm", "NOT_ENABLED_MESSAGE", "BRANCHES"]
 
 #: The error text when block syntax is used without being switched on; ``{form}`` is the block's form.
@@ -30,15 +32,23 @@ class BlockSyntaxNotEnabled(RuntimeError):
         self.form = form
 
 
-class BlockForm:
-    """Mixin: objects that are only meaningful as the head of a rewritten `with` block."""
+_Bound = TypeVar("_Bound")
+
+
+class BlockForm(Generic[_Bound]):
+    """Mixin: objects that are only meaningful as the head of a rewritten `with` block.
+
+    The type argument is what `with form as x:` binds once the block syntax has rewritten the
+    block (an expression's state fluent, say), so that type checkers read block-syntax plans
+    right; without the rewrite `__enter__` only raises.
+    """
 
     _block_form_name = "block"
 
-    def __enter__(self) -> None:
+    def __enter__(self) -> _Bound:
         raise BlockSyntaxNotEnabled(self._block_form_name)
 
-    def __exit__(self, *exc_info: object) -> bool:
+    def __exit__(self, *exc_info: object) -> Literal[False]:
         return False
 
 

@@ -309,6 +309,7 @@ def run_command(
                 db, plan=plan or file.name, robot=robot, command=" ".join(["pycram run", str(file), *ctx.args])
             ).start()
         )
+    error: BaseException | str | None  # what the trace records as the run's error
     outcome, error, code = "succeeded", None, 0
     ended: BaseException | None = None  # what ended the main thread's root task
     with StopSignals(stop_main=True) as stop:

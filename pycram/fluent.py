@@ -86,7 +86,7 @@ class Fluent:
         self._changes_only = changes_only
         self._name = name
         self._cv: threading.Condition | None = None
-        self._children: list[weakref.ref] = []  # replaced, never shrunk in place (see add_child)
+        self._children: list[weakref.ref[Fluent]] = []  # replaced, never shrunk in place (see add_child)
         self._live = 0  # number of children after the last pruning of dead references
         self._pulses = 0
         self._handle_missed = Behavior.NEVER
@@ -381,7 +381,7 @@ STOP = object()
 """Return this from a `whenever` body (function form) to leave the loop."""
 
 
-class Whenever(BlockForm):
+class Whenever(BlockForm[None]):
     """Iterating over `whenever(fluent)` waits for the fluent before each pass.
 
     `for _ in whenever(f): body` runs `body` each time `f` is not None (a pulse fluent: each

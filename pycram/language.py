@@ -39,7 +39,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Sequence
 from enum import Enum
-from typing import Any
+from typing import Any, TypeVar, overload
 
 from pycram.block_forms import BRANCHES, BlockForm
 from pycram.fluent import Behavior, Fluent, whenever
@@ -156,10 +156,10 @@ def _decide(state: Fluent, outcome: State) -> None:
         state.set_value(outcome)
 
 
-class _Expression(BlockForm):
+class _Expression(BlockForm["StateFluent"]):
     """Callable expression object; refuses `with expr:` unless the block syntax rewrote it."""
 
-    def __init__(self, kind: str, run: Callable[..., Fluent], doc: str) -> None:
+    def __init__(self, kind: str, run: Callable[..., None], doc: str) -> None:
         self.kind = kind
         self._run = run
         self._block_form_name = kind
@@ -167,10 +167,22 @@ class _Expression(BlockForm):
         self.__qualname__ = kind
         self.__doc__ = doc
 
+    @overload
+    def __call__(self, errors: list[BaseException], /) -> _BlockUse[StateFluent]: ...
+
+    @overload
     def __call__(
         self,
         *fns: Branch,
-        errors: list | None = None,
+        errors: list[BaseException] | None = None,
+        state: Fluent | None = None,
+        name: str | None = None,
+    ) -> Any: ...
+
+    def __call__(
+        self,
+        *fns: Branch | list[BaseException],
+        errors: list[BaseException] | None = None,
         state: Fluent | None = None,
         name: str | None = None,
     ) -> Any:
@@ -195,7 +207,12 @@ class _Expression(BlockForm):
         return f"<pycram expression {self.kind}>"
 
 
-class _BlockUse(BlockForm):
+_Bound = TypeVar("_Bound")
+
+
+class _BlockUse(BlockForm[_Bound]):
+    """The head of a block form called with its arguments (`par(errors)`, `failure_handling(3)`)."""
+
     def __init__(self, form: str) -> None:
         self._block_form_name = form
 
@@ -203,7 +220,7 @@ class _BlockUse(BlockForm):
 # -- sequential expressions ----------------------------------------------------------------------
 
 
-def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
+def _run_seq(fns: Sequence[Branch], errors: list[BaseException], state: Fluent, name: str) -> None:
     with task_scope(name, "seq") as scope:
         result = None
         for index, fn in enumerate(fns):
@@ -220,7 +237,7 @@ def _run_seq(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> N
         _decide(state, State.SUCCEEDED)
 
 
-def _run_try_in_order(fns: Sequence[Branch], errors: list, state: Fluent, name: str) -> None:
+def _run_try_in_order(fns: Sequence[Branch], errors: list[BaseException], state: Fluent, name: str) -> None:
     with task_scope(name, "try_in_order") as scope:
         for index, fn in enumerate(fns):
             try:
@@ -252,7 +269,11 @@ class _Concurrent:
     """Shared engine of par, try_all and pursue: outcome rules differ, guarantees do not."""
 
     def __init__(
-        self, kind: str, errors: list, state: Fluent, branch_ended: Callable[[int, Task], None] | None = None
+        self,
+        kind: str,
+        errors: list[BaseException],
+        state: Fluent,
+        branch_ended: Callable[[int, Task], None] | None = None,
     ) -> None:
         self.kind = kind
         self.branch_ended = branch_ended  # called with (index, task) as each branch ends
@@ -270,17 +291,21 @@ class _Concurrent:
     def on_end(self, task: Task) -> None:
         """Called in the branch's thread, under the group's lock, when a branch ends."""
         status = task.status.get_value()
+        group = self.group
+        assert group is not None  # set by run() before the first branch starts
         if self.branch_ended is not None:
-            self.branch_ended(self.group.tasks.index(task), task)
+            self.branch_ended(group.tasks.index(task), task)
         if status is TaskStatus.FAILED:
             if isinstance(task.exception, RetryRequested):
                 self.retry = self.retry or task.exception
                 self._decide(State.FAILED)
                 return
             self.failed += 1
-            self.errors.append(task.exception)
+            error = task.exception
+            assert error is not None  # a task ends FAILED with the exception that failed it
+            self.errors.append(error)
             if self.first_error is None:
-                self.first_error = task.exception
+                self.first_error = error
         elif status is TaskStatus.SUCCEEDED:
             self.succeeded += 1
         if self.outcome is not None:
@@ -290,7 +315,7 @@ class _Concurrent:
             if status is TaskStatus.FAILED:
                 self._decide(State.FAILED)
             elif self.succeeded == self.count:
-                self.result = [t.result for t in self.group.tasks]  # every branch's, in branch order
+                self.result = [t.result for t in group.tasks]  # every branch's, in branch order
                 self._decide(State.SUCCEEDED)
         elif kind == "try_all":
             if status is TaskStatus.SUCCEEDED:
@@ -340,7 +365,7 @@ class _Concurrent:
 def _concurrent_runner(kind: str) -> Callable[..., None]:
     def run(
         fns: Sequence[Branch],
-        errors: list,
+        errors: list[BaseException],
         state: Fluent,
         name: str,
         branch_ended: Callable[[int, Task], None] | None = None,
@@ -387,7 +412,7 @@ def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Br
         items = list(items)
     except TypeError:
         raise TypeError(f"{form}(): items must be iterable, got {type(items).__name__}: {items!r}") from None
-    branches = []
+    branches: list[Branch] = []
     for index, item in enumerate(items):
 
         def branch(item: Any = item) -> Any:
@@ -401,7 +426,7 @@ def _item_branches(items: Any, body: Callable[[Any], Any], form: str) -> list[Br
 def try_each_in_order(
     items: Any,
     body: Callable[[Any], Any],
-    errors: list | None = None,
+    errors: list[BaseException] | None = None,
     name: str | None = None,
     state: Fluent | None = None,
 ) -> Fluent:
@@ -412,13 +437,14 @@ def try_each_in_order(
     `errors`, in order) when all calls fail or `items` is empty.
     """
     branches = _item_branches(items, body, "try_each_in_order")
-    return try_in_order(*branches, errors=errors, state=state, name=name or "try_each_in_order")
+    outcome: Fluent = try_in_order(*branches, errors=errors, state=state, name=name or "try_each_in_order")
+    return outcome
 
 
 def par_loop(
     items: Any,
     body: Callable[[Any], Any],
-    errors: list | None = None,
+    errors: list[BaseException] | None = None,
     name: str | None = None,
     state: Fluent | None = None,
 ) -> Fluent:
@@ -428,10 +454,13 @@ def par_loop(
     order; the first failure evaporates the other branches (as `par`).
     """
     branches = _item_branches(items, body, "par_loop")
-    return par(*branches, errors=errors, state=state, name=name or "par_loop")
+    outcome: Fluent = par(*branches, errors=errors, state=state, name=name or "par_loop")
+    return outcome
 
 
-def with_timeout(seconds: float, fn: Branch, errors: list | None = None, name: str | None = None) -> Fluent:
+def with_timeout(
+    seconds: float, fn: Branch, errors: list[BaseException] | None = None, name: str | None = None
+) -> Fluent:
     """Run `fn` as a task; evaporate it if it has not ended after `seconds` [s] of the active clock.
 
     Returns the state fluent: SUCCEEDED if fn returned in time; FAILED if it raised (its
@@ -477,7 +506,7 @@ class _FailureHandler:
         self.retries = 0
 
 
-def _failure_handling_block(max_retries: int | None) -> _BlockUse:
+def _failure_handling_block(max_retries: int | None) -> _BlockUse[None]:
     form = "failure_handling()" if max_retries is None else f"failure_handling({max_retries})"
     return _BlockUse(form)
 
@@ -501,7 +530,7 @@ def _run_failure_handling(body: Branch, max_retries: int, name: str | None) -> A
                     raise
 
 
-class _FailureHandling(BlockForm):
+class _FailureHandling(BlockForm[None]):
     """The `failure_handling` expression object (callable; refuses a bare `with` without the
     block syntax, as the thesis' `with failure_handling:` would otherwise fail obscurely)."""
 

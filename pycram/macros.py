@@ -622,8 +622,8 @@ class _Transformer:
                 for child in node.orelse:
                     visit(child, loops, in_whenever)
                 return
-            for child in ast.iter_child_nodes(node):
-                visit(child, loops, in_whenever)
+            for sub in ast.iter_child_nodes(node):
+                visit(sub, loops, in_whenever)
 
         for stmt in stmts:
             visit(stmt, 0, False)
@@ -674,8 +674,8 @@ class _Transformer:
         body: list[ast.stmt],
         scope: _Scope,
         where: ast.AST,
-        prelude: list[ast.stmt] = (),
-    ) -> ast.FunctionDef:  # type: ignore[assignment]
+        prelude: Sequence[ast.stmt] = (),
+    ) -> ast.FunctionDef:
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
         if scope.first_param is not None:
@@ -987,7 +987,7 @@ def plan(fn: F) -> F:
     SyntaxError (with the user's file and line) for misuse of the block forms.
     """
     if isinstance(fn, (staticmethod, classmethod)):
-        return type(fn)(plan(fn.__func__))  # type: ignore[return-value]
+        return type(fn)(plan(fn.__func__))
     if not isinstance(fn, types.FunctionType):
         raise TypeError(f"@plan needs a function defined with `def`, got {type(fn).__name__}")
     if fn.__globals__.get(_TRANSFORMED_MARK):

@@ -163,7 +163,8 @@ class Execution:
 
     @property
     def done(self) -> bool:
-        return self.status.get_value().done
+        status: ProcessModuleStatus = self.status.get_value()
+        return status.done
 
     def wait(self, timeout: float | None = None) -> Any:
         """Block until the execution ended and return ``_execute``'s result.
@@ -488,7 +489,8 @@ class ProcessModule:
         queue, frees the module and settles the outcome (under ``no_evaporation``).
         """
         designator = execution.designator
-        outcome, error, result = ProcessModuleStatus.CANCELLED, None, None
+        outcome, result = ProcessModuleStatus.CANCELLED, None
+        error: BaseException | None = None
         started = False
         try:
             wait_until(self._cond, lambda: self._claim(execution))

@@ -16,6 +16,7 @@ landing at the entry of a `with task_scope(...)` exit left the tag's task RUNNIN
 from __future__ import annotations
 
 import dis
+import gc
 import inspect
 import sys
 from collections.abc import Callable
@@ -121,7 +122,11 @@ def _run_branch_with_landing(n: int, body: Callable[[], Any]) -> tuple[list[str]
 
     parent = current_task()
     before = len(parent.children)
-    state = par(branch).get_value()
+    gc.disable()  # no garbage-collection callback (e.g. a library's) runs in the traced thread
+    try:
+        state = par(branch).get_value()
+    finally:
+        gc.enable()
     return landed, parent.children[before], state
 
 

@@ -66,3 +66,40 @@ def test_the_docs_build_offline_and_strict():
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
     for stage in ("stage docs make docs", "stage wheel make wheel", "stage test make test"):
         assert stage in ci
+
+
+#: What `mypy --strict` turns on per module (mypy 2.4); `warn_redundant_casts` is global.
+STRICT_FLAGS = {
+    "disallow_any_generics": True,
+    "disallow_subclassing_any": True,
+    "disallow_untyped_calls": True,
+    "disallow_untyped_defs": True,
+    "disallow_incomplete_defs": True,
+    "check_untyped_defs": True,
+    "disallow_untyped_decorators": True,
+    "warn_unused_ignores": True,
+    "warn_return_any": True,
+    "implicit_reexport": False,
+    "strict_equality": True,
+    "extra_checks": True,
+}
+
+
+def test_ci_type_checks_the_language_core_strictly_before_the_tests():
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    assert "stage types make types" in ci
+    assert ci.index("stage types make types") < ci.index("stage test make test")
+    mypy = PYPROJECT["tool"]["mypy"]
+    assert mypy["files"] == ["pycram"] and mypy["warn_redundant_casts"] is True
+    core = next(o for o in mypy["overrides"] if "pycram.runtime" in o["module"])
+    for module in (
+        "pycram.fluent",
+        "pycram.runtime.*",
+        "pycram.language",
+        "pycram.designators.*",
+        "pycram.process_module",
+    ):
+        assert module in core["module"]
+    # `strict = true` in an override makes every module strict (python/mypy#11401): spelled out.
+    assert "strict" not in core
+    assert {flag: core.get(flag) for flag in STRICT_FLAGS} == STRICT_FLAGS

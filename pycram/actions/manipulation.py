@@ -328,7 +328,7 @@ def _wider_opening(obj: PerceivedObject) -> float | None:
     name = obj.properties.get("in")
     belief = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
-    if not name or environment is None:
+    if not name or belief is None or environment is None:
         return None
     container = environment.container(name)
     if container.kind != "drawer":

@@ -24,7 +24,10 @@ import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # imported where used: the ROS backend is optional
+    from pycram.ros.sim_environment import RosSimEnvironment
 
 log = logging.getLogger("pycram.demo")
 
@@ -251,6 +254,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
     items = demo_items(options.item_at)
     mug = demo_items(1)[0]  # the mug's size, also when it is not in the kitchen
     camera: Any = "overview"
+    world: World | RosSimEnvironment
     if options.backend == "ros":  # plan -> ROS process modules -> roscore -> sim-ros-bridge -> MuJoCo
         from pycram.ros.sim_environment import open_ros_world
 

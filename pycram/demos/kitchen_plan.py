@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import math
+from typing import Any
 
 from pycram.designator import LocationDesignator, MotionDesignator, perform
 from pycram.fluent import Fluent, whenever
@@ -94,12 +95,12 @@ def within(tolerance: float) -> Fluent:
     return network
 
 
-def motion(**properties) -> object:
+def motion(**properties) -> Any:
     """Perform a motion designator described by `properties`; return the module's result."""
     return perform(MotionDesignator(**properties))
 
 
-def location(*properties: tuple) -> object:
+def location(*properties: tuple) -> Any:
     """Resolve a location designator (robot- or world-specific resolvers decide)."""
     return LocationDesignator(list(properties)).reference()
 
@@ -132,7 +133,7 @@ def grab_item() -> None:
     Raises `GraspFailed` when the gripper closed on nothing.
     """
     target = look_goal.get_value()
-    errors = []
+    errors: list[BaseException] = []
     with par(errors) as state:
         motion(type="moving", pose=goal.get_value(), frame="map")
         if True:
@@ -189,7 +190,7 @@ def fetch_and_place() -> None:
     motion(type="subscribing_pose", fl=pose)
     motion(type="subscribing_gripper", gripper=GRIPPER, fl=r_gripper_state)
     reset_robot()
-    errors = []
+    errors: list[BaseException] = []
     with par(errors) as s:
         with whenever(pose.pulsed()):
             if head_tracking.get_value() is None:
@@ -200,11 +201,11 @@ def fetch_and_place() -> None:
                 motion(type="pointing_head", coordinates=look_goal.get_value(), wait=False, frame="map")
             sleep(0.2)
         if True:
-            task_errors = []
+            task_errors = []  # type: list[BaseException]  # (a branch's names cannot be annotated)
             with seq(task_errors) as task:
                 if True:
                     phase.set_value("fetching")
-                    grasp_errors = []
+                    grasp_errors = []  # type: list[BaseException]
                     with try_in_order(grasp_errors) as state:
                         if True:
                             log.info("trying to grasp at position 1 in front of cooker #2")
@@ -270,6 +271,7 @@ def transport() -> None:
                 ask_for_help("Put the item back into the gripper")
                 motion(type="setting_gripper", gripper=GRIPPER, position=0)
                 raise ItemLost("the item was taken from the gripper")
+            assert drive is not None  # started above: the gripper held the item, or it was lost
             drive.wait()  # the last 10 cm
         except ItemLost:
             retry()

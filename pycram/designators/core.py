@@ -272,7 +272,7 @@ class Designator:
                 return False
         return True
 
-    def _constraint_pair(self, prop: tuple, caller: str) -> tuple[Any, Any]:
+    def _constraint_pair(self, prop: tuple[Any, ...], caller: str) -> tuple[Any, Any]:
         if len(prop) != 2:
             raise PropertyError(f"{caller} on {self!r}: {_short(prop)} is neither a key nor a (key, value) pair")
         return prop

@@ -178,7 +178,7 @@ class MotionType:
         """Raise :class:`MotionPropertyError` unless ``designator`` fits this type."""
         valid = [k.name for k in self.all_keys()]
 
-        def error(message: str, key: Any, cls: type = MotionPropertyError) -> Exception:
+        def error(message: str, key: Any, cls: type[MotionPropertyError] = MotionPropertyError) -> Exception:
             return cls(
                 f"motion designator of type {self.name!r}: {message}; valid keys of "
                 f"{self.name!r}: {self.describe_keys()} (in {designator!r})",

@@ -68,7 +68,7 @@ class FloorGrid:
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.x.shape  # type: ignore[return-value]
+        return self.x.shape
 
     def zeros(self) -> np.ndarray:
         return np.zeros(self.shape)

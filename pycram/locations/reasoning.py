@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from pycram.designators.core import NoSolutionError
-from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Surface
+from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Surface, Vec3
 from pycram.world.objects import Grasp, ObjectType, object_type
 
 from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, ring_layer
@@ -429,6 +429,7 @@ class LocationReasoner:
         occupancy = occupancy_layer(env, grid, self._base_radius, swept)
         if container.kind == "door":
             occupancy = occupancy.copy()
+            assert container.hinge is not None  # a door has its hinge (checked by Container)
             hx, hy = container.hinge
             reach = max(math.hypot(x - hx, y - hy) for x, y in _corners(container.body.footprint))
             occupancy[np.hypot(grid.x - hx, grid.y - hy) < reach + self.geometry.inscribed_radius] = np.inf
@@ -465,7 +466,10 @@ class LocationReasoner:
                 grip, hold = _quat_yaw_rolled(headings[0]), _quat_yaw_rolled(headings[0])
             else:
                 grip, hold = _quat_yaw(headings[0]), None
-            poses = [((hx - c0 * back, hy - s0 * back, hz), grip), (trajectory[0], grip)]
+            poses: list[tuple[Vec3, tuple[float, float, float, float] | None]] = [
+                ((hx - c0 * back, hy - s0 * back, hz), grip),
+                (trajectory[0], grip),
+            ]
             poses += [(p, hold) for p in trajectory[1:]]
             handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
             answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
@@ -473,7 +477,9 @@ class LocationReasoner:
                 return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions), None
             # a handle too low or too high for the torso as it is: another named torso height
             for torso, height in self._other_torso_heights():
-                configuration = {**self.geometry.tucked, self.geometry.torso_joint: height}
+                joint = self.geometry.torso_joint
+                assert joint is not None  # there are other torso heights only with a torso joint
+                configuration = {**self.geometry.tucked, joint: height}
                 if prosp.in_collision((x, y, yaw), configuration):
                     continue
                 other = prosp.reachable(arm, poses, (x, y, yaw), configuration)
@@ -552,6 +558,7 @@ class LocationReasoner:
         if isinstance(value, str):
             for k in known:
                 if k.name == value:
+                    assert k.radius is not None and k.half_height is not None  # set by KnownObject.__post_init__
                     return float(k.radius), float(k.half_height), f"the {k.name}", k.name
             t = object_type(value)
             return t.footprint_radius, t.half_height, f"a {t.name}", None
@@ -590,6 +597,7 @@ class LocationReasoner:
             for k in known:
                 if k.name == own:
                     continue
+                assert k.radius is not None and k.half_height is not None  # set by KnownObject.__post_init__
                 kz0, kz1 = k.position[2] - k.half_height, k.position[2] + k.half_height
                 if kz1 <= surface.height - 0.01 or kz0 >= surface.height + 2 * half + 0.01:
                     continue

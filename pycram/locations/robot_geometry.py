@@ -12,9 +12,11 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 __all__ = ["RobotGeometry"]
+
+_XY = tuple[float, float]  # the pairs of the description module
 
 
 @dataclass(frozen=True)
@@ -62,10 +64,10 @@ class RobotGeometry:
             arms=tuple(d.ARMS),
             default_arm=d.DEFAULT_ARM,
             arm_aliases=dict(d.ARM_ALIASES),
-            reach_points={a: tuple(map(float, p)) for a, p in d.REACH_POINT_IN_BASE.items()},
+            reach_points={a: cast(_XY, tuple(map(float, p))) for a, p in d.REACH_POINT_IN_BASE.items()},
             inscribed_radius=float(d.BASE.get("inscribed_radius", radius / math.sqrt(2.0))),
             circumscribed_radius=radius,
-            approach_offsets={k: tuple(map(float, v)) for k, v in d.APPROACH_OFFSETS.items()},
+            approach_offsets={k: cast(_XY, tuple(map(float, v))) for k, v in d.APPROACH_OFFSETS.items()},
             tucked=tucked,
             arm_joints={a: tuple(s["joints"]) for a, s in d.ARMS.items()},
             ready={

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from pycram.world.environment import Container, Environment, Surface
+from pycram.world.environment import Container, Environment, Place, Surface
 from pycram.world.objects import ObjectType, object_type
 
 __all__ = ["Target", "as_target", "KnownObject"]
@@ -78,7 +78,7 @@ def _point(value: Any) -> tuple[float, float, float] | None:
         p = tuple(float(v) for v in value)
     except (TypeError, ValueError):
         return None
-    return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None  # type: ignore[return-value]
+    return p if len(p) == 3 and all(math.isfinite(v) for v in p) else None
 
 
 def _object_like(value: Any) -> Target | None:
@@ -120,19 +120,16 @@ def as_target(value: Any, environment: Environment | None = None, known_objects:
         return Target(value.handle, "container", value.name, thing=value)
     if isinstance(value, str):
         if environment is not None:
-            for kind, things in (
-                ("place", environment.places),
-                ("surface", environment.all_surfaces()),
-                ("container", environment.containers),
-            ):
+            things: Sequence[Place | Surface | Container]
+            for things in (environment.places, environment.all_surfaces(), environment.containers):
                 for thing in things:
                     if thing.name == value:
                         return (
-                            as_target(thing, environment)
-                            if kind != "place"
-                            else Target(
+                            Target(
                                 (thing.pose[0], thing.pose[1], 0.0), "place", thing.name, yaw=thing.pose[2], thing=thing
                             )
+                            if isinstance(thing, Place)
+                            else as_target(thing, environment)
                         )
         for known in known_objects:
             if known.name == value:

@@ -40,9 +40,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, cast
 
-from pycram.sim.types import Pose2D, yaw_to_quat
+from pycram.sim.types import Pose2D, Vec3, yaw_to_quat
 from pycram.world.environment import FURNITURE_TOPS
 
 __all__ = [
@@ -445,7 +445,8 @@ def known_objects_of(belief: Any) -> list:
         size = obj.properties.get("size")
         if obj.type not in OBJECT_TYPES and size is not None:  # e.g. the thesis demo's mug: as measured
             radius, half_height = 0.5 * math.hypot(size[0], size[1]), 0.5 * size[2]
-        known.append(KnownObject(obj.name, obj.type, tuple(float(v) for v in obj.pose[:3]), 0.0, radius, half_height))
+        position = cast(Vec3, tuple(float(v) for v in obj.pose[:3]))
+        known.append(KnownObject(obj.name, obj.type, position, 0.0, radius, half_height))
     return known
 
 

@@ -30,14 +30,14 @@ import logging
 import math
 import threading
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import actionlib
 import rospy
 
 from pycram.ros.config import RosRobotConfig
 from pycram.ros.ros1 import message_class
-from pycram.sim.types import Outcome, Pose2D
+from pycram.sim.types import Outcome, Pose2D, Vec3
 
 __all__ = ["SimRosBridge"]
 
@@ -52,7 +52,11 @@ class _GoalServer:
     """One action: a goal starts a simulator command; its outcome ends the goal."""
 
     def __init__(
-        self, name: str, action_type: str, start: Callable[[Any], Any], make_result: Callable[[Outcome], Any]
+        self,
+        name: str,
+        action_type: str,
+        start: Callable[..., Any],  # start(goal); `...`: the lambdas passed bind loop values as defaults
+        make_result: Callable[[Outcome], Any],
     ) -> None:
         self.name = name
         self._start, self._make_result = start, make_result
@@ -163,10 +167,10 @@ class SimRosBridge:
                     self._reach_result,
                 )
             )
-        for gripper, interface in c.grippers.items():
+        for gripper, gripper_interface in c.grippers.items():
             self._servers.append(
                 _GoalServer(
-                    interface.action,
+                    gripper_interface.action,
                     "control_msgs/GripperCommand",
                     lambda goal, g=gripper: w.set_gripper(
                         g,
@@ -400,7 +404,7 @@ def run_bridge(
 
     config = robot_config(robot)
     rospy.init_node("sim_ros_bridge", disable_signals=False)
-    world = World(robot, demo_items(item_at), base_pose=tuple(base_pose or START_POSE), realtime=realtime)
+    world = World(robot, demo_items(item_at), base_pose=cast(Vec3, tuple(base_pose or START_POSE)), realtime=realtime)
     bridge = None
     try:
         bridge = SimRosBridge(world, config, publish_rate, detection_rate)

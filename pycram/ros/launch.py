@@ -23,6 +23,7 @@ import threading
 import time
 import xmlrpc.client
 from pathlib import Path
+from typing import cast
 from urllib.parse import urlparse
 
 __all__ = ["free_port", "loopback_env", "check_master_uri", "RosMaster", "BridgeProcess"]
@@ -112,7 +113,7 @@ class RosMaster:
             if self.process.poll() is not None:
                 raise RuntimeError(f"roscore exited with {self.process.returncode}: {self.log_tail()}")
             try:
-                code, _, _ = proxy.getPid("/pycram_launcher")
+                code, _, _ = cast(tuple[int, str, int], proxy.getPid("/pycram_launcher"))  # ROS master API reply
                 if code == 1:
                     return
             except (OSError, xmlrpc.client.Error):

@@ -18,6 +18,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
 __all__ = [
     "Clock",
@@ -97,7 +98,7 @@ class ManualClock(Clock):
     def __init__(self, start: float = 0.0) -> None:
         self._now = float(start)
         self._lock = threading.Lock()
-        self._heap: list[list] = []  # [deadline, order, condition, alive]
+        self._heap: list[list[Any]] = []  # [deadline, order, condition, alive]
         self._order = itertools.count()
 
     def now(self) -> float:

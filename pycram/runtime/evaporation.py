@@ -33,9 +33,12 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 from pycram.runtime.clock import current_clock
+
+if TYPE_CHECKING:  # the task module imports this one
+    from pycram.runtime.task import Task, TaskGroup
 
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
@@ -85,10 +88,10 @@ class Runner:
         "in_plan",
     )
 
-    def __init__(self, task: object | None = None, ident: int | None = None) -> None:
+    def __init__(self, task: Task | None = None, ident: int | None = None) -> None:
         self.task = task
         self.ident = ident  # the thread's identifier once the runner is installed in it
-        self.detached: list = []  # task groups started without waiting (see TaskGroup)
+        self.detached: list[TaskGroup] = []  # task groups started without waiting (see TaskGroup)
         self._mode = _USER
         self._waiting_on: threading.Condition | None = None
         self._injected = False
@@ -96,8 +99,8 @@ class Runner:
         self._protected = 0
         self._lock = threading.Lock()
         self._sleep: threading.Condition | None = None
-        self._delivered_to: object | None = None  # the task evaporation was last delivered to,
-        self._delivered_top: object | None = None  # and its outermost ancestor evaporating then
+        self._delivered_to: Task | None = None  # the task evaporation was last delivered to,
+        self._delivered_top: Task | None = None  # and its outermost ancestor evaporating then
         self.resurfacing = 0  # how often a swallowed evaporation was re-delivered (see evaporated)
         # True while the thread runs plan code (the only place an asynchronous Evaporated may
         # land); the task runtime sets it False around its own bookkeeping (see take_back_pending)
@@ -119,13 +122,14 @@ class Runner:
                 return True
             if task is self._delivered_top:
                 return False
-            task = task.parent  # type: ignore[attr-defined]
+            task = task.parent
         return False
 
     def _mark_delivered(self) -> None:
         task = top = self.task
-        while top.parent is not None and top.parent._evaporating:  # type: ignore[union-attr]
-            top = top.parent  # type: ignore[union-attr]
+        assert top is not None  # called only while the current task is evaporating
+        while top.parent is not None and top.parent._evaporating:
+            top = top.parent
         self._delivered_to, self._delivered_top = task, top
 
     def evaporated(self) -> Evaporated:
@@ -158,6 +162,7 @@ class Runner:
             took_back = self._injected
             if took_back:  # first, so that a late delivery leaves the state untouched
                 self._injected = False
+                assert self.ident is not None  # set before anything is injected (see interrupt)
                 _take_back_async_exception(self.ident)
             previous = self._mode
             if previous == _USER:
@@ -202,6 +207,7 @@ class Runner:
         with self._lock:
             if self._injected:
                 self._injected = False
+                assert self.ident is not None  # set before anything is injected (see interrupt)
                 _take_back_async_exception(self.ident)
 
     def _wait_on(self, condition: threading.Condition) -> None:
@@ -214,6 +220,7 @@ class Runner:
         with self._lock:
             if self._injected:
                 self._injected = False
+                assert self.ident is not None  # set before anything is injected (see interrupt)
                 _take_back_async_exception(self.ident)
             self._mode = _SEALED
             self._waiting_on = None
@@ -271,7 +278,8 @@ _local = threading.local()
 def current_runner() -> Runner:
     """The calling thread's runner (created on first use for threads PyCRAM did not start)."""
     try:
-        return _local.runner
+        runner: Runner = _local.runner
+        return runner
     except AttributeError:
         runner = _local.runner = Runner(ident=threading.get_ident())
         return runner
@@ -359,6 +367,7 @@ def shielded() -> Iterator[Runner]:
     with runner._lock:
         if runner._injected:  # an interrupt raced with entering: take it back
             runner._injected = False
+            assert runner.ident is not None  # set before anything is injected (see interrupt)
             _take_back_async_exception(runner.ident)
         runner._protected += 1
     try:
@@ -524,7 +533,7 @@ def _never() -> bool:
     return False
 
 
-_async_exc_api: tuple | None = None
+_async_exc_api: tuple[Callable[..., int], Callable[..., int]] | None = None
 
 
 def prepare_interrupts() -> None:
@@ -533,7 +542,7 @@ def prepare_interrupts() -> None:
     _api()
 
 
-def _api() -> tuple:
+def _api() -> tuple[Callable[..., int], Callable[..., int]]:
     """The C function `PyThreadState_SetAsyncExc`, typed once to set and once to clear."""
     global _async_exc_api
     if _async_exc_api is None:
@@ -636,7 +645,7 @@ def _raise_if_swallowing(frame: Any, event: str, arg: object) -> object:
         return _raise_if_swallowing
     runner = current_runner()
     task = runner.task
-    if task is None or not task._evaporating:  # type: ignore[attr-defined]
+    if task is None or not task._evaporating:
         sys.settrace(None)  # the evaporated task ended: stop tracing this thread
         return None
     if runner.evaporation_due() and runner._mode == _USER:

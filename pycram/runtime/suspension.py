@@ -42,7 +42,7 @@ import logging
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, Literal
 
 import pycram.fluent as _fluent
 from pycram.runtime import evaporation as _evaporation
@@ -255,7 +255,7 @@ class with_task_suspended:
             raise
         return self.task
 
-    def __exit__(self, *exc_info: Any) -> bool:
+    def __exit__(self, *exc_info: Any) -> Literal[False]:
         wake_up(self.task)
         return False
 

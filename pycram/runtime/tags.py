@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import fnmatch
 from collections.abc import Callable, Iterator
-from typing import Any
+from typing import Any, Literal
 
 from pycram.fluent import Fluent
 from pycram.runtime.evaporation import Evaporated
@@ -50,7 +50,7 @@ class Tags:
 
     def __getitem__(self, name: str) -> Task:
         fluent = self._fluents.get(name)
-        task = fluent.get_value() if fluent is not None else None
+        task: Task | None = fluent.get_value() if fluent is not None else None
         if task is None:
             raise KeyError(f"no task tagged {name!r} has started (yet); tags so far: {sorted(self.names())}")
         return task
@@ -69,7 +69,8 @@ class Tags:
         fluent = self._fluent(name)
         if not fluent.wait_for(timeout):
             raise TimeoutError(f"no task tagged {name!r} started within {timeout:g} s")
-        return fluent.get_value()
+        task: Task = fluent.get_value()  # registered tasks only (see register)
+        return task
 
     def tag(self, name: str, fn: Callable[[], Any]) -> Callable[[], Any]:
         """`tag(name, fn)` registering in this registry (whatever `with_tags` is innermost)."""
@@ -88,7 +89,7 @@ class with_tags:
         self._binding.__enter__()
         return self.tags
 
-    def __exit__(self, *exc_info: Any) -> bool:
+    def __exit__(self, *exc_info: Any) -> Literal[False]:
         self._binding.__exit__(*exc_info)
         return False
 

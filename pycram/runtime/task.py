@@ -19,7 +19,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from enum import Enum
-from typing import Any, ParamSpec, Protocol, TypeVar, overload
+from typing import Any, Literal, ParamSpec, Protocol, TypeVar, overload
 
 import pycram.fluent as _fluent  # imported as a module: pycram.fluent imports this package
 from pycram.runtime.clock import current_clock
@@ -486,7 +486,7 @@ class task_scope:
         self._runner.task = self.task
         return self
 
-    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> bool:
+    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: object) -> Literal[False]:
         task = self.task
         self._runner.task = self._parent
         if exc is None:
@@ -551,7 +551,8 @@ class TaskGroup:
         install_runner(runner)
         if trace is not None:
             sys.settrace(trace)  # a debugger's breakpoints work in the branch (see _debugger_trace)
-        status, error, result = TaskStatus.FAILED, None, None
+        status, result = TaskStatus.FAILED, None
+        error: BaseException | None = None
         try:
             try:
                 task._start(runner)

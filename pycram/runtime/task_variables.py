@@ -35,18 +35,19 @@ class TaskVariable(Generic[T]):
 
     __slots__ = ("name", "default")
 
-    def __init__(self, name: str, default: Any = _UNSET) -> None:
+    def __init__(self, name: str, default: T = _UNSET) -> None:
         self.name = name
         self.default = default
 
-    def get(self, default: Any = _UNSET) -> T:
+    def get(self, default: T = _UNSET) -> T:
         """The value seen by the calling task; raises `LookupError` (naming the variable) when
         neither it nor an ancestor bound one and there is no default."""
         task: Task | None = current_task()
         while task is not None:
             bindings = task.info.get(_KEY)
             if bindings is not None and self in bindings:
-                return bindings[self]
+                value: T = bindings[self]  # bound through set/bound, which take a T
+                return value
             task = task.parent
         if default is not _UNSET:
             return default

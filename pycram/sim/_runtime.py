@@ -16,11 +16,11 @@ from typing import Any
 _log = logging.getLogger(__name__)
 
 try:  # pragma: no cover - exercised whichever way the repository is
-    from pycram.fluent import Fluent  # type: ignore[attr-defined]
+    from pycram.fluent import Fluent
 except ImportError:  # pragma: no cover
     _log.warning("pycram.fluent not available: pycram.sim uses a minimal stand-in Fluent")
 
-    class Fluent:  # type: ignore[no-redef]
+    class Fluent:  # type: ignore[no-redef]  # the stand-in for the missing import
         """Minimal stand-in: a value with `get_value`, `set_value` and `wait_for`."""
 
         def __init__(self, value: Any = None, name: str | None = None) -> None:
@@ -42,21 +42,21 @@ except ImportError:  # pragma: no cover
 
 
 try:  # pragma: no cover
-    from pycram.runtime.clock import ManualClock, current_clock, set_clock, use_clock  # type: ignore[attr-defined]
+    from pycram.runtime.clock import ManualClock, current_clock, set_clock, use_clock
 except ImportError:  # pragma: no cover
     _log.warning("pycram.runtime not available: pycram.sim uses a minimal stand-in clock")
 
     _active: Any = None
 
-    def current_clock() -> Any:  # type: ignore[no-redef]
+    def current_clock() -> Any:  # type: ignore[misc]  # stand-in: the clock type is missing too
         return _active
 
-    def set_clock(clock: Any) -> Any:  # type: ignore[no-redef]
+    def set_clock(clock: Any) -> Any:  # type: ignore[misc]  # stand-in: the clock type is missing too
         global _active
         previous, _active = _active, clock
         return previous
 
-    class ManualClock:  # type: ignore[no-redef]
+    class ManualClock:  # type: ignore[no-redef]  # the stand-in for the missing import
         def __init__(self, start: float = 0.0) -> None:
             self._now = start
 
@@ -67,7 +67,7 @@ except ImportError:  # pragma: no cover
             self._now = max(self._now, t)
 
     @contextmanager
-    def use_clock(clock: Any) -> Iterator[Any]:  # type: ignore[no-redef]
+    def use_clock(clock: Any) -> Iterator[Any]:
         yield clock
 
 

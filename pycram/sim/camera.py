@@ -77,7 +77,8 @@ class FollowView:
         if not points:  # nothing in the region: keep looking where we looked
             if previous is not None:
                 return previous
-            points = [tuple(float(v) for v in data.xpos[model.body(self.bodies[0]).id])]
+            x, y, z = (float(v) for v in data.xpos[model.body(self.bodies[0]).id])
+            points = [(x, y, z)]
         pts = np.asarray(points, dtype=float)
         lookat = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
         azimuth = self._azimuth(pts, lookat)

@@ -209,7 +209,9 @@ class JointTrajectory(Controller):
         return None
 
     def update(self, eng: Engine, t: float) -> Outcome | None:
-        s = smoothstep((t - self.t0) / self.duration)
+        duration = self.duration
+        assert duration is not None  # chosen by start()
+        s = smoothstep((t - self.t0) / duration)
         for j, v in zip(self.joints, self.q0 + s * (self.goal - self.q0)):
             eng.set_target(j, float(v))
         if s >= 1.0:
@@ -217,7 +219,7 @@ class JointTrajectory(Controller):
             err = max(errs)
             if err <= self.tol:
                 return ok(err)
-            if t - self.t0 > self.duration + self.settle:
+            if t - self.t0 > duration + self.settle:
                 worst = self.joints[errs.index(err)]
                 return fail("blocked", f"joints stopped {err:.3f} from the goal ({worst})", err)
         return None
@@ -364,6 +366,8 @@ class Reach(Controller):
     Fails with "unreachable" when IK finds no solution within the joint limits, with "blocked"
     when the arm does not get within `tolerance` [m] of the goal.
     """
+
+    channel: str
 
     def __init__(
         self, arm: str, goal, use_orientation: bool = True, duration: float | None = None, tolerance: float = 0.01

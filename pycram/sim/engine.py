@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import logging
 import math
+from typing import cast
 
 import mujoco
 import numpy as np
 
 from .robot_model import BASE_JOINTS, HEAD_CAMERA, pad_site, tool_site
 from .scene import Scene, initial_state, weld_name
-from .types import GripperState, JointStates, Pose, Pose2D
+from .types import GripperState, JointStates, Pose, Pose2D, Quat, Vec3
 
 _log = logging.getLogger(__name__)
 
@@ -204,12 +205,12 @@ class Engine:
 
     def item_pose(self, name: str) -> Pose:
         b = self.item_bodies[name]
-        return Pose(tuple(map(float, self.data.xpos[b])), tuple(map(float, self.data.xquat[b])))
+        return Pose(cast(Vec3, tuple(map(float, self.data.xpos[b]))), cast(Quat, tuple(map(float, self.data.xquat[b]))))
 
     def site_pose(self, site: int) -> Pose:
         quat = np.zeros(4)
         mujoco.mju_mat2Quat(quat, self.data.site_xmat[site])
-        return Pose(tuple(map(float, self.data.site_xpos[site])), tuple(map(float, quat)))
+        return Pose(cast(Vec3, tuple(map(float, self.data.site_xpos[site]))), cast(Quat, tuple(map(float, quat))))
 
     def base_contacts(self) -> list[tuple[str, str]]:
         """Pairs (robot geom, environment geom) of base links touching the environment."""

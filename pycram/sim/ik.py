@@ -104,7 +104,7 @@ def dls_ik(
     hi: np.ndarray,
     target_p: np.ndarray,
     target_q: np.ndarray | None,
-    seed: Sequence[float],
+    seed: Sequence[float] | np.ndarray,
     iterations: int = 400,
     damping: float = 0.02,
     position_tolerance: float = 0.002,

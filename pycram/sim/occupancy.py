@@ -195,7 +195,8 @@ def build_floor_map(
     floor = FloorMap(origin, resolution, {}, (), (), (), shape)
     for g in static:
         _add(floor.static, floor, model, data, g)
-    mocaps, qadr = set(), set()
+    mocaps: set[int] = set()
+    qadr: set[int] = set()
     for g in movable:
         b = int(model.geom_bodyid[g])
         while b > 0:

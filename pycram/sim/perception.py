@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any, cast
 
 import numpy as np
 
@@ -24,6 +25,7 @@ from pycram.world.belief import (
     COLOR_NAMES,
     CameraView,
     Detection,
+    Vec3,
     color_name,
     support_of,
 )
@@ -109,7 +111,7 @@ def _measure(
         (x, y, (top + bottom) / 2.0),
         (width, depth, top - bottom),
         color_name(mean),
-        tuple(float(c) for c in mean),
+        cast(Vec3, tuple(float(c) for c in mean)),  # the mean of the three channels
         None if surface is None else surface.name,
         None if container is None else container.name,
         int(len(points)),
@@ -134,8 +136,8 @@ def measure_detections(
     types = [type_name for type_name, _ in objects.values()]
     last = int(max((max(g) for _, g in objects.values() if g), default=0))
     lookup = np.full(last + 2, -1, np.int64)  # geom id -> object index; the extra last entry: none
-    for index, (_, geoms) in enumerate(objects.values()):
-        lookup[geoms] = index
+    for object_index, (_, geoms) in enumerate(objects.values()):
+        lookup[geoms] = object_index
     labels = lookup[np.where((ids >= 0) & (ids <= last), ids, last + 1)]
     counts = np.bincount(labels[labels >= 0], minlength=len(types))
     detections = []
@@ -157,7 +159,7 @@ def measure_detections(
     return sorted(detections, key=lambda d: -d.pixels)
 
 
-def _replace(detection: Detection, **changes: object) -> Detection:
+def _replace(detection: Detection, **changes: Any) -> Detection:
     return replace(detection, **changes)
 
 
@@ -166,7 +168,7 @@ def view_of(
 ) -> CameraView:
     """A `CameraView` from a camera's map position, rotation matrix and depth image."""
     return CameraView(
-        tuple(float(v) for v in position),
+        cast(Vec3, tuple(float(v) for v in position)),
         np.asarray(rotation, float).reshape(3, 3).copy(),
         float(fovy),
         depth,

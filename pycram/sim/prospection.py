@@ -152,12 +152,12 @@ class SimProspection(Prospection):
             d.qpos[adr] = v
         if joint_configuration:
             for name, value in joint_configuration.items():
-                adr = self._joint_qpos.get(name)
-                if adr is None:
+                joint_adr = self._joint_qpos.get(name)
+                if joint_adr is None:
                     raise ValueError(
                         f"unknown joint {name!r} of {self.scene.robot}; valid joints: {sorted(self._joint_qpos)}"
                     )
-                d.qpos[adr] = float(value)
+                d.qpos[joint_adr] = float(value)
         mujoco.mj_kinematics(self.model, d)
 
     def _touching(self, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -28,7 +28,7 @@ import time
 import weakref
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -53,7 +53,7 @@ from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames, State
 from .render import Renderers, write_animation, write_png
 from .robot_model import HEAD_CAMERA
 from .scene import build_scene
-from .types import Outcome, Pose, Pose2D, VisibleItem
+from .types import Outcome, Pose, Pose2D, Quat, Vec3, VisibleItem
 
 if TYPE_CHECKING:
     from .prospection import SimProspection
@@ -157,7 +157,7 @@ class World:
         self.camera_image = Fluent(None, name="camera_image")
         #: the latest state copied by the simulation thread, for prospection (never its MjData)
         self._state = StateSnapshot.of(eng.data)
-        self._prospection = None
+        self._prospection: SimProspection | None = None
         # --- command plumbing
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()
         self._lock = threading.Lock()
@@ -235,7 +235,7 @@ class World:
                 return
             self._clock_active = False
             previous = self._previous_clock
-            while previous in _CLOSED_CLOCKS:
+            while isinstance(previous, ManualClock) and previous in _CLOSED_CLOCKS:  # its keys
                 previous = _CLOSED_CLOCKS[previous]
             _CLOSED_CLOCKS[self.clock] = previous
             if current_clock() is self.clock:
@@ -455,8 +455,8 @@ class World:
         """
         self._check_arm(arm)
         goal = Pose(
-            tuple(map(float, position)),
-            tuple(map(float, orientation)) if orientation is not None else (1.0, 0.0, 0.0, 0.0),
+            cast(Vec3, tuple(map(float, position))),
+            cast(Quat, tuple(map(float, orientation))) if orientation is not None else (1.0, 0.0, 0.0, 0.0),
         )
         return self.submit(Reach(arm, goal, orientation is not None, duration, tolerance), f"reach:{arm}")
 
@@ -744,7 +744,7 @@ class World:
                 name = eng.grippers[gripper].holding
             if name is None:
                 return None
-            eng.set_item_pose(name, tuple(to) if to is not None else eng.aside_position(name))
+            eng.set_item_pose(name, cast(Vec3, tuple(to)) if to is not None else eng.aside_position(name))
             return name
 
         return self._call("take_item", fn)

@@ -29,7 +29,7 @@ import datetime as _dt
 import json
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import sqlalchemy as sa
 from sqlalchemy import exc as sa_exc
@@ -47,6 +47,9 @@ from pycram.trace.db import (
     sqlite_file,
     tasks_table,
 )
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 __all__ = [
     "RunInfo",
@@ -77,6 +80,12 @@ class RunNotFound(LookupError):
     """No run with the requested id (or no run at all)."""
 
 
+@overload
+def _utc(value: _dt.datetime) -> _dt.datetime: ...
+@overload
+def _utc(value: None) -> None: ...
+@overload
+def _utc(value: _dt.datetime | None) -> _dt.datetime | None: ...
 def _utc(value: _dt.datetime | None) -> _dt.datetime | None:
     if value is not None and value.tzinfo is None:  # SQLite stores naive datetimes
         value = value.replace(tzinfo=_dt.UTC)
@@ -235,7 +244,7 @@ class _Reading:
         else:
             self.engine = connect(url, cached=True)
 
-    def columns(self, table: sa.Table, record: type) -> list[Any]:
+    def columns(self, table: sa.Table, record: type[DataclassInstance]) -> list[Any]:
         """The columns of `table` in the field order of the dataclass `record`; a column an
         old, unmigrated database lacks reads as NULL."""
         try:
@@ -255,7 +264,7 @@ class _Reading:
         except sa_exc.SQLAlchemyError as e:
             raise database_error(self.engine.url, e, "read") from None
 
-    def rows(self, stmt: Any) -> list[Any]:
+    def rows(self, stmt: Any) -> Sequence[Any]:
         try:
             with self.engine.connect() as conn:
                 return conn.execute(stmt).all()
@@ -367,8 +376,8 @@ def _by_start(children: list[TaskNode]) -> list[TaskNode]:
         while (
             i < len(executions_)
             and start is not None
-            and executions_[i].record.start is not None
-            and executions_[i].record.start < start
+            and (execution_start := executions_[i].record.start) is not None
+            and execution_start < start
         ):
             out.append(executions_[i])
             i += 1
@@ -390,7 +399,7 @@ def execution_nodes(records: Sequence[TaskRecord], executions_: Iterable[Executi
     out: list[TaskRecord] = []
     for x in executions_:
         name = f"{x.module}: {x.designator_type}" if x.designator_type else str(x.module)
-        if kinds.get(x.task_id) == ("process-module", name):
+        if x.task_id is not None and kinds.get(x.task_id) == ("process-module", name):
             continue  # a non-blocking execution: its own task already stands for it
         status = _EXECUTION_STATUS.get(x.outcome or "", x.outcome or "unknown")
         out.append(

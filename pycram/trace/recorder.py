@@ -158,6 +158,7 @@ class _Sampler(Fluent):
     """A child fluent of a watched fluent: its pulse hands the parent's value to the recorder."""
 
     __slots__ = ("_watch",)
+    _watch: _Watch | None  # set by the _Watch that owns it
 
     def pulse(self) -> None:  # called by the parent's pulse, in the thread that set the value
         watch = self._watch
@@ -247,7 +248,7 @@ class Recorder:
         self.run_id: int | None = None
         self.run_uuid = str(uuid.uuid4())
         self.outcome: str | None = None
-        self._queue: queue.SimpleQueue[tuple] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[tuple[Any, ...] | Task] = queue.SimpleQueue()  # a task: started/ended
         self._put = self._queue.put
         # TaskListener methods: O(1), never block, no Python-level frame (see the writer)
         self.task_started = self._queue.put
@@ -302,7 +303,9 @@ class Recorder:
                         info=json.dumps(self.info, default=str) if self.info else None,
                     )
                 )
-                self.run_id = int(result.inserted_primary_key[0])
+                key = result.inserted_primary_key
+                assert key is not None  # set by a single-row INSERT
+                self.run_id = int(key[0])
         except sa_exc.SQLAlchemyError as e:  # e.g. a read-only file: say so before the plan runs
             engine.dispose()
             raise database_error(engine.url, e, "write to") from None
@@ -414,7 +417,7 @@ class Recorder:
     def __enter__(self) -> Recorder:
         return self.start()
 
-    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: Any) -> bool:
+    def __exit__(self, exc_type: type | None, exc: BaseException | None, tb: Any) -> Literal[False]:
         self.finish("succeeded" if exc is None else "failed", exc)
         return False
 
@@ -577,7 +580,7 @@ class _WriterState:
         else:
             error_type = error_message = origin = None
         runner = task._runner
-        thread = self.thread_names.get(runner.ident) if runner is not None else None
+        thread = self.thread_names.get(runner.ident) if runner is not None and runner.ident is not None else None
         name = task.name
         start, end = task.start_time, task.end_time
         return (

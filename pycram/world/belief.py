@@ -32,7 +32,7 @@ import math
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -330,7 +330,11 @@ class BeliefState(Belief):
                 self.looks = [
                     *self.looks[-(MAX_LOOKS - 1) :],
                     Look(
-                        report.stamp, tuple(view.position), tuple(float(v) for v in forward), view.fovy, view.max_range
+                        report.stamp,
+                        cast(Vec3, tuple(view.position)),
+                        cast(Vec3, tuple(float(v) for v in forward)),
+                        view.fovy,
+                        view.max_range,
                     ),
                 ]
                 for j, obj in enumerate(known):

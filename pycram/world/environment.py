@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol, TypeVar
 
 from .errors import UnknownNameError
 
@@ -297,12 +297,20 @@ class Environment:
         return max((s.height for s in self.surfaces if s.contains(x, y)), default=0.0)
 
 
-def _find(kind: str, name: str, things: Iterable) -> object:
-    things = list(things)
-    for t in things:
+class _Named(Protocol):
+    @property
+    def name(self) -> str: ...
+
+
+_N = TypeVar("_N", bound=_Named)
+
+
+def _find(kind: str, name: str, things: Iterable[_N]) -> _N:
+    found = list(things)
+    for t in found:
         if t.name == name:
             return t
-    raise UnknownNameError(kind, name, [t.name for t in things])
+    raise UnknownNameError(kind, name, [t.name for t in found])
 
 
 def rect_around(center: XY, half: XY) -> Rect:

@@ -99,7 +99,7 @@ class OccupancyGrid:
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.occupied.shape  # type: ignore[return-value]
+        return self.occupied.shape
 
     def cell(self, x: float, y: float) -> tuple[int, int]:
         """(row, col) of the cell containing map point (x, y) [m] (may be outside the grid)."""
