@@ -663,7 +663,9 @@ def experiment_command(
         None, "--name", help="Name of the experiment (default: SCENARIO-DATE-TIME); an existing name resumes it."
     ),
     resume: str | None = typer.Option(
-        None, "--resume", help="Resume the experiment with this id or name: run only the seeds not finished.",
+        None,
+        "--resume",
+        help="Resume the experiment with this id or name: run only the seeds not finished.",
         metavar="ID",
     ),
     output: Path | None = typer.Option(
@@ -678,7 +680,14 @@ def experiment_command(
     `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when
     runs were lost (a worker died), 2 for bad options.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     from pycram.interrupts import StopSignals
 
@@ -739,7 +748,9 @@ def experiment_command(
 
         with StopSignals() as stop:
             try:
-                outcome = _trace_errors(run_experiment, prepared, workers=workers, ray=ray, stop=stop, progress=progress)
+                outcome = _trace_errors(
+                    run_experiment, prepared, workers=workers, ray=ray, stop=stop, progress=progress
+                )
             except RayUnavailable as e:
                 _fail(str(e))
             except ExperimentInputError as e:

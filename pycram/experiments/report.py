@@ -27,8 +27,8 @@ def percentile(values: Iterable[float], p: float) -> float | None:
 
 
 def variant_label(variant: str) -> str:
-    """How a variant key reads in tables: "no faults", or its fault names "a,b"."""
-    return variant if variant else "no faults"
+    """How a variant key reads in tables: "none", or its fault names "a,b"."""
+    return variant if variant else "none"
 
 
 @dataclass
@@ -82,9 +82,9 @@ def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
 
     table = Table(title=title or None, header_style="bold")
     table.add_column("robot")
-    table.add_column("variant (faults)")
-    for name in ("runs", "success", "sim p50 [s]", "sim p95 [s]", "wall p50 [s]", "wall p95 [s]", "× real time"):
-        table.add_column(name, justify="right")
+    table.add_column("faults")
+    for name in ("runs", "success", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
+        table.add_column(name, justify="right", no_wrap=True)
     for g in groups:
         rate = g.success_rate
         style = "green" if rate >= 0.95 else "yellow" if rate >= 0.85 else "red"
@@ -94,10 +94,8 @@ def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
             variant_label(g.variant),
             str(g.runs),
             f"[{style}]{100 * rate:.1f} %[/{style}] ({g.successes})",
-            _seconds(percentile(g.sim_times, 50)),
-            _seconds(percentile(g.sim_times, 95)),
-            _seconds(percentile(g.wall_times, 50)),
-            _seconds(percentile(g.wall_times, 95)),
+            f"{_seconds(percentile(g.sim_times, 50))} / {_seconds(percentile(g.sim_times, 95))}",
+            f"{_seconds(percentile(g.wall_times, 50))} / {_seconds(percentile(g.wall_times, 95))}",
             "–" if rtf is None else f"{rtf:.1f}",
         )
     return table
@@ -114,7 +112,7 @@ def causes_table(groups: list[GroupSummary]) -> Any:
     table = Table(title="failure causes", header_style="bold")
     table.add_column("cause")
     for g in groups:
-        table.add_column(f"{g.robot}\n{variant_label(g.variant)}", justify="right")
+        table.add_column(f"{g.robot}\nfaults: {variant_label(g.variant)}", justify="right")
     for cause, _ in total.most_common():
         table.add_row(cause, *(str(g.causes.get(cause, 0)) for g in groups))
     if not total:
@@ -132,15 +130,20 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    labels = [f"{g.robot}\n{variant_label(g.variant)}" for g in groups]
+    labels = [f"{g.robot}\nfaults: {variant_label(g.variant)}" for g in groups]
     xs = list(range(len(groups)))
     fig, (ax_rate, ax_time, ax_causes) = plt.subplots(1, 3, figsize=(15, 4.8))
     try:
         rates = [100 * g.success_rate for g in groups]
         bars = ax_rate.bar(xs, rates, color=["#3a7" if r >= 95 else "#db3" if r >= 85 else "#c44" for r in rates])
         for bar, g in zip(bars, groups):
-            ax_rate.annotate(f"{g.successes}/{g.runs}", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-                             ha="center", va="bottom", fontsize=8)
+            ax_rate.annotate(
+                f"{g.successes}/{g.runs}",
+                (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
         ax_rate.set_xticks(xs, labels, fontsize=8)
         ax_rate.set_ylim(0, 105)
         ax_rate.set_ylabel("success rate [%]")
@@ -154,8 +157,14 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
             p50 = [percentile(v, 50) or 0.0 for v in values]
             p95 = [percentile(v, 95) or 0.0 for v in values]
             ax_time.bar([x + offset for x in xs], p50, width, label=f"{name} p50", color=colour)
-            ax_time.errorbar([x + offset for x in xs], p50, yerr=[[0] * len(xs), [b - a for a, b in zip(p50, p95)]],
-                             fmt="none", ecolor="black", capsize=3)
+            ax_time.errorbar(
+                [x + offset for x in xs],
+                p50,
+                yerr=[[0] * len(xs), [b - a for a, b in zip(p50, p95)]],
+                fmt="none",
+                ecolor="black",
+                capsize=3,
+            )
         ax_time.set_xticks(xs, labels, fontsize=8)
         ax_time.set_ylabel("time per run [s] (bar: p50, whisker: p95)")
         ax_time.set_title("time per run")

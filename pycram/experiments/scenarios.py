@@ -200,7 +200,9 @@ def thesis_scenario(
         raise ValueError(f"unknown robot {robot!r}; available robots: {', '.join(ROBOTS)}")
     unknown = sorted(set(faults) - set(THESIS_FAULTS))
     if unknown:
-        raise ValueError(f"unknown fault(s) {', '.join(unknown)}; the thesis scenario knows: {', '.join(THESIS_FAULTS)}")
+        raise ValueError(
+            f"unknown fault(s) {', '.join(unknown)}; the thesis scenario knows: {', '.join(THESIS_FAULTS)}"
+        )
     os.environ.setdefault("MUJOCO_GL", "egl")
     try:
         from pycram.trace.recorder import recording_enabled

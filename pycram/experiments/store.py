@@ -73,7 +73,10 @@ class ExperimentRecord:
         """Every run of the experiment as (robot, seed, variant key), in the order they run:
         per variant, per robot, by seed."""
         return [
-            (robot, seed, variant_key(variant)) for variant in self.variants for robot in self.robots for seed in self.seeds
+            (robot, seed, variant_key(variant))
+            for variant in self.variants
+            for robot in self.robots
+            for seed in self.seeds
         ]
 
 
@@ -197,7 +200,9 @@ def finished_keys(url: str | None, experiment_id: int) -> set[tuple[str, int, st
     return {(r.robot, r.seed, r.variant) for r in rows}
 
 
-def record_run(url: str | None, experiment_id: int, robot: str, seed: int, variant: str, result: dict[str, Any]) -> None:
+def record_run(
+    url: str | None, experiment_id: int, robot: str, seed: int, variant: str, result: dict[str, Any]
+) -> None:
     """Commit one finished run: the scenario's `result` dict (with `error` set when the scenario
     raised). Recording the same run twice keeps the first record."""
     table = experiment_runs_table

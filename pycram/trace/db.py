@@ -276,9 +276,7 @@ experiment_runs_table = sa.Table(
     "pycram_experiment_runs",
     metadata,
     sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
-    sa.Column(
-        "experiment_id", sa.Integer, sa.ForeignKey("pycram_experiments.id", ondelete="CASCADE"), nullable=False
-    ),
+    sa.Column("experiment_id", sa.Integer, sa.ForeignKey("pycram_experiments.id", ondelete="CASCADE"), nullable=False),
     sa.Column("robot", sa.String(255), nullable=False),
     sa.Column("seed", sa.Integer, nullable=False),
     sa.Column("variant", sa.String(512), nullable=False),  # sorted fault names joined by ",", "" for none
