@@ -678,7 +678,7 @@ def experiment_command(
 
     Ctrl-C stops it: the runs under way finish and are recorded (a second Ctrl-C exits at once);
     `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when
-    runs were lost (a worker died), 2 for bad options.
+    runs were lost (a worker died) or raised an error (a resume runs them again), 2 for bad options.
     """
     from rich.progress import (
         BarColumn,
@@ -772,6 +772,12 @@ def experiment_command(
     )
     if outcome.errors:
         err.print(f"[red]{len(outcome.errors)} runs were lost:[/red] " + escape("; ".join(outcome.errors[:5])))
+    raised = [r for r in runs if r.status == "error"]
+    if raised:
+        err.print(
+            f"[red]{len(raised)} runs raised an error[/red] (e.g. {escape(raised[0].robot)} seed {raised[0].seed}: "
+            f"{escape(raised[0].error or '')}); `pycram experiment --resume {record.id}` runs them again"
+        )
     left = total - len(runs)
     if outcome.interrupted or left:
         err.print(
@@ -779,7 +785,7 @@ def experiment_command(
             f"resume with `pycram experiment --resume {record.id}`[/yellow]"
         )
         raise typer.Exit(stop.exit_code if outcome.interrupted and stop.signum else 1)
-    raise typer.Exit(0)
+    raise typer.Exit(1 if raised or outcome.errors else 0)
 
 
 def main(argv: list[str] | None = None) -> int:

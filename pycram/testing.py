@@ -170,7 +170,8 @@ def scenario_double(
     For tests across processes it reads two environment variables: with
     `$PYCRAM_SCENARIO_DOUBLE_LOG` set it appends "robot seed variant" to that file for every run;
     when `$PYCRAM_SCENARIO_DOUBLE_INTERRUPT` is the seed, it sends SIGINT to its parent process
-    (the experiment's driver, for a local worker) before returning: a deterministic Ctrl-C.
+    when that is a `pycram` process (the experiment's driver, for a local worker; never a Ray
+    worker's parent) before returning: a deterministic Ctrl-C.
     """
     import os
     import signal
@@ -191,7 +192,14 @@ def scenario_double(
     sim_time = (10.0 + seed % 7) * (2.0 if "slow" in faults else 1.0)
     time.sleep(0.02)
     if os.environ.get("PYCRAM_SCENARIO_DOUBLE_INTERRUPT") == str(seed):
-        os.kill(os.getppid(), signal.SIGINT)
+        parent = os.getppid()
+        try:
+            with open(f"/proc/{parent}/cmdline", "rb") as f:
+                is_driver = b"pycram" in f.read()
+        except OSError:
+            is_driver = False
+        if is_driver:  # a local worker's parent is the experiment's driver; a Ray worker's is not
+            os.kill(parent, signal.SIGINT)
     return {
         "robot": robot,
         "seed": seed,

@@ -212,3 +212,45 @@ def test_seed_parsing():
     for bad in ("", "-1", "1-", "3-2", "a", "1.5"):
         with pytest.raises(ExperimentInputError):
             parse_seeds(bad)
+
+
+def test_a_scenario_error_is_recorded_and_run_again_on_resume(tmp_path, monkeypatch):
+    """An exception of the scenario is a recorded failure (status "error", exit code 1); a
+    resume runs only that run again and replaces its record."""
+    db = tmp_path / "t.sqlite3"
+    args = ["experiment", "--scenario", DOUBLE, "--robot", "pr2,tiago", "--seeds", "1-2", "--name", "e"]
+    args += ["--db", str(db), "--output", str(tmp_path / "out"), "--workers", "1"]
+    from pycram.experiments import runner as experiment_runner
+
+    real = experiment_runner.execute_run
+    calls = []
+
+    def flaky(scenario, robot, seed, variant, db_url, record=True):
+        calls.append((robot, seed))
+        if robot == "tiago" and seed == 2 and len(calls) <= 4:
+            raise_in = "pycram.testing:no_such_function"  # the scenario cannot even be found
+            return real(raise_in, robot, seed, variant, db_url, record)
+        return real(scenario, robot, seed, variant, db_url, record)
+
+    monkeypatch.setattr(experiment_runner, "execute_run", flaky)
+    monkeypatch.setattr(experiment_runner, "_run_local", _run_inline)
+    first = runner.invoke(app, args)
+    assert first.exit_code == 1, first.output
+    assert "1 runs raised an error" in " ".join(first.output.split())
+    rows = {(r["robot"], r["seed"]): r for r in _rows(db, "pycram_experiment_runs")}
+    assert rows[("tiago", 2)]["status"] == "error" and not rows[("tiago", 2)]["success"]
+    assert json.loads(rows[("tiago", 2)]["failure_causes"]) == ["UnknownScenario"]
+    second = runner.invoke(app, ["experiment", "--resume", "e", "--db", str(db), "-o", str(tmp_path / "out")])
+    assert second.exit_code == 0, second.output
+    assert calls[4:] == [("tiago", 2)]
+    rows = {(r["robot"], r["seed"]): r for r in _rows(db, "pycram_experiment_runs")}
+    assert len(rows) == 4 and all(r["status"] == "done" for r in rows.values())
+
+
+def _run_inline(prepared, workers, stop, finished, outcome):
+    """`_run_local` without worker processes (the test patches `execute_run` in this process)."""
+    from pycram.experiments import runner as experiment_runner
+
+    for robot, seed, variant in prepared.todo:
+        result = experiment_runner.execute_run(prepared.scenario.name, robot, seed, variant, prepared.db)
+        finished((robot, seed, variant), result)

@@ -20,8 +20,9 @@ Guarantees
   the runs under way finish and are recorded (a Ray task is cancelled instead), then
   `run_experiment` returns with `interrupted` set. Every recorded run stays recorded;
   `--resume` runs the others.
-- A scenario that raises is a finished run with status "error" (a failure whose cause is the
-  exception's type); a run that was interrupted, or whose worker died, is not recorded.
+- A scenario that raises is recorded with status "error" (a failure whose cause is the
+  exception's type; the report counts it) and a resumed experiment runs it again; a run that
+  was interrupted, or whose worker died, is not recorded.
 """
 
 from __future__ import annotations
@@ -348,7 +349,7 @@ def run_experiment(
     finally:
         outcome.wall_time = time.monotonic() - started
         outcome.interrupted = bool(stop.requested)
-        left = len(store.finished_keys(prepared.db, record_id)) < len(prepared.record.keys())
+        left = len(store.finished_keys(prepared.db, record_id, errors=True)) < len(prepared.record.keys())
         store.set_status(prepared.db, record_id, "interrupted" if left else "finished")
     return outcome
 

@@ -186,14 +186,19 @@ def set_status(url: str | None, experiment_id: int, status: str) -> None:
         raise database_error(engine.url, e, "write to") from None
 
 
-def finished_keys(url: str | None, experiment_id: int) -> set[tuple[str, int, str]]:
-    """(robot, seed, variant key) of every run of the experiment already recorded."""
+def finished_keys(url: str | None, experiment_id: int, *, errors: bool = False) -> set[tuple[str, int, str]]:
+    """(robot, seed, variant key) of every run of the experiment recorded as finished (status
+    "done"); with `errors` also those whose scenario raised (status "error", which a resumed
+    experiment runs again)."""
     table = experiment_runs_table
     engine = _engine(url)
+    statuses = ("done", "error") if errors else ("done",)
     try:
         with engine.connect() as conn:
             rows = conn.execute(
-                sa.select(table.c.robot, table.c.seed, table.c.variant).where(table.c.experiment_id == experiment_id)
+                sa.select(table.c.robot, table.c.seed, table.c.variant).where(
+                    table.c.experiment_id == experiment_id, table.c.status.in_(statuses)
+                )
             ).all()
     except sa_exc.SQLAlchemyError as e:
         raise database_error(engine.url, e, "read") from None
@@ -204,7 +209,7 @@ def record_run(
     url: str | None, experiment_id: int, robot: str, seed: int, variant: str, result: dict[str, Any]
 ) -> None:
     """Commit one finished run: the scenario's `result` dict (with `error` set when the scenario
-    raised). Recording the same run twice keeps the first record."""
+    raised). A run recorded as "error" before is replaced; one recorded as "done" is kept."""
     table = experiment_runs_table
     error = result.get("error")
     trace = result.get("trace_run_id")
@@ -227,6 +232,15 @@ def record_run(
     engine = _engine(url)
     try:
         with engine.begin() as conn:
+            conn.execute(
+                sa.delete(table).where(
+                    table.c.experiment_id == experiment_id,
+                    table.c.robot == robot,
+                    table.c.seed == int(seed),
+                    table.c.variant == variant,
+                    table.c.status == "error",
+                )
+            )
             conn.execute(sa.insert(table).values(**values))
     except sa_exc.IntegrityError:
         log.warning("run %s seed %s (%s) of experiment %s was recorded already", robot, seed, variant, experiment_id)
