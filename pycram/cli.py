@@ -680,6 +680,33 @@ def experiment_command(
     `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when
     runs were lost (a worker died) or raised an error (a resume runs them again), 2 for bad options.
     """
+    import contextlib
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        from pycram.experiments.runner import ExperimentInputError, RayUnavailable, prepare_experiment, ray_session
+    except ImportError as e:
+        _fail(f"experiments need the 'db' extra (pip install 'pycram[all]'): {e}")
+    if workers < 1:
+        _fail(f"--workers must be at least 1, not {workers}", code=2)
+    if output is not None:
+        _check_output_folder(str(output))
+    options = dict(scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db)
+    with contextlib.ExitStack() as session:
+        try:
+            if ray is not None:  # check the input, then connect (before an experiment is created)
+                _trace_errors(prepare_experiment, check_only=True, **options)
+                session.enter_context(ray_session(ray, workers))
+            prepared = _trace_errors(prepare_experiment, command=" ".join(["pycram", *sys.argv[1:]]), **options)
+        except ExperimentInputError as e:
+            _fail(str(e), code=2)
+        except RayUnavailable as e:
+            _fail(str(e))
+        _run_experiment(prepared, workers, ray, output, db)
+
+
+def _run_experiment(prepared: Any, workers: int, ray: str | None, output: Path | None, db: str | None) -> None:
+    """`pycram experiment` once its input is checked: run with a progress bar, then report."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -689,32 +716,10 @@ def experiment_command(
         TimeRemainingColumn,
     )
 
+    from pycram.experiments import report, store
+    from pycram.experiments.runner import ExperimentInputError, RayUnavailable, run_experiment
     from pycram.interrupts import StopSignals
 
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    try:
-        from pycram.experiments import report, store
-        from pycram.experiments.runner import ExperimentInputError, RayUnavailable, prepare_experiment, run_experiment
-    except ImportError as e:
-        _fail(f"experiments need the 'db' extra (pip install 'pycram[all]'): {e}")
-    if workers < 1:
-        _fail(f"--workers must be at least 1, not {workers}", code=2)
-    if output is not None:
-        _check_output_folder(str(output))
-    try:
-        prepared = _trace_errors(
-            prepare_experiment,
-            scenario=scenario,
-            robots=robot,
-            seeds=seeds,
-            faults=faults,
-            name=name,
-            resume=resume,
-            db=db,
-            command=" ".join(["pycram", *sys.argv[1:]]),
-        )
-    except ExperimentInputError as e:
-        _fail(str(e), code=2)
     record = prepared.record
     where = f"Ray ({ray})" if ray else f"{workers} worker processes"
     total = len(record.keys())

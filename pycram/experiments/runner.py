@@ -27,6 +27,7 @@ Guarantees
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import json
 import logging
@@ -35,7 +36,7 @@ import re
 import signal
 import socket
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,6 +58,7 @@ __all__ = [
     "run_experiment",
     "execute_run",
     "ray_runtime_env",
+    "ray_session",
     "MAX_SEEDS",
 ]
 
@@ -169,12 +171,14 @@ def prepare_experiment(
     resume: str | None = None,
     db: str | None = None,
     command: str | None = None,
+    check_only: bool = False,
 ) -> PreparedExperiment:
     """Check the input and create the experiment in the database, or find the one to resume.
 
     `resume` (an id or name) continues a recorded experiment: the options given must match it
     (those left out are taken from it). A `name` that is recorded already resumes that
-    experiment when the options match. Raises `ExperimentInputError` for bad input,
+    experiment when the options match. With `check_only`, only checks: nothing is created and
+    the result's `record` is the experiment to resume or None. Raises `ExperimentInputError` for bad input,
     `pycram.trace.db.TraceDatabaseError` when the database cannot be used.
     """
     from pycram.experiments import store
@@ -230,6 +234,8 @@ def prepare_experiment(
                 "or choose another --name)"
             )
         record = existing
+    elif check_only:
+        return PreparedExperiment(None, entry, db, [], 0, False)
     else:
         record = store.create_experiment(
             db, name or _default_name(entry.name), entry.name, robot_list, seed_list, variants, command
@@ -427,51 +433,66 @@ def _traces_reachable(ray: Any, db: str | None) -> bool:
     return hosts <= {here}
 
 
+@contextlib.contextmanager
+def ray_session(address: str, workers: int = 2) -> Iterator[Any]:
+    """Connect to Ray for the block and yield the `ray` module: to the cluster at `address`
+    (`auto`, `HOST:PORT`, `ray://HOST:10001`), or, for `local`, to a new instance on this
+    machine with `workers` CPUs. A connection made here is closed at the end (a local instance
+    stops with it); an existing one (`ray.is_initialized()`) is used and left open.
+    Raises `RayUnavailable` when Ray is missing or the cluster cannot be reached."""
+    ray = _import_ray()
+    if ray.is_initialized():
+        yield ray
+        return
+    try:
+        if address == "local":
+            ray.init(
+                num_cpus=workers,
+                include_dashboard=False,
+                runtime_env=ray_runtime_env(),
+                logging_level=logging.WARNING,
+            )
+        else:
+            ray.init(address=address, logging_level=logging.WARNING)
+    except (ConnectionError, RuntimeError, ValueError) as e:
+        ray.shutdown()
+        raise RayUnavailable(f"cannot connect to the Ray cluster at {address!r}: {e}") from None
+    try:
+        yield ray
+    finally:
+        ray.shutdown()
+
+
 def _run_ray(
     prepared: PreparedExperiment, address: str, workers: int, stop: Any, finished: Callable, outcome: Any
 ) -> None:
-    ray = _import_ray()
-    started_here = False
-    if not ray.is_initialized():
-        try:
-            if address == "local":
-                ray.init(
-                    num_cpus=workers,
-                    include_dashboard=False,
-                    runtime_env=ray_runtime_env(),
-                    logging_level=logging.WARNING,
-                )
-            else:
-                ray.init(address=address, logging_level=logging.WARNING)
-        except (ConnectionError, RuntimeError, ValueError) as e:
-            raise RayUnavailable(f"cannot connect to the Ray cluster at {address!r}: {e}") from None
-        started_here = True
-    try:
-        record = _traces_reachable(ray, prepared.db)
-        if not record:
-            outcome.traced = False
-            log.warning(
-                "the trace database is a SQLite file on this machine, which Ray workers on other hosts cannot "
-                "write: the runs' traces are not recorded (their results are); use PostgreSQL (--db "
-                "postgresql://...) to record them"
-            )
-        task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
-        refs: dict[Any, RunKey] = {}
-        for key in prepared.todo:
-            refs[task.remote(prepared.scenario.name, key[0], key[1], key[2], prepared.db, record)] = key
-        cancelled = False
-        while refs:
-            ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.25, fetch_local=True)
-            for ref in ready:
-                key = refs.pop(ref)
-                finished(key, _ray_result(ray, ref, key, outcome))
-            if stop.requested and not cancelled:
-                cancelled = True
-                for ref in refs:
-                    ray.cancel(ref)
-    finally:
-        if started_here:
-            ray.shutdown()
+    with ray_session(address, workers) as ray:
+        _run_ray_tasks(ray, prepared, stop, finished, outcome)
+
+
+def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: Callable, outcome: Any) -> None:
+    record = _traces_reachable(ray, prepared.db)
+    if not record:
+        outcome.traced = False
+        log.warning(
+            "the trace database is a SQLite file on this machine, which Ray workers on other hosts cannot "
+            "write: the runs' traces are not recorded (their results are); use PostgreSQL (--db "
+            "postgresql://...) to record them"
+        )
+    task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
+    refs: dict[Any, RunKey] = {}
+    for key in prepared.todo:
+        refs[task.remote(prepared.scenario.name, key[0], key[1], key[2], prepared.db, record)] = key
+    cancelled = False
+    while refs:
+        ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.25, fetch_local=True)
+        for ref in ready:
+            key = refs.pop(ref)
+            finished(key, _ray_result(ray, ref, key, outcome))
+        if stop.requested and not cancelled:
+            cancelled = True
+            for ref in refs:
+                ray.cancel(ref)
 
 
 def _ray_result(ray: Any, ref: Any, key: RunKey, outcome: ExperimentOutcome) -> dict | None:
