@@ -742,7 +742,7 @@ def _run_experiment(prepared: Any, workers: int, ray: str | None, output: Path |
     ) as bar:
         job = bar.add_task("runs", total=len(prepared.todo))
 
-        def progress(key: tuple, result: dict | None) -> None:
+        def progress(key: tuple[str, int, str], result: dict[str, Any] | None) -> None:
             if result is not None:
                 counts["ok" if result.get("success") else "failed"] += 1
             bar.update(

@@ -42,7 +42,7 @@ class GroupSummary:
     errors: int = 0  # runs whose scenario raised
     sim_times: list[float] = field(default_factory=list)
     wall_times: list[float] = field(default_factory=list)
-    causes: Counter = field(default_factory=Counter)
+    causes: Counter[str] = field(default_factory=Counter)
 
     @property
     def success_rate(self) -> float:
@@ -106,7 +106,7 @@ def causes_table(groups: list[GroupSummary]) -> Any:
     per cause (a run with several causes counts for each), most frequent first."""
     from rich.table import Table
 
-    total: Counter = Counter()
+    total: Counter[str] = Counter()
     for g in groups:
         total.update(g.causes)
     table = Table(title="failure causes", header_style="bold")
@@ -170,7 +170,7 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
         ax_time.set_title("time per run")
         ax_time.legend(fontsize=8)
 
-        causes = Counter()
+        causes: Counter[str] = Counter()
         for g in groups:
             causes.update(g.causes)
         names = [c for c, _ in causes.most_common(12)]

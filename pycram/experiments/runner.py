@@ -252,7 +252,9 @@ def _variants_text(variants: Iterable[Iterable[str]]) -> str:
 # -- one run (in a worker process or a Ray task) --------------------------------------------------
 
 
-def execute_run(scenario: str, robot: str, seed: int, variant: str, db: str | None, record: bool = True) -> dict:
+def execute_run(
+    scenario: str, robot: str, seed: int, variant: str, db: str | None, record: bool = True
+) -> dict[str, Any]:
     """Run the scenario named `scenario` once and return its result (JSON-serialisable).
 
     Runs in a worker: the scenario is looked up by name or import path. An exception of the
@@ -289,7 +291,8 @@ def execute_run(scenario: str, robot: str, seed: int, variant: str, db: str | No
     result.setdefault("faults", sorted(faults))
     result.setdefault("wall_time", time.monotonic() - started)
     result["worker"] = f"{socket.gethostname()}:{os.getpid()}"
-    return json.loads(json.dumps(result, default=str))
+    clean: dict[str, Any] = json.loads(json.dumps(result, default=str))
+    return clean
 
 
 def _worker_init() -> None:
@@ -303,7 +306,7 @@ def _worker_init() -> None:
 # -- the driver ----------------------------------------------------------------------------------
 
 #: Called after each run: its key and its result (None when it did not finish).
-Progress = Callable[[RunKey, "dict | None"], None]
+Progress = Callable[[RunKey, "dict[str, Any] | None"], None]
 
 
 class _NoStop:
@@ -337,7 +340,7 @@ def run_experiment(
     record_id = prepared.record.id
     store.set_status(prepared.db, record_id, "running")
 
-    def finished(key: RunKey, result: dict | None) -> None:
+    def finished(key: RunKey, result: dict[str, Any] | None) -> None:
         if result is not None:
             store.record_run(prepared.db, record_id, key[0], key[1], key[2], result)
             outcome.recorded += 1
@@ -360,7 +363,7 @@ def run_experiment(
     return outcome
 
 
-def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: Callable, outcome: Any) -> None:
+def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: Progress, outcome: Any) -> None:
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
@@ -389,9 +392,10 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _future_result(future: Any, key: RunKey, outcome: ExperimentOutcome) -> dict | None:
+def _future_result(future: Any, key: RunKey, outcome: ExperimentOutcome) -> dict[str, Any] | None:
     try:
-        return future.result()
+        result: dict[str, Any] = future.result()
+        return result
     except (RunInterrupted, KeyboardInterrupt):
         return None
     except Exception as e:  # the worker died (BrokenProcessPool), or the result could not be sent
@@ -464,13 +468,13 @@ def ray_session(address: str, workers: int = 2) -> Iterator[Any]:
 
 
 def _run_ray(
-    prepared: PreparedExperiment, address: str, workers: int, stop: Any, finished: Callable, outcome: Any
+    prepared: PreparedExperiment, address: str, workers: int, stop: Any, finished: Progress, outcome: Any
 ) -> None:
     with ray_session(address, workers) as ray:
         _run_ray_tasks(ray, prepared, stop, finished, outcome)
 
 
-def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: Callable, outcome: Any) -> None:
+def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: Progress, outcome: Any) -> None:
     record = _traces_reachable(ray, prepared.db)
     if not record:
         outcome.traced = False
@@ -495,9 +499,10 @@ def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: 
                 ray.cancel(ref)
 
 
-def _ray_result(ray: Any, ref: Any, key: RunKey, outcome: ExperimentOutcome) -> dict | None:
+def _ray_result(ray: Any, ref: Any, key: RunKey, outcome: ExperimentOutcome) -> dict[str, Any] | None:
     try:
-        return ray.get(ref)
+        result: dict[str, Any] = ray.get(ref)
+        return result
     except (ray.exceptions.TaskCancelledError, KeyboardInterrupt):
         return None
     except ray.exceptions.RayTaskError as e:

@@ -161,7 +161,7 @@ def _import_target(path: str, name: str) -> ScenarioFunction:
                 f"exist (yet); available scenarios: {available}"
             ) from None
         raise UnknownScenario(f"scenario {name!r} cannot be imported ({module_name}): {e}") from None
-    function = getattr(module, attribute, None)
+    function: ScenarioFunction | None = getattr(module, attribute, None)
     if not callable(function):
         raise UnknownScenario(
             f"scenario {name!r}: {module_name} has no function {attribute!r}; available scenarios: {available}"
