@@ -673,8 +673,11 @@ def experiment_command(
     ),
     db: str | None = DbOption,
 ) -> None:
-    """Run a scenario for many robots, seeds and fault variants in parallel, headless; record every
-    run in the trace database; print success rates, failure causes and times; write a plot.
+    """Run a scenario over many robots, seeds and faults in parallel; report success and times.
+
+    Each run is headless and recorded in the trace database; at the end a table shows the
+    success rate per robot and variant, the failure causes and the simulated and wall time
+    (p50/p95), and a plot is written.
 
     Ctrl-C stops it: the runs under way finish and are recorded (a second Ctrl-C exits at once);
     `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when

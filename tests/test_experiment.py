@@ -254,3 +254,20 @@ def _run_inline(prepared, workers, stop, finished, outcome):
     for robot, seed, variant in prepared.todo:
         result = experiment_runner.execute_run(prepared.scenario.name, robot, seed, variant, prepared.db)
         finished((robot, seed, variant), result)
+
+
+@pytest.mark.skipif(
+    not os.environ.get("PYCRAM_TEST_POSTGRES_URL"),
+    reason="PYCRAM_TEST_POSTGRES_URL is not set (.ci/run sets it; start a server with scripts/start_test_postgres.sh)",
+)
+def test_an_experiment_in_postgresql(tmp_path):
+    """The experiment's tables and resuming work in PostgreSQL as in SQLite."""
+    url = os.environ["PYCRAM_TEST_POSTGRES_URL"]
+    name = f"pg-{os.getpid()}-{time.time_ns()}"
+    args = ["experiment", "--scenario", DOUBLE, "--robot", "pr2,tiago", "--seeds", "1-6", "--faults", "drop"]
+    args += ["--name", name, "--db", url, "--output", str(tmp_path / "out"), "--workers", "2"]
+    first = runner.invoke(app, args)
+    assert first.exit_code == 0, first.output
+    assert "66.7 % (4)" in " ".join(first.output.split())
+    again = runner.invoke(app, args)
+    assert again.exit_code == 0 and "12 recorded before, 0 to run" in " ".join(again.output.split())
