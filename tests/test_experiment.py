@@ -252,7 +252,7 @@ def _run_inline(prepared, workers, stop, finished, outcome):
     from pycram.experiments import runner as experiment_runner
 
     for robot, seed, variant in prepared.todo:
-        result = experiment_runner.execute_run(prepared.scenario.name, robot, seed, variant, prepared.db)
+        result = experiment_runner.execute_run(prepared.scenario.spec, robot, seed, variant, prepared.db)
         finished((robot, seed, variant), result)
 
 
@@ -271,3 +271,25 @@ def test_an_experiment_in_postgresql(tmp_path):
     assert "66.7 % (4)" in " ".join(first.output.split())
     again = runner.invoke(app, args)
     assert again.exit_code == 0 and "12 recorded before, 0 to run" in " ".join(again.output.split())
+
+
+def test_a_scenario_registered_in_the_driver_runs_in_the_workers(tmp_path):
+    """Workers find a registered callable by its import path: no registration there."""
+    from pycram.experiments.scenarios import SCENARIOS, register_scenario
+    from pycram.testing import scenario_double
+
+    register_scenario("double", scenario_double, faults=("drop", "slow"))
+    try:
+        assert SCENARIOS["double"].spec == "pycram.testing:scenario_double"
+        db = tmp_path / "t.sqlite3"
+        result = runner.invoke(
+            app,
+            ["experiment", "--scenario", "double", "--seeds", "1-3", "--faults", "slow"]
+            + ["--db", str(db), "--output", str(tmp_path / "out")],
+        )
+        assert result.exit_code == 0, result.output
+        runs = _rows(db, "pycram_experiment_runs")
+        assert [r["sim_time"] for r in sorted(runs, key=lambda r: r["seed"])] == [22.0, 24.0, 26.0]
+        assert _rows(db, "pycram_experiments")[0]["scenario"] == "double"
+    finally:
+        SCENARIOS.pop("double", None)

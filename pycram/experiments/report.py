@@ -82,7 +82,7 @@ def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
 
     table = Table(title=title or None, header_style="bold")
     table.add_column("robot")
-    table.add_column("faults")
+    table.add_column("faults", overflow="fold")
     for name in ("runs", "success", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
         table.add_column(name, justify="right", no_wrap=True)
     for g in groups:
@@ -112,7 +112,7 @@ def causes_table(groups: list[GroupSummary]) -> Any:
     table = Table(title="failure causes", header_style="bold")
     table.add_column("cause")
     for g in groups:
-        table.add_column(f"{g.robot}\nfaults: {variant_label(g.variant)}", justify="right")
+        table.add_column(f"{g.robot}\nfaults: {variant_label(g.variant)}", justify="right", overflow="fold")
     for cause, _ in total.most_common():
         table.add_row(cause, *(str(g.causes.get(cause, 0)) for g in groups))
     if not total:

@@ -372,7 +372,7 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
     futures: dict[Any, RunKey] = {}
     try:
         for key in prepared.todo:
-            future = pool.submit(execute_run, prepared.scenario.name, key[0], key[1], key[2], prepared.db, True)
+            future = pool.submit(execute_run, prepared.scenario.spec, key[0], key[1], key[2], prepared.db, True)
             futures[future] = key
         pending = set(futures)
         stopping = False
@@ -486,7 +486,7 @@ def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: 
     task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
     refs: dict[Any, RunKey] = {}
     for key in prepared.todo:
-        refs[task.remote(prepared.scenario.name, key[0], key[1], key[2], prepared.db, record)] = key
+        refs[task.remote(prepared.scenario.spec, key[0], key[1], key[2], prepared.db, record)] = key
     cancelled = False
     while refs:
         ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.25, fetch_local=True)

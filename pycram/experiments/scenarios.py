@@ -16,8 +16,9 @@ not finished: a resumed experiment runs it again).
 Scenarios are registered by name, either as a callable or lazily as an import path
 `"package.module:function"` that is imported only when the scenario is used (so a scenario
 whose module does not exist yet costs nothing until then). `--scenario` also takes such an
-import path directly. Worker processes and Ray tasks look the scenario up by the same *spec*
-(name or import path), never by pickling a closure.
+import path directly. Worker processes and Ray tasks look the scenario up by its import path
+(`Scenario.spec`), never by pickling a closure: a module-level function is found there even
+when it was registered only in the driver.
 """
 
 from __future__ import annotations
@@ -88,6 +89,19 @@ class Scenario:
         if callable(self.target):
             return self.target
         return _import_target(self.target, self.name)
+
+    @property
+    def spec(self) -> str:
+        """How worker processes and Ray tasks find the scenario: its import path
+        (`"module:function"`) when it has one — so that a scenario registered at run time in
+        the driver needs no registration in the workers — else its name."""
+        if isinstance(self.target, str):
+            return self.target
+        module = getattr(self.target, "__module__", None)
+        qualname = getattr(self.target, "__qualname__", "")
+        if module and module != "__main__" and qualname and "<" not in qualname:
+            return f"{module}:{qualname}"
+        return self.name
 
     def known_faults(self) -> tuple[str, ...] | None:
         """The fault names the scenario accepts: `faults`, else the `FAULTS` attribute of its
