@@ -109,9 +109,13 @@ def test_thesis_on_local_ray(tmp_path, local_ray):
     result = runner.invoke(
         app,
         ["experiment", "--scenario", "thesis", "--robot", "pr2", "--seeds", "1-4", "--ray", "auto"]
-        + ["--db", str(db), "--output", str(out)],
+        + ["--faults", "misplaced,steal", "--db", str(db), "--output", str(out)],
     )
     _check_thesis_experiment(db, out, result)
+    # the faults happened, and the plan recovered from them: grasps failed, the mug was taken
+    results = [json.loads(r["result"]) for r in _rows(db, "pycram_experiment_runs")]
+    assert all(r["faults"] == ["misplaced", "steal"] and r["failed_grasps"] >= 1 for r in results), results
+    assert all(r["recoveries"] >= 1 and r["objects"]["mug"]["placed"] for r in results), results
     assert local_ray.is_initialized()  # a connection the caller made is left open
     # the runs ran in Ray's worker processes, not here
     workers = {json.loads(r["result"])["worker"] for r in _rows(db, "pycram_experiment_runs")}
