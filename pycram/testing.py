@@ -8,6 +8,9 @@ doubles so that nobody mistakes them for real robot code.
   cancel-hook calls.
 - :class:`CountingGenerator` is a resolver solution that counts how far it was advanced (to
   prove lazy resolution).
+- :func:`scenario_double` is an experiment scenario (`pycram experiment --scenario
+  pycram.testing:scenario_double`) that runs no simulation: a scripted result per seed in a few
+  milliseconds, for testing experiment machinery.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from pycram.process_module import ProcessModule
 from pycram.runtime import wait_until
 from pycram.runtime.evaporation import runtime_code
 
-__all__ = ["ScriptedProcessModule", "CountingGenerator"]
+__all__ = ["ScriptedProcessModule", "CountingGenerator", "scenario_double", "SCENARIO_DOUBLE_FAULTS"]
 
 
 class ScriptedProcessModule(ProcessModule):
@@ -160,3 +163,67 @@ class CountingGenerator:
         for item in self._items:
             self.advanced += 1
             yield item
+
+
+#: The faults `scenario_double` knows.
+SCENARIO_DOUBLE_FAULTS = ("drop", "slow")
+
+
+def scenario_double(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    db_url: str | None = None,
+    pictures: bool = False,
+) -> dict[str, Any]:
+    """A scripted experiment scenario (no simulation): the result of a `pycram experiment` run.
+
+    Succeeds unless `"drop"` is among `faults` and the seed is divisible by 3 (then the cause is
+    `ObjectSlipped`); `sim_time` is 10 + seed % 7 [s] (twice that with `"slow"`). Knows the
+    robots pr2 and tiago and the faults in `SCENARIO_DOUBLE_FAULTS` (`ValueError` otherwise).
+    For tests across processes it reads two environment variables: with
+    `$PYCRAM_SCENARIO_DOUBLE_LOG` set it appends "robot seed variant" to that file for every run;
+    when `$PYCRAM_SCENARIO_DOUBLE_INTERRUPT` is the seed, it sends SIGINT to its parent process
+    when that is a `pycram` process (the experiment's driver, for a local worker; never a Ray
+    worker's parent) before returning: a deterministic Ctrl-C.
+    """
+    import os
+    import signal
+    import time
+
+    started = time.monotonic()
+    if robot not in ("pr2", "tiago"):
+        raise ValueError(f"unknown robot {robot!r}; available robots: pr2, tiago")
+    unknown = sorted(set(faults) - set(SCENARIO_DOUBLE_FAULTS))
+    if unknown:
+        raise ValueError(f"unknown fault(s) {', '.join(unknown)}; known: {', '.join(SCENARIO_DOUBLE_FAULTS)}")
+    variant = ",".join(sorted(faults))
+    log_file = os.environ.get("PYCRAM_SCENARIO_DOUBLE_LOG")
+    if log_file:
+        with open(log_file, "a", encoding="utf-8") as f:
+            f.write(f"{robot} {seed} {variant or '-'}\n")
+    failed = "drop" in faults and seed % 3 == 0
+    sim_time = (10.0 + seed % 7) * (2.0 if "slow" in faults else 1.0)
+    time.sleep(0.02)
+    if os.environ.get("PYCRAM_SCENARIO_DOUBLE_INTERRUPT") == str(seed):
+        parent = os.getppid()
+        try:
+            with open(f"/proc/{parent}/cmdline", "rb") as f:
+                is_driver = b"pycram" in f.read()
+        except OSError:
+            is_driver = False
+        if is_driver:  # a local worker's parent is the experiment's driver; a Ray worker's is not
+            os.kill(parent, signal.SIGINT)
+    return {
+        "robot": robot,
+        "seed": seed,
+        "faults": sorted(faults),
+        "success": not failed,
+        "objects": {"cup": {"placed": not failed, "failure": "ObjectSlipped" if failed else None, "reason": None}},
+        "failure_causes": ["ObjectSlipped"] if failed else [],
+        "sim_time": sim_time,
+        "wall_time": time.monotonic() - started,
+    }
+
+
+scenario_double.FAULTS = SCENARIO_DOUBLE_FAULTS  # type: ignore[attr-defined]  # read by the experiment runner

@@ -66,6 +66,7 @@ class DemoOptions:
     record: bool = True
     quiet: bool = False
     animation: bool = True  # record run.gif (False: no animation, a faster run)
+    pictures: bool = True  # write start/end snapshots and the run's pictures (False: none, no folder)
     backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
 
 
@@ -193,7 +194,8 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
     result = DemoResult(exit_code=1, message="", output=output, run_id=run_id)
     error: BaseException | None = None
     try:
-        output.mkdir(parents=True, exist_ok=True)
+        if options.pictures:
+            output.mkdir(parents=True, exist_ok=True)
         _run_in_world(options, result, recorder, stop)
     except BaseException as exc:
         error = exc
@@ -211,7 +213,7 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
                 reason = f"{type(error).__name__}: {error}"
             result.run_id = recorder.finish(outcome, reason)
             result.trace_loss = recorder.loss_report()
-    if recorder is not None:
+    if recorder is not None and options.pictures:
         result.files.extend(_write_run_pictures(result, recorder))
     return result
 
@@ -288,12 +290,13 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
             recorder.set_run_info(robot=options.robot)
             for fluent in (plan.phase, world.base_pose):
                 recorder.watch(fluent, fluent.name, max_rate_hz=5.0)
-        world.snapshot(output / "start.png", camera=camera)
-        result.files.append(output / "start.png")
+        if options.pictures:
+            world.snapshot(output / "start.png", camera=camera)
+            result.files.append(output / "start.png")
         plan.forget_state()
         story = _Story(plan, thief, stop)
         add_task_listener(story)
-        if options.animation:
+        if options.animation and options.pictures:
             world.start_recording(
                 camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1], caption=story.caption
             )
@@ -309,10 +312,11 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         result.failed_grasps = failed_grasps(run.task)
         result.recoveries = recoveries(run.task)
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
-        world.snapshot(output / "end.png", camera=camera)
-        result.files.append(output / "end.png")
+        if options.pictures:
+            world.snapshot(output / "end.png", camera=camera)
+            result.files.append(output / "end.png")
         # the recorder may lag behind on a busy machine: let it finish rather than lose the end
-        frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation else []
+        frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation and options.pictures else []
         if result.item_on_cooker_1:
             result.exit_code, result.message = 0, "the item rests on cooker #1"
         elif not result.message:

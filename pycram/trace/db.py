@@ -53,13 +53,16 @@ __all__ = [
     "designators_table",
     "executions_table",
     "fluent_samples_table",
+    "experiments_table",
+    "experiment_runs_table",
     "present_columns",
     "SUPPORTED_KINDS",
 ]
 
 #: 2: `pycram_tasks.error_origin`, `pycram_runs.clock` and `pycram_runs.lost_records`; 3:
-#: `pycram_tasks.location` (added to older databases on connect).
-SCHEMA_VERSION = 3
+#: `pycram_tasks.location` (added to older databases on connect); 4: the tables
+#: `pycram_experiments` and `pycram_experiment_runs` (`pycram experiment`; created on connect).
+SCHEMA_VERSION = 4
 
 #: Database kinds (SQLAlchemy backend names) that can hold run traces.
 SUPPORTED_KINDS = ("sqlite", "postgresql")
@@ -248,6 +251,47 @@ fluent_samples_table = sa.Table(
     sa.Column("number", sa.Float),  # the value as a number, when it is one
 )
 sa.Index("ix_pycram_fluent_samples_run_name", fluent_samples_table.c.run_id, fluent_samples_table.c.name)
+
+
+#: One row per experiment (`pycram experiment`): its name, scenario, robots, seeds and variants.
+experiments_table = sa.Table(
+    "pycram_experiments",
+    metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("name", sa.String(255), nullable=False, unique=True),
+    sa.Column("scenario", sa.String(512), nullable=False),  # registry name or `module:function`
+    sa.Column("robots", sa.Text, nullable=False),  # JSON list of robot names
+    sa.Column("seeds", sa.Text, nullable=False),  # JSON list of seeds
+    sa.Column("variants", sa.Text, nullable=False),  # JSON list of variants (lists of fault names)
+    sa.Column("created_at", sa.DateTime(timezone=True), nullable=False),
+    sa.Column("updated_at", sa.DateTime(timezone=True)),
+    sa.Column("status", sa.String(32)),  # "running", "interrupted", "finished"
+    sa.Column("host", sa.String(255)),
+    sa.Column("command", sa.Text),
+    sa.Column("info", sa.Text),  # JSON object of extra metadata
+)
+
+#: One row per finished run of an experiment: robot, seed, variant and the scenario's result.
+experiment_runs_table = sa.Table(
+    "pycram_experiment_runs",
+    metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("experiment_id", sa.Integer, sa.ForeignKey("pycram_experiments.id", ondelete="CASCADE"), nullable=False),
+    sa.Column("robot", sa.String(255), nullable=False),
+    sa.Column("seed", sa.Integer, nullable=False),
+    sa.Column("variant", sa.String(512), nullable=False),  # sorted fault names joined by ",", "" for none
+    sa.Column("status", sa.String(16), nullable=False),  # "done", or "error" when the scenario raised
+    sa.Column("success", sa.Boolean, nullable=False),
+    sa.Column("failure_causes", sa.Text),  # JSON list of failure type names
+    sa.Column("sim_time", sa.Float),  # [s]
+    sa.Column("wall_time", sa.Float),  # [s]
+    sa.Column("trace_run_id", sa.Integer),  # the run's trace in `pycram_runs`, when it was recorded
+    sa.Column("error", sa.Text),  # why the scenario raised (status "error")
+    sa.Column("result", sa.Text),  # the scenario's whole result (JSON)
+    sa.Column("worker", sa.String(255)),  # host:pid that ran it
+    sa.Column("finished_at", sa.DateTime(timezone=True)),
+    sa.UniqueConstraint("experiment_id", "robot", "seed", "variant", name="uq_pycram_experiment_runs_key"),
+)
 
 
 def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
