@@ -446,8 +446,14 @@ def ensure_schema(engine: Engine) -> None:
             metadata.create_all(engine, checkfirst=True)
             break
         except (sa_exc.IntegrityError, sa_exc.ProgrammingError, sa_exc.OperationalError) as e:
+            text = str(e).lower()
+            if "readonly" in text or "read-only" in text:
+                # a database opened read-only cannot get the tables a newer schema added (e.g.
+                # the experiment tables): reading what it has still works
+                log.warning("trace database %s is read-only: tables of a newer schema not created", engine.url)
+                break
             # another process created a table between our check and our CREATE
-            if attempt == 2 or "already exists" not in str(e).lower() and "duplicate" not in str(e).lower():
+            if attempt == 2 or "already exists" not in text and "duplicate" not in text:
                 raise
             log.debug("schema creation raced with another process; retrying: %s", e)
     _add_missing_columns(engine)
@@ -470,6 +476,8 @@ def present_columns(engine: Engine, table: sa.Table) -> frozenset[str]:
 def _add_missing_columns(engine: Engine) -> None:
     """ALTER TABLE ... ADD COLUMN for every column of `metadata` an existing table lacks."""
     for table in metadata.sorted_tables:
+        if not sa.inspect(engine).has_table(table.name):
+            continue  # a read-only database without a table of a newer schema: nothing to add to
         for attempt in range(2):
             _present.get(engine, {}).pop(table.name, None)
             missing = [c for c in table.columns if c.name not in present_columns(engine, table)]
