@@ -41,6 +41,7 @@ import rospy
 from pycram.ros.config import RosRobotConfig
 from pycram.ros.detections import detections_message
 from pycram.ros.ros1 import message_class
+from pycram.sim.perception import PerceptionFaults
 from pycram.sim.types import Outcome, Pose2D, Vec3
 
 __all__ = ["SimRosBridge"]
@@ -390,18 +391,26 @@ def run_bridge(
     publish_rate: float = 50.0,
     detection_rate: float = 2.0,
     ready: Callable[[], None] | None = None,
+    perception_faults: PerceptionFaults | None = None,
 ) -> None:
     """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the demo kitchen with
     ``robot`` and the demo's mug at slot ``item_at`` (0: no item), at ``base_pose`` (default the
-    demo's start). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once
-    everything is served."""
+    demo's start), the head camera's object perception with ``perception_faults`` (none by
+    default). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once everything
+    is served."""
     from pycram.demos.kitchen_world import START_POSE, demo_items
     from pycram.ros.config import robot_config
     from pycram.sim import World
 
     config = robot_config(robot)
     rospy.init_node("sim_ros_bridge", disable_signals=False)
-    world = World(robot, demo_items(item_at), base_pose=cast(Vec3, tuple(base_pose or START_POSE)), realtime=realtime)
+    world = World(
+        robot,
+        demo_items(item_at),
+        base_pose=cast(Vec3, tuple(base_pose or START_POSE)),
+        realtime=realtime,
+        perception_faults=perception_faults,
+    )
     bridge = None
     try:
         bridge = SimRosBridge(world, config, publish_rate, detection_rate)
