@@ -592,9 +592,20 @@ def sim_ros_bridge_command(
     allow_remote_master: bool = typer.Option(
         False, "--allow-remote-master", help="Accept a ROS_MASTER_URI that is not on loopback."
     ),
+    pose_noise: float = typer.Option(
+        0.0, "--pose-noise", min=0.0, help="Perception fault: std. dev. of the noise on measured centres [m]."
+    ),
+    miss_probability: float = typer.Option(
+        0.0, "--miss-probability", min=0.0, max=1.0, help="Perception fault: probability that a seen object is missed."
+    ),
+    wrong_color_probability: float = typer.Option(
+        0.0, "--wrong-color-probability", min=0.0, max=1.0, help="Perception fault: probability of a wrong colour."
+    ),
+    perception_seed: int = typer.Option(0, "--perception-seed", help="Seed of the perception faults."),
 ) -> None:
     """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
-    /amcl_pose, /joint_states, /clock), as a real robot's drivers would. Needs ROS_MASTER_URI."""
+    /amcl_pose, /joint_states, /clock, the head camera's detections), as a real robot's drivers
+    would. Needs ROS_MASTER_URI."""
     if robot not in ("pr2", "tiago"):
         _fail(f"--robot must be 'pr2' or 'tiago', not {robot!r}", code=2)
     try:
@@ -608,12 +619,14 @@ def sim_ros_bridge_command(
     os.environ["ROS_IP"] = os.environ["ROS_HOSTNAME"] = host
     os.environ.setdefault("MUJOCO_GL", "egl")
     from pycram.ros.bridge import run_bridge
+    from pycram.sim.perception import PerceptionFaults
 
     run_bridge(
         robot,
         item_at=item_at,
         realtime=realtime,
         publish_rate=publish_rate,
+        perception_faults=PerceptionFaults(pose_noise, miss_probability, wrong_color_probability, perception_seed),
         ready=lambda: print(f"sim-ros-bridge ready: {robot} on {os.environ['ROS_MASTER_URI']}", flush=True),
     )
 

@@ -49,6 +49,7 @@ __all__ = [
     "PerceptionModule",
     "SimRobot",
     "cancel_running_handle",
+    "seen_objects",
     "shutdown_modules",
 ]
 
@@ -387,22 +388,30 @@ class PerceptionModule(SimProcessModule):
         self.last_update: Any = None
 
     def _execute(self, designator: Any) -> Any:
-        from pycram.designators.object import ObjectDesignator
-
         solution = designator.reference()
         _check_cmd(self, solution, "perceive")
         report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
         update = self.last_update = self.belief.update(report)
-        seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
-        wanted = solution.get("object")
-        if wanted is None:
-            return seen
-        if isinstance(wanted, ObjectDesignator):
-            matching = [obj for obj in seen if wanted.matches(obj)]
-            if matching:
-                wanted.perceived(matching[0], timestamp=report.stamp)
-            return matching
-        return [obj for obj in seen if wanted in (obj.name, obj.type)]
+        return seen_objects(update, solution.get("object"), report.stamp)
+
+
+def seen_objects(update: Any, wanted: Any, stamp: float) -> list[Any]:
+    """What a ``detecting`` motion returns, on every backend: the believed objects seen in one
+    look (``update``, a :class:`pycram.world.belief.BeliefUpdate`), most visible first,
+    restricted by ``wanted`` when given -- a type or belief name, or an object designator, whose
+    best match is then recorded with ``designator.perceived(obj, timestamp=stamp)`` (``stamp``
+    [s]: the look's time)."""
+    from pycram.designators.object import ObjectDesignator
+
+    seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
+    if wanted is None:
+        return seen
+    if isinstance(wanted, ObjectDesignator):
+        matching = [obj for obj in seen if wanted.matches(obj)]
+        if matching:
+            wanted.perceived(matching[0], timestamp=stamp)
+        return matching
+    return [obj for obj in seen if wanted in (obj.name, obj.type)]
 
 
 def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:

@@ -9,7 +9,9 @@ Layout (one concept per module; ``rospy`` is imported only by :mod:`pycram.ros.r
 * :mod:`pycram.ros.config` -- per-robot interface names (PR2's real names, TIAGo's), as data.
 * :mod:`pycram.ros.modules` -- the process modules (navigation, head, torso, arms, grippers,
   perception) and the sensor fluents.
-* :mod:`pycram.ros.robot` -- :func:`~pycram.ros.robot.make_ros_robot`.
+* :mod:`pycram.ros.detections` -- perception reports as detections messages and back (the
+  ROS perception module folds them into the robot's belief).
+* :mod:`pycram.ros.robot` -- :func:`~pycram.ros.robot.make_ros_robot` (with a belief state).
 * :mod:`pycram.ros.bridge` -- ``pycram sim-ros-bridge``: the simulator served over ROS.
 * :mod:`pycram.ros.launch` -- roscore and the bridge as subprocesses, on loopback.
 * :mod:`pycram.ros.sim_environment` -- the demo's simulated environment (items, the helper's

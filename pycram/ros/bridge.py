@@ -15,8 +15,11 @@ A ROS 1 node that runs a :class:`pycram.sim.World` and serves, under the names o
   base_footprint on ``/tf``), ``/joint_states`` (gripper openings as
   the configured opening joints), and ``<sim_namespace>/items`` (simulator ground truth:
   where each item is and which gripper holds it -- for judging runs, never for plans).
-  ``detections_topic``: the items the head camera sees, at ``detection_rate`` [Hz], only while
-  somebody subscribes (rendering costs CPU).
+  ``detections_topic``: what the head camera's object perception measures (type, centre, size,
+  colour, support and container of each object seen, the camera view with its depth image --
+  :meth:`pycram.sim.World.detect`, the world's perception faults included; no simulator names
+  or true poses), at ``detection_rate`` [Hz], only while somebody subscribes (rendering costs
+  CPU).
 * service ``<sim_namespace>/command`` (pycram_msgs/SimCommand): the environment's hands
   (``take_item``, ``give_item``) and pictures (``snapshot``).
 
@@ -36,7 +39,9 @@ import actionlib
 import rospy
 
 from pycram.ros.config import RosRobotConfig
+from pycram.ros.detections import detections_message
 from pycram.ros.ros1 import message_class
+from pycram.sim.perception import PerceptionFaults
 from pycram.sim.types import Outcome, Pose2D, Vec3
 
 __all__ = ["SimRosBridge"]
@@ -305,25 +310,18 @@ class SimRosBridge:
         self._items_pub.publish(items)
 
     def _publish_detections(self) -> None:
+        """One look of the head camera (:meth:`pycram.sim.World.detect`: measured detections,
+        the world's perception faults included, no simulator names or true poses) as a
+        ``pycram_msgs/DetectedItems``, stamped with the simulated time of the image."""
         if self._detections_pub.get_num_connections() == 0:
             return
-        outcome = self.world.perceive().wait(10.0)
+        outcome = self.world.detect().wait(10.0)
         if outcome is None or not outcome.succeeded:
             return
-        message = message_class("pycram_msgs/DetectedItems")()
-        message.header.stamp = rospy.Time.from_sec(self.world.sim_time.get_value())
-        message.header.frame_id = self.config.map_frame
-        message.items = [
-            message_class("pycram_msgs/DetectedItem")(
-                name=v.name,
-                type=v.type,
-                pose=_pose_msg(v.pose),
-                pixels=int(v.pixels),
-                u=float(v.centroid[0]),
-                v=float(v.centroid[1]),
-            )
-            for v in outcome.value
-        ]
+        report = outcome.value
+        message = detections_message(report, lambda t, **f: message_class(t)(**f), self.config.map_frame)
+        message.header.stamp = rospy.Time.from_sec(report.stamp)
+        message.depth.header.stamp = message.header.stamp
         self._detections_pub.publish(message)
 
     # -- the environment's hands ----------------------------------------------------------------
@@ -393,18 +391,26 @@ def run_bridge(
     publish_rate: float = 50.0,
     detection_rate: float = 2.0,
     ready: Callable[[], None] | None = None,
+    perception_faults: PerceptionFaults | None = None,
 ) -> None:
     """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the demo kitchen with
     ``robot`` and the demo's mug at slot ``item_at`` (0: no item), at ``base_pose`` (default the
-    demo's start). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once
-    everything is served."""
+    demo's start), the head camera's object perception with ``perception_faults`` (none by
+    default). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once everything
+    is served."""
     from pycram.demos.kitchen_world import START_POSE, demo_items
     from pycram.ros.config import robot_config
     from pycram.sim import World
 
     config = robot_config(robot)
     rospy.init_node("sim_ros_bridge", disable_signals=False)
-    world = World(robot, demo_items(item_at), base_pose=cast(Vec3, tuple(base_pose or START_POSE)), realtime=realtime)
+    world = World(
+        robot,
+        demo_items(item_at),
+        base_pose=cast(Vec3, tuple(base_pose or START_POSE)),
+        realtime=realtime,
+        perception_faults=perception_faults,
+    )
     bridge = None
     try:
         bridge = SimRosBridge(world, config, publish_rate, detection_rate)

@@ -9,7 +9,8 @@ evaporably, on the goal's ``result`` fluent.
 Guarantees
 ----------
 - Same results as the simulated modules: the reached ``Pose2D`` (navigation), the reached tool
-  ``Pose`` (reach), the measured opening [m] (gripper), a list of ``VisibleItem`` (perception).
+  ``Pose`` (reach), the measured opening [m] (gripper), the believed objects seen
+  (``PerceivedObject``, perception; the robot's belief is updated as in-process).
 - A failed goal raises :class:`~pycram.ros.transport.RosMotionFailed` naming the command, the
   action and the robot's reason (the simulator's outcome reason behind the bridge:
   ``collision``, ``unreachable``, ...). A goal that does not end within its time-out [s of the
@@ -35,10 +36,12 @@ from typing import Any
 
 from pycram.fluent import Fluent
 from pycram.process_module import ProcessModule
-from pycram.robots.sim_modules import _check_cmd, _fmt, _fmt_pose2d, cancel_running_handle
+from pycram.robots.sim_modules import _check_cmd, _fmt, _fmt_pose2d, cancel_running_handle, seen_objects
 from pycram.ros.config import RosRobotConfig
+from pycram.ros.detections import report_of
 from pycram.ros.transport import ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed, Transport
-from pycram.sim.types import Pose, Pose2D, VisibleItem
+from pycram.sim.types import Pose, Pose2D
+from pycram.world.belief import BeliefState, BeliefUpdate
 
 __all__ = [
     "MessageCounter",
@@ -445,14 +448,35 @@ class RosGripperModule(RosProcessModule):
 
 
 class RosPerceptionModule(RosProcessModule):
-    """``'cmd': 'perceive'``: the items of a detections message sampled after the request (most
-    visible first), restricted to ``'object'`` (name or type) when given. Fails with reason
-    ``'timeout'`` when no detections arrive within 10 s (wall time)."""
+    """``'cmd': 'perceive'``: one look, from the detections topic, folded into the robot's belief
+    exactly as the in-process :class:`pycram.robots.sim_modules.PerceptionModule` does.
+
+    Takes the first ``pycram_msgs/DetectedItems`` message whose image was taken after the
+    request (the second message from then on: the first may show the scene from before it),
+    turns it into a :class:`~pycram.world.belief.PerceptionReport`
+    (:func:`pycram.ros.detections.report_of`, stamped with the message's ``header.stamp``) and
+    calls ``belief.update`` (a :class:`~pycram.world.belief.BeliefState`): new objects are
+    added, seen ones refreshed, believed ones that the view says should have been seen but were
+    not are marked gone. Returns the believed objects seen (``PerceivedObject``, most visible
+    first), restricted by ``'object'`` when given (a type, a belief name or an object
+    designator, see :func:`~pycram.robots.sim_modules.seen_objects`); the look's
+    :class:`~pycram.world.belief.BeliefUpdate` is kept in ``last_update``. Fails with reason
+    ``'timeout'`` when no detections arrive within ``timeout`` [s, wall time].
+    """
 
     def __init__(
-        self, transport: Transport, config: RosRobotConfig, state: RosRobotState, name: str = "perception"
+        self,
+        transport: Transport,
+        config: RosRobotConfig,
+        state: RosRobotState,
+        belief: BeliefState,
+        name: str = "perception",
+        timeout: float = 10.0,
     ) -> None:
         super().__init__(name, transport, config, state)
+        self.belief = belief
+        self.timeout = timeout
+        self.last_update: BeliefUpdate | None = None
         self.detections = MessageCounter()
         self._subscription: Any = None  # subscribed on first use: the bridge renders only for subscribers
 
@@ -464,23 +488,17 @@ class RosPerceptionModule(RosProcessModule):
                 self.config.detections_topic, "pycram_msgs/DetectedItems", self.detections.tick
             )
         # the second message from now: the first may show the scene from before the request
-        if not self.detections.wait_for_count(self.detections.count + 2, 10.0):
+        if not self.detections.wait_for_count(self.detections.count + 2, self.timeout):
             raise RosMotionFailed(
-                "perceive", "timeout", f"no detections on {self.config.detections_topic} within 10.0 s"
+                "perceive", "timeout", f"no detections on {self.config.detections_topic} within {self.timeout:.1f} s"
             )
         message = self.detections.latest
-        items = [
-            VisibleItem(
-                i.name,
-                i.type,
-                Pose(
-                    (i.pose.position.x, i.pose.position.y, i.pose.position.z),
-                    (i.pose.orientation.w, i.pose.orientation.x, i.pose.orientation.y, i.pose.orientation.z),
-                ),
-                int(i.pixels),
-                (float(i.u), float(i.v)),
-            )
-            for i in message.items
-        ]
-        wanted = solution.get("object")
-        return items if wanted is None else [i for i in items if wanted in (i.name, i.type)]
+        report = report_of(message, self.transport.time_to_seconds(message.header.stamp))
+        update = self.last_update = self.belief.update(report)
+        return seen_objects(update, solution.get("object"), report.stamp)
+
+    def close(self) -> None:
+        """End the detections subscription (idempotent)."""
+        subscription, self._subscription = self._subscription, None
+        if subscription is not None:
+            subscription.close()

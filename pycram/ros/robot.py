@@ -19,23 +19,34 @@ from pycram.robots.sim_vocabulary import motion_types
 from pycram.ros import modules as rm
 from pycram.ros.config import RosRobotConfig, robot_config
 from pycram.ros.transport import Transport
+from pycram.world.belief import BeliefState
 
 __all__ = ["RosRobot", "make_ros_robot"]
 
 
 class RosRobot(Robot):
     """A :class:`~pycram.robot.Robot` driven over ROS. ``state`` holds its sensor fluents
-    (:class:`~pycram.ros.modules.RosRobotState`); :meth:`shutdown` ends subscriptions and takes
-    the modules offline (idempotent)."""
+    (:class:`~pycram.ros.modules.RosRobotState`); ``belief`` (a
+    :class:`~pycram.world.belief.BeliefState` of the configured environment) what it perceived,
+    filled by its ``detecting`` motion from the detections topic and read by its object resolver,
+    as on the simulated robot. No prospection over ROS (``prospection`` is None).
+    :meth:`shutdown` ends subscriptions and takes the modules offline (idempotent)."""
 
     def __init__(
         self, name: str, transport: Transport, config: RosRobotConfig, state: rm.RosRobotState, description: Any
     ) -> None:
         super().__init__(name)
         self.transport, self.config, self.state, self.description = transport, config, state, description
+        #: What this robot believes is in the world: filled by its perception module, read by its
+        #: object resolver.
+        self.belief = BeliefState(state.environment)
+        self.object_resolvers.append(self.belief.resolver)
 
     def shutdown(self) -> None:
         shutdown_modules(self)
+        for module in self.process_modules.values():
+            if isinstance(module, rm.RosPerceptionModule):
+                module.close()
         self.state.close()
 
     def __repr__(self) -> str:
@@ -77,7 +88,7 @@ def make_ros_robot(
     arms = {a: robot.add_process_module(f"arm_{a}", rm.RosArmModule(*args, a)) for a in config.arms}
     grippers = {g: robot.add_process_module(f"gripper_{g}", rm.RosGripperModule(*args, g)) for g in config.grippers}
     sensors = robot.add_process_module("sensors", SensorModule(state))
-    perception = robot.add_process_module("perception", rm.RosPerceptionModule(*args))
+    perception = robot.add_process_module("perception", rm.RosPerceptionModule(*args, robot.belief))
 
     robot.motion_types.update(motion_types(state, description))
     robot.motion_resolvers.append(make_motion_resolver(state, description))

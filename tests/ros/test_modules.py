@@ -101,8 +101,9 @@ def test_detecting_sees_the_mug(ros_robot):
     motion(type="setting_torso", position="up")
     motion(type="pointing_head", coordinates=[x, y, 0.95])
     seen = motion(type="detecting")
-    assert [item.name for item in seen] == ["mug"], seen
-    assert seen[0].pose.position[0] == pytest.approx(x, abs=0.05)
+    assert [obj.type for obj in seen] == ["mug"], seen
+    assert seen[0].pose[0] == pytest.approx(x, abs=0.05)
+    assert seen[0] in ros_robot.belief.present()
     assert motion(type="detecting", object="no such thing") == []
 
 

@@ -36,9 +36,11 @@ PACKAGES = ("control_msgs", "pycram_msgs")
 #: Installed message types whose definitions (and their dependencies') the generator needs.
 DEPENDENCIES = (
     "std_msgs/Header",
+    "std_msgs/ColorRGBA",
     "geometry_msgs/PointStamped",
     "geometry_msgs/PoseStamped",
     "geometry_msgs/Vector3",
+    "sensor_msgs/Image",
     "trajectory_msgs/JointTrajectory",
     "actionlib_msgs/GoalID",
     "actionlib_msgs/GoalStatus",
