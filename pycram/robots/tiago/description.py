@@ -114,6 +114,15 @@ APPROACH_OFFSETS = {
     "place": (0.0, 0.01),
     "retreat": (0.10, 0.02),
 }
+#: Doors: why this robot does not open or close them (read by `pycram.actions.containers`; a
+#: robot without this entry does). Measured on the apartment's fridge (issue 16).
+DOOR_REFUSAL = (
+    "the TIAGo does not open doors yet: closing in on the fridge door's vertical handle its wrist "
+    "ends rolled about 70 deg off the commanded orientation, so the gripper closes on the handle's "
+    "standoffs (81 mm open) instead of the bar, the door follows only to 3-12 deg, and with the wrist "
+    "turning with the door the arc beyond about 35 deg has no IK solution from the standing pose found"
+)
+
 #: Position tolerance [m] of the tool per phase.
 REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place": 0.02, "default": 0.01}
 
