@@ -1,4 +1,5 @@
-"""Opening and closing drawers: grasp the handle, pull (or push) it along the drawer's slide.
+"""Opening and closing drawers and doors: grasp the handle, move it along the drawer's slide
+or the door's arc.
 
 `Open("drawer 2")`: ``('to_open', container)`` chooses where to stand, which arm and -- for a
 handle too low or too high for the torso as it is -- the torso height.
@@ -8,15 +9,24 @@ trajectory in steps, lets go, backs off and looks again: the drawer must be meas
 6 cm of the goal, or at least 15 cm out: enough to look and reach in).
 `Close("drawer 2")` is the same, pushing back to closed.
 
-Failures, after `CONTAINER_ATTEMPTS` standing poses: `HandleMissed` (the gripper closed beside
-the handle), `ContainerStuck` (the drawer did not follow the pull), `ObjectOutOfReach` (no
-standing pose). Doors (the fridge) are not opened by a robot yet: ``Open('fridge')`` raises
-`ContainerFailure` with reason ``'door_not_supported'`` -- a door's handle swings on an arc that
-the fixed-orientation ``reaching`` motion cannot follow.
+`Open("fridge")` (a door, `DOOR_OPENING` = 69 deg unless told): the arms parked, the robot
+drives to the standing pose, looks, grasps the vertical handle bar with the fingers closing
+horizontally (the tool pointing into the door), and carries the handle along its arc around the
+hinge in `DOOR_STEPS` tool poses, the wrist turning with the door (``reaching`` with an
+``orientation``). Letting go it backs the hand off the door and out round the door's free edge,
+backs the base off and parks the arm (an arm coming back round an open door pushes it shut). The
+door must be measured at least 60 deg open (`DOOR_USEFUL`) or within 10 deg of the goal; closed,
+below 4 deg (`DOOR_CLOSED`). `Close("fridge")` pushes the handle back along the arc from the
+pose the door was opened from. Robots whose description names a `DOOR_REFUSAL` (the TIAGo) do
+not: ``ContainerFailure`` with reason ``'door_not_supported'`` and that reason.
 
-The environment's description (handle positions, slide directions, limits) is map knowledge the
-plan may read; how far a drawer is open comes only from perception (the belief's
-``container_states``).
+Failures, after `CONTAINER_ATTEMPTS` standing poses: `HandleMissed` (the gripper closed beside
+the handle -- or, for a door, on something wider than its bar), `ContainerStuck` (the drawer or
+door did not follow), `ObjectOutOfReach` (no standing pose).
+
+The environment's description (handle positions, slide directions, hinges, limits) is map
+knowledge the plan may read; how far a container is open comes only from perception (the
+belief's ``container_states``).
 """
 
 from __future__ import annotations
@@ -47,7 +57,16 @@ from .core import (
     unwrap,
 )
 
-__all__ = ["Open", "Close", "DRAWER_OPENING", "CONTAINER_ATTEMPTS", "PULL_STEPS", "HANDLE_OPENING"]
+__all__ = [
+    "Open",
+    "Close",
+    "DRAWER_OPENING",
+    "DOOR_OPENING",
+    "CONTAINER_ATTEMPTS",
+    "PULL_STEPS",
+    "DOOR_STEPS",
+    "HANDLE_OPENING",
+]
 
 log = logging.getLogger("pycram.actions")
 
@@ -68,16 +87,34 @@ PUSH_BEYOND = 0.03
 #: A drawer counts as closed below this opening [m], as opened when within this of its goal --
 #: or at least `USEFUL_OPENING` [m] out (enough to look and reach in).
 CLOSED, OPEN_TOLERANCE, USEFUL_OPENING = 0.03, 0.06, 0.15
+#: How far [rad] `Open` swings a door when not told (69 deg).
+DOOR_OPENING = 1.2
+#: Tool poses along a door's arc (about 9 deg apart for `DOOR_OPENING`).
+DOOR_STEPS = 8
+#: A door counts as closed below this angle [rad] (4 deg), as opened when within this of its
+#: goal -- or at least `DOOR_USEFUL` [rad] open (60 deg: enough to look and reach in).
+DOOR_CLOSED, DOOR_TOLERANCE, DOOR_USEFUL = math.radians(4), math.radians(10), math.radians(60)
+#: Closing pushes the handle this far [rad] beyond closed (the door's stop holds it).
+DOOR_PUSH_BEYOND = 0.03
+#: Backing off from a door's handle [m] when the standing pose does not say (its pre-grasp offset).
+DOOR_BACK_OFF = 0.1
+#: Above this measured opening [m] the gripper closed on something wider than a handle's bar.
+DOOR_HANDLE_WIDEST = 0.04
+#: Letting go, the hand moves out this far [m] past the door's free edge before the arm goes up.
+DOOR_EDGE_CLEARANCE = 0.12
+#: ... and the base backs off this far [m] (the elbow clear of the door) before the arm goes up.
+DOOR_BASE_BACK_OFF = 0.3
 
 
 def Open(container: str, arm: str | None = None, opening: float | None = None) -> ActionDesignator:
-    """Open the drawer `container` (its name in the environment) by `opening` [m] (default
-    `DRAWER_OPENING`) with `arm` (None: the reasoning chooses). Returns the measured opening."""
+    """Open the drawer or door `container` (its name in the environment) by `opening` [m, rad for
+    a door] (default `DRAWER_OPENING`, `DOOR_OPENING`) with `arm` (None: the reasoning chooses).
+    Returns the measured opening."""
     return make_action("opening", container=container, arm=arm, opening=opening)
 
 
 def Close(container: str, arm: str | None = None) -> ActionDesignator:
-    """Close the drawer `container`. Returns the measured opening [m] afterwards."""
+    """Close the drawer or door `container`. Returns the measured opening [m or rad] afterwards."""
     return make_action("closing", container=container, arm=arm)
 
 
@@ -96,13 +133,16 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
     if name not in names:
         raise ActionParameterError(action, "container", f"the environment has no container {name!r}", names)
     container = environment.container(name)
-    if container.kind != "drawer":
+    if container.kind == "door":
+        refusal = _door_refusal()
+        if refusal is not None:
+            raise ContainerFailure(f"{action} {name!r}: {refusal}", name, designator, "door_not_supported")
+    elif container.kind != "drawer":
         raise ContainerFailure(
-            f"{action} {name!r}: robots open and close drawers only so far (a door's "
-            f"handle swings on an arc the reaching motion cannot follow)",
+            f"{action} {name!r}: robots open and close drawers and doors only, not a {container.kind!r}",
             name,
             designator,
-            "door_not_supported",
+            "not_supported",
         )
     return belief, environment, container
 
@@ -124,8 +164,11 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     arm, grasp = location.arm, location.grasp
     gripper = gripper_of(arm)
     motion(type="setting_gripper", gripper=gripper, position=1)
+    # a door stands open beside the pose: the arm goes in (the standing pose was checked with the
+    # arms parked); for a drawer it is up, ready
+    raised = "park" if container.kind == "door" else "carry"
     try:
-        motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+        motion(type="setting_arm_configuration", arm=arm, configuration=raised)
     except RECOVERABLE as error:  # e.g. close to the furniture after a failed attempt
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
     if location.torso is not None:  # the handle is too low or too high for the torso as it was
@@ -139,6 +182,10 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
         motion(type="moving", pose=location)
     start = _measure(belief, container)
     start = 0.0 if start is None else start
+    if container.kind == "door":
+        if abs(start - goal) < DOOR_TOLERANCE / 2:
+            return start
+        return _swing_door(location, belief, container, start, goal)
     if abs(start - goal) < OPEN_TOLERANCE / 2:
         return start
     handle = list(container.handle_position(start))
@@ -181,6 +228,122 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     return measured
 
 
+def _door_refusal() -> str | None:
+    """Why the active robot does not open and close doors (its description's `DOOR_REFUSAL`;
+    None: it does)."""
+    refusal = getattr(getattr(current_robot(), "description", None), "DOOR_REFUSAL", None)
+    return None if refusal is None else str(refusal)
+
+
+def _yaw_quat(yaw: float) -> list[float]:
+    """Orientation (w, x, y, z) of a tool pointing along `yaw` [rad], fingers opening horizontally."""
+    return [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+
+
+def _door_heading(container: Any, q: float) -> float:
+    """Tool heading [rad] at the handle of the door `container` opened by `q` [rad]: into the
+    door, against its opening direction (which turns with the door)."""
+    dx, dy = container.opening_direction
+    a = container.hinge_sign * q
+    dx, dy = math.cos(a) * dx - math.sin(a) * dy, math.sin(a) * dx + math.cos(a) * dy
+    return math.atan2(-dy, -dx)
+
+
+def _door_pose(container: Any, q: float, back: float = 0.0) -> tuple[list[float], list[float]]:
+    """Tool (position [m], orientation) at the handle of the door opened by `q` [rad], `back` [m]
+    away from it against the tool's heading."""
+    heading = _door_heading(container, q)
+    x, y, z = container.handle_position(q)
+    return [x - back * math.cos(heading), y - back * math.sin(heading), z], _yaw_quat(heading)
+
+
+def _swing_door(location: Any, belief: Any, container: Any, start: float, goal: float) -> float:
+    """Grasp the handle of the door `container` (measured open by `start` [rad]), carry it along
+    its arc around the hinge to `goal` [rad] in `DOOR_STEPS` tool poses (the wrist turning with
+    the door), let go, back off along the tool's heading, look. Returns the measured angle."""
+    arm = location.arm
+    gripper = gripper_of(arm)
+    poses: tuple[Any, ...] = tuple(getattr(location, "tool_poses", ()) or ())
+    back = math.dist(poses[0][0], poses[1][0]) if len(poses) >= 2 else DOOR_BACK_OFF
+    pre, orientation = _door_pose(container, start, back)
+    handle, _ = _door_pose(container, start)
+    motion(type="reaching", arm=arm, target=pre, phase="pre_grasp", orientation=orientation)
+    motion(type="reaching", arm=arm, target=handle, phase="grasp", orientation=orientation)
+    opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
+    reached = start
+    if not HANDLE_OPENING <= opening <= DOOR_HANDLE_WIDEST:  # beside the bar, or on its standoffs
+        _let_go_of_door(arm, gripper, container, reached, back)
+        where = "beside the handle" if opening < HANDLE_OPENING else "on something wider than the handle's bar"
+        raise HandleMissed(
+            f"the {gripper} gripper closed {where} of {container.name!r} (opening {opening * 1000:.1f} mm)",
+            container.name,
+        )
+    closing = goal == 0.0
+    try:
+        for k in range(1, DOOR_STEPS + 1 + closing):
+            q = start + (goal - start) * min(k, DOOR_STEPS) / DOOR_STEPS
+            beyond = k > DOOR_STEPS
+            if beyond:
+                q = -DOOR_PUSH_BEYOND  # against the stop, if the arm gets there: the hand lags the door
+            target, turned = _door_pose(container, q)
+            try:
+                motion(type="reaching", arm=arm, target=target, orientation=turned)
+            except RECOVERABLE as error:
+                if getattr(unwrap(error), "reason", None) != "blocked" and not beyond:
+                    raise
+                log.info("%s: the handle stopped moving at step %d: %s", container.name, k, unwrap(error))
+                break
+            reached = q
+    finally:
+        _let_go_of_door(arm, gripper, container, reached, back)
+    measured = _measure(belief, container)
+    if measured is None:
+        raise ContainerFailure(f"could not see the handle of {container.name!r} after moving it", container.name)
+    done = measured < DOOR_CLOSED if closing else measured >= min(goal - DOOR_TOLERANCE, DOOR_USEFUL)
+    if not done:
+        raise ContainerStuck(
+            f"{container.name!r} is open {math.degrees(measured):.0f} deg after moving its handle from "
+            f"{math.degrees(start):.0f} towards {math.degrees(goal):.0f} deg",
+            container.name,
+        )
+    return measured
+
+
+def _let_go_of_door(arm: str, gripper: str, container: Any, q: float, back: float) -> None:
+    """Let go of a door's handle (at `q` [rad]), back off the door's face along the tool's heading
+    and out past the door's free edge (an arm reaching round an open door would push it shut on
+    its way back), arm up."""
+    q = max(q, 0.0)
+    away, orientation = _door_pose(container, q, back)
+    beyond, _ = _door_pose(container, q, -back)
+    hx, hy = container.hinge
+    handle = container.handle_position(q)
+    radius = math.hypot(handle[0] - hx, handle[1] - hy)
+    width = max(math.hypot(x - hx, y - hy) for x, y in _corners(container.body.footprint))
+    scale = (width + DOOR_EDGE_CLEARANCE) / radius
+
+    def past_edge(point: list[float]) -> list[float]:
+        return [hx + (point[0] - hx) * scale, hy + (point[1] - hy) * scale, point[2]]
+
+    around = [
+        lambda: motion(type="reaching", arm=arm, target=past_edge(away), phase="retreat", orientation=orientation),
+        lambda: motion(type="reaching", arm=arm, target=past_edge(beyond), phase="retreat", orientation=orientation),
+    ]
+    best_effort(
+        "letting go of a handle",
+        lambda: motion(type="setting_gripper", gripper=gripper, position=1),
+        lambda: motion(type="reaching", arm=arm, target=away, phase="retreat", orientation=orientation),
+        *(around if q > DOOR_CLOSED else []),  # a closed door has no edge to reach round
+        lambda: motion(type="moving", pose=(-DOOR_BASE_BACK_OFF, 0.0, 0.0), frame="base_footprint"),
+        lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
+    )
+
+
+def _corners(footprint: tuple[float, float, float, float]) -> list[tuple[float, float]]:
+    x0, y0, x1, y1 = footprint
+    return [(x0, y0), (x0, y1), (x1, y0), (x1, y1)]
+
+
 def _release(arm: str, gripper: str, handle: list[float], grasp: str) -> None:
     """Let go of the handle and back off (best effort), the arm up for driving."""
     best_effort(
@@ -203,7 +366,8 @@ def _standing_poses(container: Any, arm: str | None, travel: float, closing: boo
     remembered = _opened_from.get(current_robot(), {}).get(container.name)
     if closing and remembered is not None and (arm is None or remembered.arm == arm):
         yield remembered
-        for step in (1, 2):  # the drawer is further in after each push: push on from nearer
+        # the drawer is further in after each push: push on from nearer (a door: from where it was opened)
+        for step in (1, 2) if container.kind == "drawer" else ():
             closer = _stepped_in(remembered, step * STEP_IN)
             if closer is not None:
                 yield closer
@@ -236,6 +400,8 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
     last: BaseException | None = None
     travel = max(goal, belief.container_states.get(container.name, 0.0), 0.05)
     try:
+        if container.kind == "door" and action == "closing":
+            travel = 0.0  # ('to_open', door) validates the arc from the believed angle to `travel`
         poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=action == "closing")
         for number, location in enumerate(poses, start=1):
             if number > CONTAINER_ATTEMPTS:
@@ -269,10 +435,14 @@ def opening(designator: ActionDesignator) -> float:
 
     def goal_of(container: Any) -> float:
         low, high = container.limits
-        goal = DRAWER_OPENING if wanted is None else float(wanted)
+        default = DOOR_OPENING if container.kind == "door" else DRAWER_OPENING
+        goal = default if wanted is None else float(wanted)
+        unit, travel = ("rad", "hinge's range") if container.kind == "door" else ("m", "slide")
         if not low < goal <= high:
             raise ActionParameterError(
-                "opening", "opening", f"{goal} m is outside the slide of {container.name!r} ({low}..{high} m)"
+                "opening",
+                "opening",
+                f"{goal} {unit} is outside the {travel} of {container.name!r} ({low}..{high} {unit})",
             )
         return goal
 

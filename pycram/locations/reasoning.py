@@ -474,7 +474,10 @@ class LocationReasoner:
             handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
             answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
             if answer:
-                return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions), None
+                return (
+                    BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions, tool_poses=tuple(poses)),
+                    None,
+                )
             # a handle too low or too high for the torso as it is: another named torso height
             for torso, height in self._other_torso_heights():
                 joint = self.geometry.torso_joint
@@ -484,7 +487,10 @@ class LocationReasoner:
                     continue
                 other = prosp.reachable(arm, poses, (x, y, yaw), configuration)
                 if other:
-                    return BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=other.solutions, torso=torso), None
+                    location = BaseLocation(
+                        x, y, yaw, arm, handle_grasp, cost, joints=other.solutions, tool_poses=tuple(poses), torso=torso
+                    )
+                    return location, None
             return None, (f"unreachable for arm {arm!r}", answer.reason)
 
         target = Target(container.handle, "container", container.name, thing=container)

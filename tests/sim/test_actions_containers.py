@@ -1,12 +1,13 @@
-"""Opening and closing drawers (issue 16) and searching closed drawers (issue 15), judged with
-the simulator's truth: the drawer's joint really moved, the object really was inside."""
+"""Opening and closing drawers and the fridge door (issue 16) and searching closed containers
+(issue 15), judged with the simulator's truth: the drawer's slide or the door's hinge really
+moved, the object really was inside."""
 
 from __future__ import annotations
 
 import math
 
 import pytest
-from action_helpers import TABLE, apartment_with, run_as_task, tasks_named
+from action_helpers import TABLE, apartment_with, holding, run_as_task, tasks_named
 from sim_helpers import ok
 
 from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, Search
@@ -44,11 +45,39 @@ def test_a_stuck_drawer_raises_container_stuck_after_every_standing_pose():
         assert opening_of(world, "drawer 3") < 0.02
 
 
-def test_doors_are_not_opened_by_robots_yet_and_say_so():
+def test_the_pr2_opens_and_closes_the_fridge_door_by_its_handle_along_its_arc():
+    with apartment_with("pr2", {"cup": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        measured = perform(Open("fridge"))
+        assert opening_of(world, "fridge") >= math.radians(60)  # the hinge: enough to look and reach in
+        assert abs(measured - opening_of(world, "fridge")) < math.radians(1)  # perceived, not assumed
+        assert abs(robot.belief.container_states["fridge"] - opening_of(world, "fridge")) < math.radians(1)
+        assert not holding(world)
+        measured = perform(Close("fridge"))
+        assert opening_of(world, "fridge") < math.radians(4)
+        assert abs(measured - opening_of(world, "fridge")) < math.radians(1)
+        assert robot.belief.container_states["fridge"] < math.radians(4)
+
+
+def test_a_stuck_fridge_door_raises_container_stuck():
+    with apartment_with("pr2", {"cup": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        ok(world.set_container_stuck("fridge"))
+        with pytest.raises(ContainerStuck, match="fridge") as caught:
+            run_as_task(lambda: perform(Open("fridge")))
+        assert caught.value.container == "fridge" and caught.value.attempts
+        assert opening_of(world, "fridge") < math.radians(3)
+
+
+def test_the_tiago_does_not_open_doors_yet_and_says_why():
     with apartment_with("tiago", {"cup": TABLE}) as (world, robot):
-        with pytest.raises(ContainerFailure, match="drawers only") as caught:
+        with pytest.raises(ContainerFailure, match="TIAGo does not open doors yet.*IK") as caught:
             perform(Open("fridge"))
         assert caught.value.reason == "door_not_supported"
+        with pytest.raises(ContainerFailure, match="TIAGo does not open doors"):
+            perform(Close("fridge"))
         with pytest.raises(ActionParameterError, match=r"no container 'drawer 9'.*valid: drawer 1"):
             perform(Open("drawer 9"))
 
@@ -64,4 +93,18 @@ def test_search_opens_a_closed_drawer_and_finds_the_cup_inside():
         assert math.dist(found.pose[:2], truth[:2]) < 0.05
         assert opening_of(world, "drawer 2") >= 0.15
         openings = tasks_named(task, "perform opening")  # drawers on the way may be opened too
+        assert openings and all(t.status.get_value().value == "succeeded" for t in openings)
+
+
+def test_search_opens_the_closed_fridge_and_finds_the_milk_inside():
+    with apartment_with("pr2", {"milk": ("fridge middle shelf", (3.05, 4.6))}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        assert opening_of(world, "fridge") < 0.01
+        found, task = run_as_task(lambda: perform(Search(ObjectDesignator(type="milk"))))
+        assert found.type == "milk" and found.properties["in"] == "fridge"
+        truth = world.item_poses.get_value()["milk"].position
+        assert math.dist(found.pose[:2], truth[:2]) < 0.05
+        assert opening_of(world, "fridge") >= math.radians(60)
+        openings = tasks_named(task, "perform opening")
         assert openings and all(t.status.get_value().value == "succeeded" for t in openings)

@@ -114,6 +114,18 @@ APPROACH_OFFSETS = {
     "place": (0.0, 0.01),
     "retreat": (0.10, 0.02),
 }
+#: Doors: why this robot does not open or close them (read by `pycram.actions.containers`; a
+#: robot without this entry does). Measured on the apartment's fridge (issue 16).
+DOOR_REFUSAL = (
+    "the TIAGo does not open doors yet: closing in on the fridge door's vertical handle its wrist "
+    "ends rolled about 110 deg about the approach axis, off the commanded orientation, so the gripper "
+    "closes on the handle's standoffs (81 mm open) instead of the bar and the door follows to 3-12 deg "
+    "only; with the grip turned 180 deg about that axis it holds the bar, but the bar slips out of its "
+    "finger tips at 34 deg (the arm then stops 19 mm short of the next pose on the arc), and a grasp "
+    "15-25 mm deeper stalls against the door; the IK finds no solution on the arc beyond 35-43 deg "
+    "from the one standing pose found"
+)
+
 #: Position tolerance [m] of the tool per phase.
 REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place": 0.02, "default": 0.01}
 
