@@ -1,0 +1,142 @@
+"""The set-table plan: search, fetch and place each object of a breakfast setting, robot-agnostic.
+
+The plan knows the objects only through perception (the robot's belief, filled by `Search`),
+the table's place settings as data (`PlaceSetting`: an object type and the point [m, map] where
+it should stand) and the environment's description (containers by name). It runs unchanged on
+the two-armed PR2 and the one-armed TIAGo: arms, grasps and standing poses are chosen by the
+action library's designators.
+
+For each place setting, in order:
+
+* ``Transport(ObjectDesignator(type=...), point)`` -- search (drawers are opened when the
+  object is not found on open surfaces), pick up, place; the action library recovers inside
+  (next standing pose, perceiving again, searching again when the object was taken);
+* the transport runs under `with_timeout` (a budget of simulated time per object) and under
+  `failure_handling` with one more round for the failures that a second look may fix (the
+  object was moved, missed by perception, a drawer was stuck and is free now);
+* afterwards, with empty hands, every container the robot believes open is closed again
+  (`Close`), so no drawer is left sticking out into the room.
+
+The outcome of each setting (placed, or the typed failure that stopped it) is returned; the plan
+raises nothing for a failed object, so the other objects are still brought.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any
+
+from pycram.actions import Close, MoveTorso, ParkArms, Transport
+from pycram.designator import ObjectDesignator, perform
+from pycram.failures import PlanFailure
+from pycram.fluent import Fluent
+from pycram.language import State, with_timeout
+from pycram.robot import current_robot
+
+__all__ = [
+    "PlaceSetting",
+    "SettingOutcome",
+    "set_table",
+    "close_opened_containers",
+    "OBJECT_TIME_BUDGET",
+    "ROUNDS",
+    "current_object",
+    "objects_done",
+]
+
+log = logging.getLogger("pycram.demo")
+
+#: Simulated time [s] one object may take (search, fetch, place, all recoveries).
+OBJECT_TIME_BUDGET = 240.0
+#: Transport rounds per object (a second round after a failure a new search may fix).
+ROUNDS = 2
+
+#: The object type being brought now (None between objects), for people watching and for the
+#: simulated person of the scenario's faults.
+current_object = Fluent(None, name="set_table.current_object")
+#: How many objects are at their place settings.
+objects_done = Fluent(0, name="set_table.objects_done")
+
+
+@dataclass(frozen=True)
+class PlaceSetting:
+    """Where an object of type `type` should stand on the table: `point` [m, map frame] is the
+    object's centre standing upright there; `seat` names the seat the setting belongs to."""
+
+    type: str
+    point: tuple[float, float, float]
+    seat: str = ""
+
+
+@dataclass
+class SettingOutcome:
+    """What became of one place setting: `placed`, or the `failure` that stopped it (a typed
+    failure of `pycram.failures`, or `TimeoutError` when the budget ran out) and every round's
+    failure in `attempts`."""
+
+    setting: PlaceSetting
+    placed: bool = False
+    failure: BaseException | None = None
+    attempts: list[str] = field(default_factory=list)
+
+
+def close_opened_containers() -> list[str]:
+    """Close every container the robot believes open (from its last look); returns their
+    names. A container that will not close is logged and left (its failure is not raised)."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if belief is None or environment is None:
+        return []
+    closed = []
+    for container in environment.containers:
+        if container.kind != "drawer" or belief.container_open(container.name) is not True:
+            continue
+        try:
+            perform(Close(container.name))
+            closed.append(container.name)
+        except PlanFailure as failure:
+            log.warning("could not close %s: %s", container.name, failure)
+    return closed
+
+
+def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
+    """Transport rounds for one setting, each bounded by the time budget."""
+    for round_number in range(1, ROUNDS + 1):
+        errors: list[BaseException] = []
+
+        def transport() -> Any:
+            return perform(Transport(ObjectDesignator(type=setting.type), setting.point))
+
+        state = with_timeout(OBJECT_TIME_BUDGET / ROUNDS, transport, errors, name=f"bring the {setting.type}")
+        if state.get_value() is State.SUCCEEDED:
+            outcome.placed, outcome.failure = True, None
+            return
+        error = errors[0] if errors else PlanFailure(f"bringing the {setting.type} did not succeed")
+        outcome.failure = error
+        outcome.attempts.append(f"round {round_number}: {type(error).__name__}: {error}")
+        log.warning("set table: the %s, round %d: %s: %s", setting.type, round_number, type(error).__name__, error)
+        if not isinstance(error, (PlanFailure, TimeoutError)):
+            raise error  # a bug, not a failure of the world
+        close_opened_containers()  # the next round starts with the room as it should be
+
+
+def set_table(settings: list[PlaceSetting]) -> list[SettingOutcome]:
+    """Bring every object of `settings` to its place; close the containers opened on the way.
+
+    Returns one `SettingOutcome` per setting, in order. Raises only for bugs (a failure of the
+    world is an outcome) and evaporation.
+    """
+    objects_done.set_value(0)
+    outcomes = [SettingOutcome(s) for s in settings]
+    perform(ParkArms())
+    perform(MoveTorso("up"))
+    for outcome in outcomes:
+        current_object.set_value(outcome.setting.type)
+        log.info("set table: bringing the %s to %s", outcome.setting.type, outcome.setting.point)
+        _bring(outcome.setting, outcome)
+        current_object.set_value(None)
+        if outcome.placed:
+            objects_done.set_value(objects_done.get_value() + 1)
+        close_opened_containers()
+    return outcomes
