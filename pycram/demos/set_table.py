@@ -40,6 +40,8 @@ from pycram.demos.set_table_plan import PlaceSetting, SettingOutcome
 __all__ = [
     "OBJECTS",
     "START_SUPPORTS",
+    "START_REGIONS",
+    "start_scene",
     "SEAT",
     "SETTINGS",
     "FAULTS",
@@ -62,8 +64,22 @@ SCENARIOS = ("thesis", "set-table")
 #: The objects of the breakfast setting, in the order they are brought (types both robots grasp
 #: reliably: spoons are too thin for the fingers, cereal boxes push away; see the docs).
 OBJECTS = ("plate", "bowl", "cup", "milk")
-#: Where objects start: open counters and the insides of the three drawers.
-START_SUPPORTS = ("counter", "cabinet top", "drawer 1 inside", "drawer 2 inside", "drawer 3 inside")
+#: Where objects start, as data: surface name -> the region (x0, y0, x1, y1) [m, map; for drawer
+#: insides with the drawer closed] of it where they may stand -- the front strip of the counter
+#: and the middle of the top drawer, where both robots' arms reach (the counter is 0.6 m deep;
+#: its back half is out of reach of both robots). The fridge is left out: robots cannot open
+#: doors yet.
+START_REGIONS: dict[str, tuple[float, float, float, float]] = {
+    "counter": (0.45, 4.47, 2.45, 4.58),
+    "drawer 3 inside": (0.2, 2.6, 0.4, 3.2),
+}
+#: Which of `START_REGIONS` each object may start on (measured: what both robots pick up).
+START_SUPPORTS: dict[str, tuple[str, ...]] = {
+    "plate": ("counter",),
+    "bowl": ("counter",),
+    "cup": ("counter", "drawer 3 inside"),
+    "milk": ("counter",),
+}
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
 SEAT = "table south"
@@ -192,7 +208,11 @@ class SetTableResult:
 
     def summary(self) -> str:
         """One line per object not placed, and per container left open."""
-        lines = [f"{name}: {o.failure or 'not at its place'} ({o.reason})" for name, o in self.objects.items() if not o.placed]
+        lines = [
+            f"{name}: {o.failure or 'not at its place'} ({o.reason})"
+            for name, o in self.objects.items()
+            if not o.placed
+        ]
         lines += [f"{c} left open ({q:.2f} m)" for c, q in self.open_containers.items()]
         if self.error:
             lines.append(f"plan stopped: {self.error}")
@@ -220,7 +240,9 @@ def _tilt(quaternion: tuple[float, float, float, float]) -> float:
     return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
 
 
-def judge(world: Any, settings: list[PlaceSetting], outcomes: list[SettingOutcome] | None, result: SetTableResult) -> None:
+def judge(
+    world: Any, settings: list[PlaceSetting], outcomes: list[SettingOutcome] | None, result: SetTableResult
+) -> None:
     """Fill `result.objects` and `result.open_containers` from the simulator's ground truth
     (judging only: the plan never sees it) and the plan's `outcomes` (the typed failures)."""
     poses = world.item_poses.get_value()
@@ -266,7 +288,9 @@ class Faults:
     each waiting on fluent networks of the world's sensors and the plan's `current_object`).
     Which object, which drawer, where: drawn from `rng`. `injected` lists what happened."""
 
-    def __init__(self, world: Any, kinds: frozenset[str], rng: random.Random, settings: list[PlaceSetting]) -> None:
+    def __init__(
+        self, world: Any, kinds: frozenset[str], rng: random.Random, settings: list[PlaceSetting], placements: list[Any]
+    ) -> None:
         from pycram.fluent import Fluent
 
         self.world, self.kinds, self.rng, self.settings = world, kinds, rng, settings
@@ -274,9 +298,9 @@ class Faults:
         self._stop = Fluent(None, name="faults.stop")
         self._threads: list[threading.Thread] = []
         self._lock = threading.Lock()
-        self.moved_object = rng.choice([p.name for p in world.placements if p.container is None] or [None])
+        self.moved_object = rng.choice([p.name for p in placements if p.container is None] or [None])
         self.taken_object = rng.choice([s.type for s in settings])
-        in_drawers = sorted({p.container for p in world.placements if p.container is not None})
+        in_drawers = sorted({p.container for p in placements if p.container is not None})
         self.stuck_drawer = rng.choice(in_drawers) if in_drawers else None
         self.stuck_for = rng.uniform(4.0, 10.0)
         self.obstacle_fraction = rng.uniform(0.35, 0.6)
@@ -393,7 +417,9 @@ class Faults:
         to = self._free_counter_spot(name)
         outcome = self.world.take_item(gripper=gripper, to=to).wait(10.0)
         if outcome is not None and outcome.succeeded and outcome.value:
-            self.note(f"taken: a person took the {name} from the {gripper} gripper, put it at ({to[0]:.2f}, {to[1]:.2f})")
+            self.note(
+                f"taken: a person took the {name} from the {gripper} gripper, put it at ({to[0]:.2f}, {to[1]:.2f})"
+            )
 
     def _stuck_drawer(self) -> None:
         """The drawer is stuck (from the start); `stuck_for` [s of simulated time] after the
@@ -473,16 +499,60 @@ class _PlanThread:
         self._thread.join(timeout)
 
 
-def open_world(robot: str, seed: int, faults: frozenset[str] = frozenset()) -> Any:
-    """The apartment with the scenario's objects at random spots from `seed` and `robot` at the
-    start pose (perception misses detections with the ``missed`` fault)."""
-    from pycram.sim import World
-    from pycram.sim.perception import PerceptionFaults
+def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS) -> list[Any]:
+    """Where `objects` start (`pycram.world.scenes.Placement`s), drawn from `seed`: a support of
+    a kind the object is found on among `START_REGIONS`, a spot in its region clear of the
+    others, a random yaw (boxes roughly square to the counter's edge: perception does not
+    measure yaw). The same seed gives the same scene."""
+    from pycram.world.scenes import GAP, Placement
+    from pycram.world.objects import object_type
 
+    rng = random.Random(seed)
+    placed: list[Placement] = []
+    for name in objects:
+        otype = object_type(name)
+        supports = list(START_SUPPORTS[name])
+        for _ in range(500):
+            support = rng.choice(supports)
+            surface = environment.surface(support)
+            x0, y0, x1, y1 = START_REGIONS[support]
+            x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
+            if otype.shape == "box":
+                yaw = rng.choice((0.0, math.pi / 2, math.pi, -math.pi / 2)) + rng.uniform(-0.15, 0.15)
+            else:
+                yaw = rng.uniform(-math.pi, math.pi)
+            container = environment.container_of(support)
+            candidate = Placement(
+                name,
+                name,
+                support,
+                None if container is None else container.name,
+                (x, y, surface.height + otype.half_height + 0.001),
+                yaw,
+                otype.footprint_radius,
+            )
+            if not any(candidate.overlaps(other, GAP + 0.1) for other in placed):
+                placed.append(candidate)
+                break
+        else:
+            raise RuntimeError(f"no free start spot for the {name} (seed {seed})")
+    return placed
+
+
+def open_world(robot: str, seed: int, faults: frozenset[str] = frozenset()) -> tuple[Any, list[Any]]:
+    """The apartment with the scenario's objects at random spots from `seed` (`start_scene`)
+    and `robot` at the start pose (perception misses detections with the ``missed`` fault).
+    Returns the world and the placements."""
+    from pycram.environments import load as load_environment
+    from pycram.sim import ItemSpec, World
+    from pycram.sim.perception import PerceptionFaults
+    from pycram.world.objects import object_type
+
+    placements = start_scene(load_environment("apartment"), seed)
+    items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
-    return World(
-        robot, environment="apartment", objects=list(OBJECTS), seed=seed, supports=START_SUPPORTS, perception_faults=perception
-    )
+    world = World(robot, items, environment="apartment", perception_faults=perception)
+    return world, placements
 
 
 def _check(robot: str, seed: int, faults: Any) -> frozenset[str]:
@@ -515,7 +585,7 @@ def run_scenario(
     kinds = _check(robot, seed, faults)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
-    world = open_world(robot, seed, kinds)
+    world, placements = open_world(robot, seed, kinds)
     plan: _PlanThread | None = None
     injector: Faults | None = None
     robot_handle = None
@@ -530,7 +600,7 @@ def run_scenario(
             world.snapshot(output / "start.png", camera=camera)
             if animation:
                 world.start_recording(camera, fps=4.0, width=480, height=360, caption=_caption)
-        injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings)
+        injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
         plan = _PlanThread(robot_handle, settings)
         sim_start = world.sim_time.get_value()
         injector.start()
@@ -575,7 +645,9 @@ def _caption() -> str:
     from pycram.demos.set_table_plan import current_object, objects_done
 
     current = current_object.get_value()
-    return f"set table: {objects_done.get_value()}/{len(OBJECTS)} done" + (f", bringing the {current}" if current else "")
+    return f"set table: {objects_done.get_value()}/{len(OBJECTS)} done" + (
+        f", bringing the {current}" if current else ""
+    )
 
 
 def run_set_table(
@@ -611,7 +683,113 @@ def run_set_table(
         run_id = None
         if recorder is not None:
             ok = result is not None and result.success
-            run_id = recorder.finish("succeeded" if ok else "failed", None if ok else (result.summary() if result else "error"))
+            run_id = recorder.finish(
+                "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
+            )
     out = result.as_dict()
     out["run_id"] = run_id
     return out
+
+
+# -- `pycram demo --scenario set-table` -------------------------------------------------------------
+
+
+def _output_folder(robot: str, seed: int, run_id: Any) -> Path:
+    stem = f"set-table-{robot}-{seed}"
+    return Path("output") / (f"{stem}-{run_id}" if run_id is not None else f"{stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+
+
+def main(
+    robot: str = "pr2",
+    seed: int = 0,
+    faults: str | frozenset[str] = "",
+    output: str | None = None,
+    db: str | None = None,
+    record: bool = True,
+    quiet: bool = False,
+    animation: bool = True,
+) -> int:
+    """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
+    tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
+    the task-tree SVG and the timeline of the recorded run. Returns the exit code: 0 only when
+    every object is at its place setting and every drawer closed; 2 for bad options; else 1."""
+    import os
+    from types import SimpleNamespace
+
+    from rich.console import Console
+    from rich.live import Live
+
+    from pycram.demos.kitchen import _log_to_terminal, _stderr_console, _task_tree_display, _write_run_pictures
+    from pycram.demos.set_table_plan import current_object, objects_done
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    console = Console()
+    try:
+        kinds = _check(robot, seed, faults)
+    except ValueError as error:
+        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
+        return 2
+    if not quiet:
+        _log_to_terminal()
+    recorder = None
+    if record:
+        from pycram.trace import start_recording
+
+        recorder = start_recording(url=db, plan=f"set table ({robot}, seed {seed})")
+    run_id = recorder.run_id if recorder is not None else None
+    folder = Path(output) if output else _output_folder(robot, seed, run_id)
+    live = None if quiet else Live("", console=_stderr_console(), refresh_per_second=4, transient=False)
+
+    def progress(world: Any, plan: Any, injector: Any) -> None:
+        if live is None:
+            return
+        current = current_object.get_value()
+        live.update(
+            f"objects done: {objects_done.get_value()}/{len(OBJECTS)}  "
+            f"{'bringing the ' + current if current else 'between objects':<22}  "
+            f"faults: {len(injector.injected)}  sim {world.sim_time.get_value():6.1f} s"
+        )
+
+    result: SetTableResult | None = None
+    task = None
+    try:
+        if live is not None:
+            live.start()
+        result, task = run_scenario(
+            robot, seed, kinds, recorder=recorder, output=folder, animation=animation, progress=progress
+        )
+    finally:
+        if live is not None:
+            live.stop()
+        if recorder is not None:
+            ok = result is not None and result.success
+            run_id = recorder.finish(
+                "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
+            )
+    view = SimpleNamespace(plan_task=task, run_id=run_id, output=folder, tree_text="")
+    files = [folder / n for n in ("start.png", "end.png", "run.gif") if (folder / n).exists()]
+    if recorder is not None:
+        files += _write_run_pictures(view, recorder)  # type: ignore[arg-type]
+    console.print()
+    console.print(_task_tree_display(view, db))  # type: ignore[arg-type]
+    assert result is not None
+    console.print(
+        f"\nthe plan simulated {result.sim_time:.1f} s; the whole run took {result.wall_time:.1f} s of wall time"
+    )
+    for name, obj in result.objects.items():
+        mark = (
+            "[green]placed[/green]"
+            if obj.placed
+            else f"[red]missing[/red] ({obj.failure or 'not at its place'}: {obj.reason})"
+        )
+        console.print(f"  {name}: {mark}", highlight=False)
+    if result.faults_injected:
+        console.print("faults: " + "; ".join(result.faults_injected), highlight=False)
+    console.print(f"pictures in {folder.resolve()}: " + ", ".join(p.name for p in files))
+    if run_id is not None:
+        console.print(f"recorded as run {run_id} (see `pycram show {run_id}`)")
+    if result.success:
+        console.print("[bold green]SUCCESS[/bold green]: the table is set, every drawer closed")
+        return 0
+    console.print(f"[bold red]FAILURE[/bold red]: {result.summary()}", highlight=False)
+    return 1
