@@ -1,7 +1,7 @@
 """The set-table scenario: a breakfast for one, from a seed, in the apartment (issue 17).
 
 From a seed, the objects of `OBJECTS` start at random spots on the counters and inside the
-drawers (`START_SUPPORTS`; the fridge is left out: robots cannot open doors yet, see
+drawers (`START_REGIONS`; the fridge is left out: robots cannot open doors yet, see
 `docs/set-table.md`). The robot starts at the apartment's start pose, knowing nothing about the
 objects, and runs `set_table_plan.set_table` for the place settings of `SETTINGS` (stated
 relative to the table's edge at the seat). The simulator's ground truth is used for judging only
@@ -39,7 +39,6 @@ from pycram.demos.set_table_plan import PlaceSetting, SettingOutcome
 
 __all__ = [
     "OBJECTS",
-    "START_SUPPORTS",
     "START_REGIONS",
     "start_scene",
     "SEAT",
@@ -64,21 +63,17 @@ SCENARIOS = ("thesis", "set-table")
 #: The objects of the breakfast setting, in the order they are brought (types both robots grasp
 #: reliably: spoons are too thin for the fingers, cereal boxes push away; see the docs).
 OBJECTS = ("plate", "bowl", "cup", "milk")
-#: Where objects start, as data: surface name -> the region (x0, y0, x1, y1) [m, map; for drawer
-#: insides with the drawer closed] of it where they may stand -- the front strip of the counter
-#: and the middle of the top drawer, where both robots' arms reach (the counter is 0.6 m deep;
-#: its back half is out of reach of both robots). The fridge is left out: robots cannot open
-#: doors yet.
-START_REGIONS: dict[str, tuple[float, float, float, float]] = {
-    "counter": (0.45, 4.47, 2.45, 4.58),
-    "drawer 3 inside": (0.2, 2.6, 0.4, 3.2),
-}
-#: Which of `START_REGIONS` each object may start on (measured: what both robots pick up).
-START_SUPPORTS: dict[str, tuple[str, ...]] = {
-    "plate": ("counter",),
-    "bowl": ("counter",),
-    "cup": ("counter", "drawer 3 inside"),
-    "milk": ("counter",),
+#: Where objects start, as data: object type -> the supports (surface names) it may start on,
+#: each with the region (x0, y0, x1, y1) [m, map; for drawer insides with the drawer closed]
+#: where it may stand: the front strip of the counter (the counter is 0.6 m deep; its back is
+#: out of reach of both robots, and side grasps of tall objects need the pre-grasp off the
+#: counter) and the middle of the top drawer. Measured: what both robots pick up. The fridge is
+#: left out: robots cannot open doors yet.
+START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
+    "plate": {"counter": (0.5, 4.54, 2.4, 4.56)},
+    "bowl": {"counter": (0.5, 4.5, 2.4, 4.55)},
+    "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "drawer 3 inside": (0.2, 2.6, 0.4, 3.2)},
+    "milk": {"counter": (0.5, 4.47, 2.4, 4.5)},
 }
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
@@ -102,7 +97,7 @@ CLOSED = 0.03
 #: Probability of a missed detection with the ``missed`` fault.
 MISS_PROBABILITY = 0.3
 #: The scenario's budget of simulated time [s] (all objects) and of wall time [s].
-SIM_TIME_LIMIT = 1200.0
+SIM_TIME_LIMIT = 2400.0
 WALL_TIME_LIMIT = 1800.0
 
 
@@ -504,18 +499,18 @@ def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS)
     a kind the object is found on among `START_REGIONS`, a spot in its region clear of the
     others, a random yaw (boxes roughly square to the counter's edge: perception does not
     measure yaw). The same seed gives the same scene."""
-    from pycram.world.scenes import GAP, Placement
     from pycram.world.objects import object_type
+    from pycram.world.scenes import GAP, Placement
 
     rng = random.Random(seed)
     placed: list[Placement] = []
     for name in objects:
         otype = object_type(name)
-        supports = list(START_SUPPORTS[name])
+        supports = list(START_REGIONS[name])
         for _ in range(500):
             support = rng.choice(supports)
             surface = environment.surface(support)
-            x0, y0, x1, y1 = START_REGIONS[support]
+            x0, y0, x1, y1 = START_REGIONS[name][support]
             x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
             if otype.shape == "box":
                 yaw = rng.choice((0.0, math.pi / 2, math.pi, -math.pi / 2)) + rng.uniform(-0.15, 0.15)
@@ -539,7 +534,9 @@ def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS)
     return placed
 
 
-def open_world(robot: str, seed: int, faults: frozenset[str] = frozenset()) -> tuple[Any, list[Any]]:
+def open_world(
+    robot: str, seed: int, faults: frozenset[str] = frozenset(), objects: tuple[str, ...] = OBJECTS
+) -> tuple[Any, list[Any]]:
     """The apartment with the scenario's objects at random spots from `seed` (`start_scene`)
     and `robot` at the start pose (perception misses detections with the ``missed`` fault).
     Returns the world and the placements."""
@@ -548,7 +545,7 @@ def open_world(robot: str, seed: int, faults: frozenset[str] = frozenset()) -> t
     from pycram.sim.perception import PerceptionFaults
     from pycram.world.objects import object_type
 
-    placements = start_scene(load_environment("apartment"), seed)
+    placements = start_scene(load_environment("apartment"), seed, objects)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
     world = World(robot, items, environment="apartment", perception_faults=perception)
@@ -574,6 +571,7 @@ def run_scenario(
     output: Path | None = None,
     animation: bool = False,
     progress: Any = None,
+    objects: tuple[str, ...] = OBJECTS,
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
@@ -585,12 +583,12 @@ def run_scenario(
     kinds = _check(robot, seed, faults)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
-    world, placements = open_world(robot, seed, kinds)
+    world, placements = open_world(robot, seed, kinds, objects)
     plan: _PlanThread | None = None
     injector: Faults | None = None
     robot_handle = None
     try:
-        settings = place_settings(world.environment)
+        settings = place_settings(world.environment, objects=objects)
         robot_handle = robot_packages.load(robot, world)
         if recorder is not None:
             recorder.set_run_info(robot=robot)
@@ -656,11 +654,13 @@ def run_set_table(
     faults: frozenset[str] = frozenset(),
     db_url: str | None = None,
     pictures: bool = False,
+    objects: tuple[str, ...] = OBJECTS,
 ) -> dict[str, Any]:
     """Run the set-table scenario once, headless and without animation, for `pycram experiment`.
 
     `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
-    recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``. Returns
+    recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``;
+    `objects`: the object types to bring (a subset of `OBJECTS`, in that order). Returns
     a JSON-serialisable dict: ``success``, ``objects`` (per object: ``placed``, ``failure`` (a
     failure type's name or None), ``reason``), ``failure_causes``, ``sim_time`` [s],
     ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``.
@@ -678,7 +678,7 @@ def run_set_table(
     output = Path("output") / f"set-table-{robot}-{seed}" if pictures else None
     result: SetTableResult | None = None
     try:
-        result, _ = run_scenario(robot, seed, kinds, recorder=recorder, output=output)
+        result, _ = run_scenario(robot, seed, kinds, recorder=recorder, output=output, objects=tuple(objects))
     finally:
         run_id = None
         if recorder is not None:
