@@ -727,7 +727,7 @@ def main(
     try:
         kinds = _check(robot, seed, faults)
     except ValueError as error:
-        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
+        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
         return 2
     if not quiet:
         _log_to_terminal()
