@@ -5,7 +5,7 @@ Runs `pycram.demos.set_table.run_set_table` for each robot and seed, one run per
 wall time p50/p95, and the speed factor (simulated / wall time).
 
     MUJOCO_GL=egl .venv/bin/python benchmarks/set_table.py [--robots pr2,tiago] [--seeds 100-109]
-        [--faults moved,taken,stuck,obstacle,missed] [--jobs 1] [--json results.jsonl]
+        [--faults moved,taken,stuck,obstacle,missed] [--objects cup,milk] [--jobs 1] [--json results.jsonl]
 """
 
 from __future__ import annotations
@@ -24,11 +24,12 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 from _worlds import percentile  # noqa: E402
 
 
-def _one(args: tuple[str, int, tuple[str, ...]]) -> dict:
-    from pycram.demos.set_table import run_set_table
+def _one(args: tuple) -> dict:
+    from pycram.demos.set_table import OBJECTS, run_set_table
 
-    robot, seed, faults = args
-    return run_set_table(robot, seed, frozenset(faults))
+    robot, seed, faults, *rest = args
+    objects = rest[0] if rest and rest[0] else OBJECTS
+    return run_set_table(robot, seed, frozenset(faults), objects=tuple(objects))
 
 
 def _seeds(text: str) -> list[int]:
@@ -45,10 +46,12 @@ def main() -> None:
     parser.add_argument("--seeds", default="100-109")
     parser.add_argument("--faults", default="")
     parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--objects", default="", help="object types to bring (default: the scenario's)")
     parser.add_argument("--json", default=None, help="append one JSON line per run to this file")
     args = parser.parse_args()
     faults = tuple(f for f in args.faults.split(",") if f)
-    jobs = [(r, s, faults) for r in args.robots.split(",") for s in _seeds(args.seeds)]
+    objects = tuple(o for o in args.objects.split(",") if o)
+    jobs = [(r, s, faults, objects) for r in args.robots.split(",") for s in _seeds(args.seeds)]
     ctx = multiprocessing.get_context("spawn")
     results: list[dict] = []
     with ctx.Pool(args.jobs, maxtasksperchild=1) as pool:
@@ -72,7 +75,8 @@ def main() -> None:
         sims, walls = [r["sim_time"] for r in rs], [r["wall_time"] for r in rs]
         objects = Counter(n for r in rs for n, o in r["objects"].items() if o["placed"])
         print(
-            f"{robot}: {ok}/{len(rs)} succeeded ({100 * ok / len(rs):.0f} %), faults {','.join(faults) or 'none'}; "
+            f"{robot}: {ok}/{len(rs)} succeeded ({100 * ok / len(rs):.0f} %), objects {','.join(objects) or 'all'}, "
+            f"faults {','.join(faults) or 'none'}; "
             f"sim p50 {percentile(sims, 50):.0f} s p95 {percentile(sims, 95):.0f} s; "
             f"wall p50 {percentile(walls, 50):.0f} s p95 {percentile(walls, 95):.0f} s; "
             f"speed {sum(sims) / sum(walls):.1f}x real time"

@@ -89,8 +89,9 @@ SETTINGS: dict[str, tuple[float, float]] = {
 }
 #: The fault kinds `run_set_table` / `pycram demo --faults` accept.
 FAULTS = ("moved", "taken", "stuck", "obstacle", "missed")
-#: Judging: an object counts as placed within this distance [m] of its setting and this tilt.
+#: Judging: an object counts as placed within this distance [m] of its setting ...
 TOLERANCE = 0.05
+#: ... and tilted at most this much [rad] from upright.
 MAX_TILT = math.radians(20.0)
 #: A drawer counts as closed below this opening [m].
 CLOSED = 0.03
