@@ -1,7 +1,7 @@
 """The set-table scenario: a breakfast for one, from a seed, in the apartment (issue 17).
 
-From a seed, the objects of `OBJECTS` start at random spots on the counters and inside the
-drawers (`START_REGIONS`; the fridge is left out: robots cannot open doors yet, see
+From a seed, the objects of `OBJECTS` start at random spots on the kitchen counter and the
+drawer cabinet's top (`START_REGIONS`; not inside the drawers or the fridge yet, see
 `docs/set-table.md`). The robot starts at the apartment's start pose, knowing nothing about the
 objects, and runs `set_table_plan.set_table` for the place settings of `SETTINGS` (stated
 relative to the table's edge at the seat). The simulator's ground truth is used for judging only
@@ -14,8 +14,8 @@ acting on the simulator (this module is the plan's environment, not the plan):
 * ``moved``: a person moves the object the robot is about to fetch, once it comes near;
 * ``taken``: a person takes the object out of the gripper while the robot carries it and puts it
   back on the counter;
-* ``stuck``: a drawer holding an object is stuck at first and frees itself a while after the
-  robot first pulls on it;
+* ``stuck``: a drawer (one holding an object, if any does) is stuck at first and frees itself a
+  while after the robot first pulls on it (it matters when a search opens the drawers);
 * ``obstacle``: a box appears on the floor in the robot's way once it drives to the table;
 * ``missed``: perception misses a visible object with a probability (`MISS_PROBABILITY`).
 
@@ -64,16 +64,17 @@ SCENARIOS = ("thesis", "set-table")
 #: reliably: spoons are too thin for the fingers, cereal boxes push away; see the docs).
 OBJECTS = ("plate", "bowl", "cup", "milk")
 #: Where objects start, as data: object type -> the supports (surface names) it may start on,
-#: each with the region (x0, y0, x1, y1) [m, map; for drawer insides with the drawer closed]
-#: where it may stand: the front strip of the counter (the counter is 0.6 m deep; its back is
-#: out of reach of both robots, and side grasps of tall objects need the pre-grasp off the
-#: counter) and the middle of the top drawer. Measured: what both robots pick up. The fridge is
-#: left out: robots cannot open doors yet.
+#: each with the region (x0, y0, x1, y1) [m, map] where it may stand: the front strips of the
+#: kitchen counter and of the drawer cabinet's top. Measured: the counter's back half is out of
+#: both robots' reach; side grasps of tall objects need the pre-grasp off the counter; objects
+#: inside the drawers cannot be picked up yet (side grasps hit the drawer's walls, the robot does
+#: not fit in front of a fully opened drawer) and the fridge's door cannot be opened -- so the
+#: drawers are searched (with the ``missed`` fault) but no object starts in them.
 START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
-    "plate": {"counter": (0.5, 4.54, 2.4, 4.56)},
-    "bowl": {"counter": (0.5, 4.5, 2.4, 4.55)},
-    "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "drawer 3 inside": (0.2, 2.6, 0.4, 3.2)},
-    "milk": {"counter": (0.5, 4.47, 2.4, 4.5)},
+    "plate": {"counter": (0.5, 4.54, 2.4, 4.56), "cabinet top": (0.42, 2.55, 0.45, 3.25)},
+    "bowl": {"counter": (0.5, 4.5, 2.4, 4.55), "cabinet top": (0.42, 2.55, 0.5, 3.25)},
+    "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.55, 0.54, 3.25)},
+    "milk": {"counter": (0.5, 4.47, 2.4, 4.5), "cabinet top": (0.47, 2.55, 0.53, 3.25)},
 }
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
@@ -297,7 +298,8 @@ class Faults:
         self.moved_object = rng.choice([p.name for p in placements if p.container is None] or [None])
         self.taken_object = rng.choice([s.type for s in settings])
         in_drawers = sorted({p.container for p in placements if p.container is not None})
-        self.stuck_drawer = rng.choice(in_drawers) if in_drawers else None
+        drawers = [c.name for c in world.environment.containers if c.kind == "drawer"]
+        self.stuck_drawer = rng.choice(in_drawers or drawers) if drawers else None
         self.stuck_for = rng.uniform(4.0, 10.0)
         self.obstacle_fraction = rng.uniform(0.35, 0.6)
 
@@ -349,25 +351,22 @@ class Faults:
         return {s.get_value().holding for s in self.world.gripper_states.values()} - {None}
 
     def _free_counter_spot(self, name: str, near: tuple[float, float] | None = None) -> tuple[float, float, float]:
-        """A spot on the counter [m] clear of every object, for `name` standing upright."""
+        """A spot [m] for `name` standing upright in its counter start region, clear of every
+        object (and at least 0.15 m from `near`, within 0.6 m of it, when given)."""
         from pycram.world.objects import object_type
 
         surface = self.world.environment.surface("counter")
-        x0, y0, x1, y1 = surface.bounds
+        x0, y0, x1, y1 = START_REGIONS[name]["counter"]
         poses = self.world.item_poses.get_value()
-        half = object_type(name).half_height
-        for _ in range(200):
-            if near is not None:
-                x = min(max(near[0] + self.rng.uniform(-0.5, 0.5), x0 + 0.15), x1 - 0.15)
-                y = min(max(near[1] + self.rng.uniform(-0.1, 0.1), y0 + 0.15), y1 - 0.15)
-            else:
-                x, y = self.rng.uniform(x0 + 0.15, x1 - 0.15), self.rng.uniform(y0 + 0.15, y1 - 0.15)
-            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.22 for n, p in poses.items()):
+        z = surface.height + object_type(name).half_height + 0.002
+        for _ in range(300):
+            x, y = self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)
+            if near is not None and not 0.15 < math.hypot(x - near[0], y - near[1]) < 0.6:
                 continue
-            if near is not None and math.hypot(x - near[0], y - near[1]) < 0.15:
+            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.25 for n, p in poses.items()):
                 continue
-            return (x, y, surface.height + half + 0.002)
-        return (x0 + 0.3, y0 + 0.3, surface.height + half + 0.002)
+            return (x, y, z)
+        return ((x0 + x1) / 2, (y0 + y1) / 2, z)
 
     def _move_object(self) -> None:
         """Once the robot comes within 1.5 m of the object it is about to fetch, a person moves

@@ -50,6 +50,8 @@ log = logging.getLogger("pycram.demo")
 #: Simulated time [s] one transport round may take (search, fetch, place, the recoveries inside;
 #: a search through the three drawers alone takes about 150 s).
 ROUND_TIME_BUDGET = 300.0
+#: Drawers are opened this much [m] short of their slide's end (far out: the inside within reach).
+OPEN_SHORT_OF_END = 0.03
 #: Transport rounds per object (a second round after a failure a new search may fix).
 ROUNDS = 2
 
@@ -104,9 +106,14 @@ def close_opened_containers() -> list[str]:
 def open_alone(container: str) -> Any:
     """Open `container` after closing every other container believed open: a search that looks
     into one drawer after another leaves at most one open (open drawers stand in the robot's
-    way, and in the way of closing the ones below them)."""
+    way, and in the way of closing the ones below them), and open it as far as it goes."""
     close_opened_containers()
-    return perform(Open(container))
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    opening = None
+    if environment is not None and environment.container(container).kind == "drawer":
+        opening = environment.container(container).limits[1] - OPEN_SHORT_OF_END  # as far as it goes
+    return perform(Open(container, opening=opening))
 
 
 def find(type_name: str) -> Any:
