@@ -71,10 +71,10 @@ OBJECTS = ("plate", "bowl", "cup", "milk")
 #: not fit in front of a fully opened drawer) and the fridge's door cannot be opened -- so the
 #: drawers are searched (with the ``missed`` fault) but no object starts in them.
 START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
-    "plate": {"counter": (0.5, 4.54, 2.4, 4.56), "cabinet top": (0.42, 2.55, 0.45, 3.25)},
-    "bowl": {"counter": (0.5, 4.5, 2.4, 4.55), "cabinet top": (0.42, 2.55, 0.5, 3.25)},
-    "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.55, 0.54, 3.25)},
-    "milk": {"counter": (0.5, 4.47, 2.4, 4.5), "cabinet top": (0.47, 2.55, 0.53, 3.25)},
+    "plate": {"counter": (0.5, 4.54, 2.4, 4.56), "cabinet top": (0.42, 2.6, 0.45, 3.15)},
+    "bowl": {"counter": (0.5, 4.5, 2.4, 4.55), "cabinet top": (0.42, 2.6, 0.5, 3.15)},
+    "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.6, 0.54, 3.15)},
+    "milk": {"counter": (0.5, 4.47, 2.4, 4.5), "cabinet top": (0.47, 2.6, 0.53, 3.15)},
 }
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
