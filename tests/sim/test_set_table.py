@@ -91,7 +91,9 @@ def test_the_table_is_set_end_to_end(robot, seed, objects):
 
 
 @pytest.mark.timeout(400)
-def test_a_run_with_an_object_taken_from_the_gripper_recovers():
-    out = run_set_table("pr2", 2, frozenset({"taken"}))
-    assert any(f.startswith("taken:") for f in out["faults_injected"]), out["faults_injected"]
+def test_a_run_with_faults_recovers_from_a_taken_and_a_moved_object_and_an_obstacle():
+    out = run_set_table("pr2", 4, frozenset({"taken", "moved", "obstacle"}))
+    kinds = {f.split(":")[0] for f in out["faults_injected"]}
+    assert {"taken", "moved", "obstacle"} <= kinds, out["faults_injected"]
+    assert out["faults"] == ["moved", "obstacle", "taken"]
     _assert_set(out)
