@@ -40,6 +40,7 @@ from pycram.demos.set_table_plan import PlaceSetting, SettingOutcome
 __all__ = [
     "OBJECTS",
     "START_REGIONS",
+    "START_SPACING",
     "start_scene",
     "SEAT",
     "SETTINGS",
@@ -76,6 +77,9 @@ START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
     "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.6, 0.54, 3.15)},
     "milk": {"counter": (0.5, 4.47, 2.4, 4.5), "cabinet top": (0.47, 2.6, 0.53, 3.15)},
 }
+#: Objects start at least this far [m] apart (between their footprints): an arm reaching for one
+#: object knocks over a neighbour closer than this (measured: tall milk cartons and cups).
+START_SPACING = 0.25
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
 SEAT = "table south"
@@ -363,7 +367,7 @@ class Faults:
             x, y = self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)
             if near is not None and not 0.15 < math.hypot(x - near[0], y - near[1]) < 0.6:
                 continue
-            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.25 for n, p in poses.items()):
+            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.4 for n, p in poses.items()):
                 continue
             return (x, y, z)
         return ((x0 + x1) / 2, (y0 + y1) / 2, z)
@@ -526,7 +530,7 @@ def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS)
                 yaw,
                 otype.footprint_radius,
             )
-            if not any(candidate.overlaps(other, GAP + 0.1) for other in placed):
+            if not any(candidate.overlaps(other, GAP + START_SPACING) for other in placed):
                 placed.append(candidate)
                 break
         else:
