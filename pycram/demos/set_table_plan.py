@@ -24,12 +24,14 @@ raises nothing for a failed object, so the other objects are still brought.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from pycram.actions import Close, MoveTorso, Open, ParkArms, Transport, search_for
+from pycram.actions import Close, Detect, LookAt, MoveTorso, Navigate, Open, ParkArms, Transport, search_for
+from pycram.actions.core import base_pose_fluent
 from pycram.designator import ObjectDesignator, perform
-from pycram.failures import PlanFailure
+from pycram.failures import GraspFailed, ObjectOutOfReach, PlanFailure
 from pycram.fluent import Fluent
 from pycram.language import State, with_timeout
 from pycram.robot import current_robot
@@ -52,6 +54,8 @@ log = logging.getLogger("pycram.demo")
 ROUND_TIME_BUDGET = 300.0
 #: Drawers are opened this much [m] short of their slide's end (far out: the inside within reach).
 OPEN_SHORT_OF_END = 0.03
+#: Looking from elsewhere: a named place at least this far [m] from where the robot stands.
+ELSEWHERE = 0.5
 #: Transport rounds per object (a second round after a failure a new search may fix).
 ROUNDS = 2
 
@@ -122,6 +126,35 @@ def find(type_name: str) -> Any:
     return search_for(ObjectDesignator(type=type_name), open_container=open_alone)
 
 
+def look_from_elsewhere(type_name: str) -> None:
+    """Look at the believed object of `type_name` from the named place of the environment
+    nearest to it that the robot does not stand at: a pose perceived from one view (the object
+    partly hidden, e.g. by the robot's own arm) is measured again from another. Best effort."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if belief is None or environment is None:
+        return
+    believed = [o for o in belief.present() if o.type == type_name]
+    if not believed:
+        return
+    target = believed[0]
+    here = base_pose_fluent().get_value()
+    places = [
+        p.pose
+        for p in environment.places
+        if here is None or math.hypot(p.pose[0] - here.x, p.pose[1] - here.y) > ELSEWHERE
+    ]
+    if not places:
+        return
+    place = min(places, key=lambda pose: math.dist(pose[:2], target.pose[:2]))
+    try:
+        perform(Navigate(place))
+        perform(LookAt(target))
+        perform(Detect(type_name))
+    except PlanFailure as failure:
+        log.info("set table: looking at the %s from elsewhere: %s", type_name, failure)
+
+
 def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
     """Transport rounds for one setting, each bounded by the time budget."""
     for round_number in range(1, ROUNDS + 1):
@@ -142,6 +175,8 @@ def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
         if not isinstance(error, (PlanFailure, TimeoutError)):
             raise error  # a bug, not a failure of the world
         close_opened_containers()  # the next round starts with the room as it should be
+        if isinstance(error, (ObjectOutOfReach, GraspFailed)):
+            look_from_elsewhere(setting.type)  # perceived from one view only: measure it again
 
 
 def set_table(settings: list[PlaceSetting]) -> list[SettingOutcome]:
