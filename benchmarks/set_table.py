@@ -73,7 +73,7 @@ def main() -> None:
         ok = sum(r["success"] for r in rs)
         causes = Counter(c for r in rs for c in r["failure_causes"])
         sims, walls = [r["sim_time"] for r in rs], [r["wall_time"] for r in rs]
-        objects = Counter(n for r in rs for n, o in r["objects"].items() if o["placed"])
+        placed = Counter(n for r in rs for n, o in r["objects"].items() if o["placed"])
         print(
             f"{robot}: {ok}/{len(rs)} succeeded ({100 * ok / len(rs):.0f} %), objects {','.join(objects) or 'all'}, "
             f"faults {','.join(faults) or 'none'}; "
@@ -81,7 +81,7 @@ def main() -> None:
             f"wall p50 {percentile(walls, 50):.0f} s p95 {percentile(walls, 95):.0f} s; "
             f"speed {sum(sims) / sum(walls):.1f}x real time"
         )
-        print(f"  objects placed: {dict(objects)}; failure causes: {dict(causes) or 'none'}")
+        print(f"  objects placed: {dict(placed)}; failure causes: {dict(causes) or 'none'}")
 
 
 if __name__ == "__main__":

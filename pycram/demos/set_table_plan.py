@@ -52,8 +52,6 @@ log = logging.getLogger("pycram.demo")
 #: Simulated time [s] one transport round may take (search, fetch, place, the recoveries inside;
 #: a search through the three drawers alone takes about 150 s).
 ROUND_TIME_BUDGET = 300.0
-#: Drawers are opened this much [m] short of their slide's end (far out: the inside within reach).
-OPEN_SHORT_OF_END = 0.03
 #: Looking from elsewhere: a named place at least this far [m] from where the robot stands.
 ELSEWHERE = 0.5
 #: Transport rounds per object (a second round after a failure a new search may fix).
@@ -110,14 +108,9 @@ def close_opened_containers() -> list[str]:
 def open_alone(container: str) -> Any:
     """Open `container` after closing every other container believed open: a search that looks
     into one drawer after another leaves at most one open (open drawers stand in the robot's
-    way, and in the way of closing the ones below them), and open it as far as it goes."""
+    way, and in the way of closing the ones below them)."""
     close_opened_containers()
-    belief = getattr(current_robot(), "belief", None)
-    environment = getattr(belief, "environment", None)
-    opening = None
-    if environment is not None and environment.container(container).kind == "drawer":
-        opening = environment.container(container).limits[1] - OPEN_SHORT_OF_END  # as far as it goes
-    return perform(Open(container, opening=opening))
+    return perform(Open(container))
 
 
 def find(type_name: str) -> Any:
@@ -197,4 +190,5 @@ def set_table(settings: list[PlaceSetting]) -> list[SettingOutcome]:
         if outcome.placed:
             objects_done.set_value(objects_done.get_value() + 1)
         close_opened_containers()
+    close_opened_containers()  # a drawer that would not close is tried once more, from afresh
     return outcomes
