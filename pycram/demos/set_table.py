@@ -201,7 +201,8 @@ class SetTableResult:
 
     @property
     def failure_causes(self) -> list[str]:
-        causes = [o.failure for o in self.objects.values() if not o.placed and o.failure]
+        # an object the plan believed placed that is not at its place: "not_at_place"
+        causes = [o.failure or "not_at_place" for o in self.objects.values() if not o.placed]
         causes += [f"open:{c}" for c in self.open_containers]
         if self.error is not None:
             causes.append(self.error.split(":")[0])

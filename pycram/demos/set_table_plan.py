@@ -31,9 +31,11 @@ from typing import Any
 from pycram.actions import Close, Detect, LookAt, MoveTorso, Navigate, Open, ParkArms, Transport, search_for
 from pycram.actions.core import base_pose_fluent
 from pycram.designator import ObjectDesignator, perform
+from pycram.designators.core import DesignatorError
 from pycram.failures import GraspFailed, ObjectOutOfReach, PlanFailure
 from pycram.fluent import Fluent
 from pycram.language import State, with_timeout
+from pycram.process_module import ProcessModuleError
 from pycram.robot import current_robot
 
 __all__ = [
@@ -44,10 +46,15 @@ __all__ = [
     "ROUND_TIME_BUDGET",
     "ROUNDS",
     "current_object",
+    "WORLD_FAILURES",
     "objects_done",
 ]
 
 log = logging.getLogger("pycram.demo")
+
+#: What a failed step of the world raises: typed plan failures, and motions a process module
+#: could not execute or designators without a solution that escaped an action's recovery.
+WORLD_FAILURES = (PlanFailure, ProcessModuleError, DesignatorError)
 
 #: Simulated time [s] one transport round may take (search, fetch, place, the recoveries inside;
 #: a search through the three drawers alone takes about 150 s).
@@ -100,7 +107,7 @@ def close_opened_containers() -> list[str]:
         try:
             perform(Close(container.name))
             closed.append(container.name)
-        except PlanFailure as failure:
+        except WORLD_FAILURES as failure:
             log.warning("could not close %s: %s", container.name, failure)
     return closed
 
@@ -144,7 +151,7 @@ def look_from_elsewhere(type_name: str) -> None:
         perform(Navigate(place))
         perform(LookAt(target))
         perform(Detect(type_name))
-    except PlanFailure as failure:
+    except WORLD_FAILURES as failure:
         log.info("set table: looking at the %s from elsewhere: %s", type_name, failure)
 
 
@@ -165,7 +172,7 @@ def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
         outcome.failure = error
         outcome.attempts.append(f"round {round_number}: {type(error).__name__}: {error}")
         log.warning("set table: the %s, round %d: %s: %s", setting.type, round_number, type(error).__name__, error)
-        if not isinstance(error, (PlanFailure, TimeoutError)):
+        if not isinstance(error, (*WORLD_FAILURES, TimeoutError)):
             raise error  # a bug, not a failure of the world
         close_opened_containers()  # the next round starts with the room as it should be
         if isinstance(error, (ObjectOutOfReach, GraspFailed)):
