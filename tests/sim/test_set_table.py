@@ -97,3 +97,17 @@ def test_a_run_with_faults_recovers_from_a_taken_and_a_moved_object_and_an_obsta
     assert {"taken", "moved", "obstacle"} <= kinds, out["faults_injected"]
     assert out["faults"] == ["moved", "obstacle", "taken"]
     _assert_set(out)
+
+
+@pytest.mark.timeout(300)
+def test_a_run_for_the_experiment_runner_is_recorded_with_pictures(tmp_path, monkeypatch):
+    pytest.importorskip("sqlalchemy")
+    from pycram.trace import query
+
+    monkeypatch.chdir(tmp_path)
+    url = f"sqlite:///{tmp_path / 'trace.db'}"
+    out = run_set_table("tiago", 2, db_url=url, pictures=True, objects=("cup", "milk"))
+    _assert_set(out, ("cup", "milk"))
+    assert out["run_id"] is not None
+    assert (tmp_path / "output" / "set-table-tiago-2" / "end.png").exists()
+    assert any(str(r.id) == str(out["run_id"]) for r in query.runs(url=url))
