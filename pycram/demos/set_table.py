@@ -70,12 +70,14 @@ OBJECTS = ("plate", "bowl", "cup", "milk")
 #: both robots' reach; side grasps of tall objects need the pre-grasp off the counter; objects
 #: inside the drawers cannot be picked up yet (side grasps hit the drawer's walls, the robot does
 #: not fit in front of a fully opened drawer) and the fridge's door cannot be opened -- so the
-#: drawers are searched (with the ``missed`` fault) but no object starts in them.
+#: drawers are searched (with the ``missed`` fault) but no object starts in them. The milk
+#: carton starts on the counter only: on the cabinet top the PR2's arm knocked it over in 2 of
+#: 12 seeds.
 START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
     "plate": {"counter": (0.5, 4.54, 2.4, 4.56), "cabinet top": (0.42, 2.6, 0.45, 3.15)},
     "bowl": {"counter": (0.5, 4.5, 2.4, 4.55), "cabinet top": (0.42, 2.6, 0.5, 3.15)},
     "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.6, 0.54, 3.15)},
-    "milk": {"counter": (0.5, 4.47, 2.4, 4.5), "cabinet top": (0.47, 2.6, 0.53, 3.15)},
+    "milk": {"counter": (0.5, 4.47, 2.4, 4.5)},  # on the cabinet top the arm knocks it over
 }
 #: Objects start at least this far [m] apart (between their footprints): an arm reaching for one
 #: object knocks over a neighbour closer than this (measured: tall milk cartons and cups).
