@@ -421,10 +421,41 @@ def demo_command(
         help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
         "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set).",
     ),
+    scenario: str = typer.Option(
+        "thesis",
+        "--scenario",
+        help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the apartment.",
+    ),
+    faults: str = typer.Option(
+        "",
+        "--faults",
+        help="set-table only: comma-separated faults drawn from the seed: moved, taken, stuck, obstacle, missed.",
+    ),
 ) -> None:
-    """The thesis demo: fetch and place in the simulated kitchen, with recovery from failures."""
+    """The thesis demo (fetch and place in the simulated kitchen, with recovery from failures),
+    or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
     if output is not None:
         _check_output_folder(output)
+    scenarios = ("thesis", "set-table")
+    if scenario not in scenarios:
+        _fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
+    if scenario == "set-table":
+        from pycram.demos.set_table import main as set_table_main
+
+        code = _trace_errors(
+            set_table_main,
+            robot=robot,
+            seed=seed,
+            faults=faults,
+            output=output,
+            db=db,
+            record=_record_flag(record),
+            quiet=quiet,
+            animation=animation,
+        )
+        raise typer.Exit(int(code or 0))
+    if faults:
+        _fail("--faults applies to --scenario set-table only (the thesis demo has --steal)", code=2)
     try:
         from pycram.demos.kitchen import main as demo_main
     except ModuleNotFoundError as e:

@@ -97,8 +97,11 @@ log = logging.getLogger("pycram.actions")
 PICK_ROUNDS = 3
 #: Standing poses tried per perception.
 STANDING_POSES = 2
-#: The object counts as moved when seen again farther than this [m] from where it was planned for.
+#: The object counts as moved when seen again farther than this [m] from where it was planned for
+#: -- or than `MOVED_FRACTION` of its footprint radius, for wide objects: the perceived centre of
+#: a plate or bowl depends on the view (its far rim hidden by its near one), by up to ~5 cm.
 MOVED = 0.03
+MOVED_FRACTION = 0.5
 #: Spots tried per placing (spots without a standing pose to place from included), and standing
 #: poses per spot.
 PLACE_SPOTS = 8
@@ -266,7 +269,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     _look_again(obj)
     if obj.gone:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
-    if math.dist(obj.pose, planned) > MOVED:
+    if math.dist(obj.pose, planned) > max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius):
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
     point = _grasp_point(obj, grasp)
     try:
