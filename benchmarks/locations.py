@@ -78,6 +78,10 @@ def analytic_works(world, description, prospection, target, point) -> tuple[floa
     return elapsed, False
 
 
+def _xyz(p) -> str:
+    return "(" + ", ".join(f"{v:.2f}" for v in p) + ")"
+
+
 def pct(values: list[float], q: float) -> float:
     return float(np.percentile(values, q)) if values else float("nan")
 
@@ -90,6 +94,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--scenes", type=int, default=50)
     parser.add_argument("--robots", default="pr2,tiago")
+    parser.add_argument("--explain", action="store_true", help="print why each failed to_reach query failed")
     args = parser.parse_args()
     chosen = scenes(args.scenes)
     first_all: list[float] = []
@@ -111,6 +116,8 @@ def main() -> int:
                     stats["to_reach"].append(dt)
                     if error is not None:
                         fails["to_reach"] += 1
+                        if args.explain:
+                            print(f"  {robot_name} seed {seed}, {name} at {_xyz(pose.position)}: {error}")
                     else:
                         dt, nxt, error = timed(designator.next_solution)
                         stats["next"].append(dt)

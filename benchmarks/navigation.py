@@ -10,7 +10,8 @@ it), so it is timed with the simulation stopped.
 
     MUJOCO_GL=egl .venv/bin/python benchmarks/navigation.py [--env apartment] [--robot pr2] [--pairs 300]
 
-The last line has the form `planning: p50 X ms, p95 Y ms over N plans`.
+The last line has the form `planning: p50 X ms, p95 Y ms over N plans ...`: the times with the
+3D check, what a drive spends before it moves.
 """
 
 from __future__ import annotations
@@ -52,6 +53,8 @@ def main(argv: list[str]) -> int:
     rng = random.Random(11)
     all_times: list[float] = []
     settings = []
+    from pycram.sim.prospection import SimProspection
+
     with open_world(args.robot, args.env) as world:
         for setting in ("no obstacles", "3 obstacles"):
             if setting == "3 obstacles":
@@ -59,15 +62,17 @@ def main(argv: list[str]) -> int:
                     assert world.place_obstacle(x, y).wait(60).succeeded
             t0 = time.perf_counter()
             planner = floor_planner(world)
-            settings.append((setting, planner, (time.perf_counter() - t0) * 1e3))
-        prospection = world.prospection()  # answers on the last state after the world closed
+            build = (time.perf_counter() - t0) * 1e3
+            # the 3D check on the state the planner was built for (not a later one)
+            snapshot = world._state
+            prospection = SimProspection(world.scene, lambda snapshot=snapshot: snapshot)
+            settings.append((setting, planner, build, prospection))
     # planning runs in the simulation thread (the simulation waits for it): time it alone
     print(f"base path planning for the {args.robot} in {args.env!r}")
-    for setting, planner, build in settings:
+    for setting, planner, build, prospection in settings:
         poses = free_poses(planner, rng, 2 * args.pairs)
         pairs = list(zip(poses[::2], poses[1::2]))
         times, straight, detour, none = _plan_times(planner, pairs)
-        all_times += times
         detour_times = sorted(times)[straight:] if detour else []
         print(
             f"{setting:>13}: p50 {percentile(times, 50):6.1f} ms, p95 {percentile(times, 95):6.1f} ms, "
@@ -84,13 +89,14 @@ def main(argv: list[str]) -> int:
         with_exact = []
         for pair in pairs:  # a fresh memo per plan, as drives have
             with_exact += _plan_times(planner, [pair], memoized_free(prospection))[0]
+        all_times += with_exact
         print(
             f"{'':>13}  with the whole robot checked in 3D along the path (as drives do): "
             f"p50 {percentile(with_exact, 50):6.1f} ms, p95 {percentile(with_exact, 95):6.1f} ms"
         )
     print(
         f"planning: p50 {percentile(all_times, 50):.1f} ms, p95 {percentile(all_times, 95):.1f} ms "
-        f"over {len(all_times)} plans (target p95 <= 50 ms)"
+        f"over {len(all_times)} plans with the 3D check, as drives plan (target p95 <= 50 ms)"
     )
     return 0
 

@@ -23,7 +23,9 @@ Obstacles may come in layers, each kept off by its own outline of the robot (the
 uses height bands: the base alone keeps off a counter the arms reach over, the robot with its
 arms keeps off walls and tall boxes). A backend may add an exact check of poses
 (``exact_check``): where only the convex outline of an arm is in the way it decides, and it
-validates the final path every `EXACT_STEP`.
+validates the final path every `EXACT_STEP` -- wherever an obstacle of a layer is within reach
+of an outline (poses farther than every outline's radius from every obstacle are free by
+construction).
 
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
@@ -323,6 +325,14 @@ class PathPlanner:
         # only they are in the way, the backend's exact check decides
         return all(exact_check(float(xs[i]), float(ys[i]), float(yaws[i])) for i in np.nonzero(hit)[0])
 
+    def _surely_free(self, x: float, y: float) -> bool:
+        """Whether the robot at (x, y), at any heading and in any outline of its layers, is
+        farther than the clearance from every occupied cell (then no exact check is needed)."""
+        g = self.grid
+        r = int(math.floor((y - g.origin[1]) / g.resolution))
+        c = int(math.floor((x - g.origin[0]) / g.resolution))
+        return 0 <= r < g.shape[0] and 0 <= c < g.shape[1] and bool(self._sure_free[r, c])
+
     def segment_free(
         self, a: BasePose, b: BasePose, escape: BasePose | None = None, exact_check: PoseCheck | None = None
     ) -> bool:
@@ -418,6 +428,8 @@ class PathPlanner:
                 s = i / n
                 x, y = prev.x + s * (w.x - prev.x), prev.y + s * (w.y - prev.y)
                 if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+                    continue
+                if self._surely_free(x, y):  # no layer's obstacle within any outline's reach
                     continue
                 if not exact_check(x, y, prev.yaw + s * dyaw):
                     return (x, y)
