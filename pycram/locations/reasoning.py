@@ -93,9 +93,12 @@ FACING_SCALE = 0.6
 APPROACH_TOLERANCE = 0.45
 #: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
 TOP_PENALTY = 0.3
-#: Pushing a door: base headings tried per cell, relative to the one that puts the middle of the
-#: push at the arm's comfortable reach point [rad] (the hand sweeps across the robot's front).
-PUSH_YAW_OFFSETS = (0.0, -0.5, -1.0, 0.5)
+#: Pushing a door: base headings tried per cell, relative to the one that puts the push's first
+#: tool pose at the arm's comfortable reach point [rad] (the hand then sweeps across the front).
+PUSH_YAW_OFFSETS = (0.0, -0.4, 0.4, -0.8, 0.8)
+#: ... and the cells are ranked by how far [rad, as a scale] their bearing from the hinge is from
+#: the door's direction half way through the push (the robot stands in front of the swing).
+PUSH_BEARING_SCALE = 0.5
 #: Default opening [m for drawers, rad for doors] followed by ``to_open``.
 DRAWER_OPENING, DOOR_OPENING = 0.3, 1.2
 #: Grasp phases of ``to_reach`` by action.
@@ -520,14 +523,24 @@ class LocationReasoner:
         env = self.environment()
         start = float(self.container_states().get(container.name, 0.0))
         poses = doors.push_sequence(container, contact, start, goal, side)
-        middle = tuple(np.mean([p.position for p in poses if p.phase == "push"], axis=0))
+        # the hardest pose to reach is the first (from inside: past the door's free edge)
+        first = poses[0].position
         arms = self._arms(desig.prop_value("arm"))
         grid = FloorGrid.of(env)
         occupancy = occupancy_layer(env, grid, self._base_radius).copy()
         assert container.hinge is not None  # a door (checked above)
         hx, hy = container.hinge
-        swing = container.door_width + self.geometry.inscribed_radius
-        occupancy[np.hypot(grid.x - hx, grid.y - hy) < swing] = np.inf
+        # the base keeps clear of the panel wherever it will be during the push (the door swings
+        # only between where it is and `goal`, not all round the hinge)
+        low, high = sorted((start, goal))
+        for q in np.linspace(low, high, max(2, int(math.degrees(high - low) / 3) + 1)):
+            for distance in np.linspace(0.0, container.door_width, 8):
+                (px, py), _, _ = container.door_face(float(q), float(distance), "outside")
+                occupancy[np.hypot(grid.x - px, grid.y - py) < self._base_radius] = np.inf
+        # in front of the middle of the swing: around the hinge, where the door points half way
+        (mx, my), _, _ = container.door_face((start + goal) / 2, 1.0, "outside")
+        bearing = np.arctan2(grid.y - hy, grid.x - hx) - math.atan2(my - hy, mx - hx)
+        swing_layer = (np.abs((bearing + np.pi) % (2 * np.pi) - np.pi) / PUSH_BEARING_SCALE) ** 2
         maps, streams = {}, []
         for i, arm in enumerate(arms):
             d0 = self.geometry.reach_distance(arm)
@@ -535,7 +548,8 @@ class LocationReasoner:
                 grid,
                 {
                     "occupancy": occupancy,
-                    "reach": ring_layer(grid, middle, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4), d0 + 0.4),
+                    "reach": ring_layer(grid, first, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4), d0 + 0.4),
+                    "swing": swing_layer,
                 },
             )
             streams.append(_ranked(maps[arm], i, arm))
@@ -545,7 +559,7 @@ class LocationReasoner:
         def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
-            natural = math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm)
+            natural = math.atan2(first[1] - y, first[0] - x) - self.geometry.reach_bearing(arm)
             prosp = self.prospection()
             failure: tuple[str, str | None] = ("in collision", None)
             for offset in PUSH_YAW_OFFSETS:

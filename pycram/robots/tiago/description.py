@@ -121,6 +121,10 @@ APPROACH_OFFSETS = {
 #: pulls a door by its handle this far [rad] (20 deg: the door ends 18-19 deg open), lets go and
 #: pushes the door on from inside (`DOOR_PUSH`).
 DOOR_PULL_LIMIT = 0.35
+#: Before closing on a door's handle bar the gripper opens this far (a fraction of its 90 mm):
+#: closing from wide open, its fingers sank 2.7 mm into the 24 mm bar and then stayed there when
+#: told to open (measured on the fridge; from half open they sink 0.7 mm and let go).
+DOOR_GRIP_OPENING = 0.5
 #: How the hand meets a door's faces when it pushes them (see `pycram.locations.doors`). Inside:
 #: the tool points along the face towards the hinge (heading pi), the side of the palm (0.05 m
 #: from the tool axis, its centre 0.07 m behind the tool frame) against the face -- the back of a
