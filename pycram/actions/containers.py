@@ -439,6 +439,8 @@ def _operate_door(
     pushed shut by its outside face from where location reasoning finds, else by the handle
     from a new standing pose."""
     move = partial(_move_handle, belief=belief, container=container)
+    if container.name not in belief.container_states:  # never seen: how far is it open?
+        best_effort("looking at a door", partial(_measure, belief, container))
     if action == "closing":
         remembered = _remembered_handle_pose(container, arm)
         if remembered:
@@ -558,11 +560,14 @@ def _door_push_contact() -> Any:
 
 def _push_poses(container: Any, arm: str | None, goal: float, side: str) -> Any:
     """Solutions of ``('to_open', door), ('pushing', side)``: where to stand to push the door's
-    `side` face from its believed angle to `goal` [rad]. The hands are closed first: a hand
-    pushes closed, and the reasoning checks the robot as it is (open fingers collide)."""
+    `side` face from its believed angle to `goal` [rad]. The grippers are set as the robot
+    pushes with them first (``DOOR_PUSH[side]['gripper']``, a fraction open; default closed):
+    the reasoning checks the robot as it is."""
+    fraction = float(_door_push_contact()[side].get("gripper", 0.0))
     for hand in [arm] if arm is not None else arms():
         best_effort(
-            "closing a hand to push", partial(motion, type="setting_gripper", gripper=gripper_of(hand), position=0)
+            "setting a hand to push",
+            partial(motion, type="setting_gripper", gripper=gripper_of(hand), position=fraction),
         )
     properties: list[tuple[str, Any]] = [("to_open", container.name), ("opening", goal), ("pushing", side)]
     if arm is not None:
@@ -577,10 +582,11 @@ def _push_door(location: Any, belief: Any, container: Any, goal: float) -> float
     arm, side = location.arm, location.push
     contact = _door_push_contact()
     gripper = gripper_of(arm)
+    fraction = float(contact[side].get("gripper", 0.0))
     best_effort(
         "before pushing a door",
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
-        lambda: motion(type="setting_gripper", gripper=gripper, position=0),
+        lambda: motion(type="setting_gripper", gripper=gripper, position=fraction),
     )
     if location.torso is not None:
         motion(type="setting_torso", position=location.torso)

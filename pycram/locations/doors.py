@@ -11,6 +11,7 @@ face is that robot's data, its description's ``DOOR_PUSH[side]``:
   the face;
 - ``'offset'`` (along [m], off [m]): the tool frame from the contact point, along the panel
   (towards the free edge positive) and off the face;
+- ``'gripper'`` (optional): how far open [fraction] the gripper is while pushing (default 0);
 
 the tool's fingers open horizontally. The door's geometry (hinge, width, faces, handle height)
 is the environment's description (`pycram.world.environment.Container.door_face`).
