@@ -16,9 +16,15 @@ hinge in `DOOR_STEPS` tool poses, the wrist turning with the door (``reaching`` 
 ``orientation``). Letting go it backs the hand off the door and out round the door's free edge,
 backs the base off and parks the arm (an arm coming back round an open door pushes it shut). The
 door must be measured at least 60 deg open (`DOOR_USEFUL`) or within 10 deg of the goal; closed,
-below 4 deg (`DOOR_CLOSED`). `Close("fridge")` pushes the handle back along the arc from the
-pose the door was opened from. Robots whose description names a `DOOR_REFUSAL` (the TIAGo) do
-not: ``ContainerFailure`` with reason ``'door_not_supported'`` and that reason.
+below 4 deg (`DOOR_CLOSED`). A robot whose grip carries a door only part of the way (its
+description's `DOOR_PULL_LIMIT`, the TIAGo) pulls it that far by the handle, lets go, and pushes
+it on from inside with its hand (no grasp) from a standing pose of its own
+(``('to_open', door), ('pushing', 'inside')``, tool poses from `pycram.locations.doors` and the
+robot's `DOOR_PUSH`). `Close("fridge")` pushes the handle back along the arc from the pose the
+door was opened from by its handle alone; else (opened by pushing, after a failed opening, or
+by someone else) it pushes the door shut by its outside face from where location reasoning
+finds, at most `DOOR_PUSH_ARC` per standing pose; a robot without `DOOR_PUSH` closes by the
+handle from a new standing pose. A door never measured is looked at first.
 
 Failures, after `CONTAINER_ATTEMPTS` standing poses: `HandleMissed` (the gripper closed beside
 the handle -- or, for a door, on something wider than its bar), `ContainerStuck` (the drawer or
