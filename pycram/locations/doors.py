@@ -40,6 +40,7 @@ __all__ = [
 ]
 
 Side = Literal["inside", "outside"]
+#: The faces a door is pushed by: ``'inside'`` (to open it further), ``'outside'`` (to shut it).
 PUSH_SIDES: tuple[Side, Side] = ("inside", "outside")
 
 #: Pushing from inside, the hand meets the face this far [m] from the free edge (leverage, and
