@@ -479,7 +479,7 @@ def _operate_door(
             action, designator, container, _standing_poses(container, arm, goal), partial(move, goal=goal)
         )
         return measured
-    if belief.container_states.get(container.name, 0.0) < limit - DOOR_TOLERANCE:
+    if belief.container_states.get(container.name, 0.0) < limit - DOOR_TOLERANCE / 2:
         # as far as the grip carries the door (measured at least `limit - DOOR_TOLERANCE`)
         _try_poses(
             action,
