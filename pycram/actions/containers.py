@@ -472,6 +472,13 @@ def _operate_door(
                 _push_poses(container, arm, target, "outside"),
                 lambda location, target=target: _push_door(location, belief, container, target),
             )
+        if measured >= DOOR_CLOSED:  # never silently: still open after every stage
+            raise ContainerStuck(
+                f"closing {container.name!r}: still open {math.degrees(measured):.0f} deg after "
+                f"{CONTAINER_ATTEMPTS} pushes",
+                container.name,
+                designator,
+            )
         return measured
     limit = _door_pull_limit()
     if limit is None or goal <= limit:
@@ -583,8 +590,10 @@ def _push_poses(container: Any, arm: str | None, goal: float, side: str) -> Any:
 
 def _push_door(location: Any, belief: Any, container: Any, goal: float) -> float:
     """One attempt: stand at `location`, look, push the door's `location.push` face along its arc
-    from where it is measured to `goal` [rad] with the hand closed (no grasp), back off, arm
-    parked, look. Returns the measured angle."""
+    from where it is measured to `goal` [rad] with the hand (no grasp; the gripper as the robot's
+    `DOOR_PUSH` says), back off, arm parked, look. Returns the measured angle [rad]: opened at
+    least `DOOR_USEFUL` or within `DOOR_TOLERANCE` of `goal`, shut below `DOOR_CLOSED`, part of the
+    way shut at most `DOOR_TOLERANCE` beyond `goal` -- else `ContainerStuck`."""
     arm, side = location.arm, location.push
     contact = _door_push_contact()
     gripper = gripper_of(arm)
