@@ -16,9 +16,15 @@ hinge in `DOOR_STEPS` tool poses, the wrist turning with the door (``reaching`` 
 ``orientation``). Letting go it backs the hand off the door and out round the door's free edge,
 backs the base off and parks the arm (an arm coming back round an open door pushes it shut). The
 door must be measured at least 60 deg open (`DOOR_USEFUL`) or within 10 deg of the goal; closed,
-below 4 deg (`DOOR_CLOSED`). `Close("fridge")` pushes the handle back along the arc from the
-pose the door was opened from. Robots whose description names a `DOOR_REFUSAL` (the TIAGo) do
-not: ``ContainerFailure`` with reason ``'door_not_supported'`` and that reason.
+below 4 deg (`DOOR_CLOSED`). A robot whose grip carries a door only part of the way (its
+description's `DOOR_PULL_LIMIT`, the TIAGo) pulls it that far by the handle, lets go, and pushes
+it on from inside with its hand (no grasp) from a standing pose of its own
+(``('to_open', door), ('pushing', 'inside')``, tool poses from `pycram.locations.doors` and the
+robot's `DOOR_PUSH`). `Close("fridge")` pushes the handle back along the arc from the pose the
+door was opened from by its handle alone; else (opened by pushing, after a failed opening, or
+by someone else) it pushes the door shut by its outside face from where location reasoning
+finds, at most `DOOR_PUSH_ARC` per standing pose; a robot without `DOOR_PUSH` closes by the
+handle from a new standing pose. A door never measured is looked at first.
 
 Failures, after `CONTAINER_ATTEMPTS` standing poses: `HandleMissed` (the gripper closed beside
 the handle -- or, for a door, on something wider than its bar), `ContainerStuck` (the drawer or
@@ -40,6 +46,7 @@ from typing import Any
 from pycram.designators.action import ActionDesignator
 from pycram.designators.location import LocationDesignator
 from pycram.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
+from pycram.locations import doors
 from pycram.robot import current_robot
 
 from .core import (
@@ -47,6 +54,7 @@ from .core import (
     ActionParameterError,
     action_plan,
     arm_name,
+    arms,
     attempt,
     base_pose_fluent,
     best_effort,
@@ -94,6 +102,9 @@ DOOR_STEPS = 8
 #: A door counts as closed below this angle [rad] (4 deg), as opened when within this of its
 #: goal -- or at least `DOOR_USEFUL` [rad] open (60 deg: enough to look and reach in).
 DOOR_CLOSED, DOOR_TOLERANCE, DOOR_USEFUL = math.radians(4), math.radians(10), math.radians(60)
+#: Pushing a door shut by its outside face, at most this far [rad] (46 deg) from one standing pose
+#: (from further open no pose was found for the TIAGo's arm: it closes in stages).
+DOOR_PUSH_ARC = 0.8
 #: Closing pushes the handle this far [rad] beyond closed (the door's stop holds it).
 DOOR_PUSH_BEYOND = 0.03
 #: Backing off from a door's handle [m] when the standing pose does not say (its pre-grasp offset).
@@ -102,6 +113,8 @@ DOOR_BACK_OFF = 0.1
 DOOR_HANDLE_WIDEST = 0.04
 #: Letting go, the hand moves out this far [m] past the door's free edge before the arm goes up.
 DOOR_EDGE_CLEARANCE = 0.12
+#: ... when the door is open more than this [rad] (30 deg; less open, the arm comes back in front of it)
+DOOR_AROUND_FROM = math.radians(30)
 #: ... and the base backs off this far [m] (the elbow clear of the door) before the arm goes up.
 DOOR_BASE_BACK_OFF = 0.3
 
@@ -133,11 +146,7 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
     if name not in names:
         raise ActionParameterError(action, "container", f"the environment has no container {name!r}", names)
     container = environment.container(name)
-    if container.kind == "door":
-        refusal = _door_refusal()
-        if refusal is not None:
-            raise ContainerFailure(f"{action} {name!r}: {refusal}", name, designator, "door_not_supported")
-    elif container.kind != "drawer":
+    if container.kind not in ("door", "drawer"):
         raise ContainerFailure(
             f"{action} {name!r}: robots open and close drawers and doors only, not a {container.kind!r}",
             name,
@@ -147,19 +156,28 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
     return belief, environment, container
 
 
-def _measure(belief: Any, container: Any) -> float | None:
-    """Look at the handle; the opening [m] perception measured (None when it could not)."""
-    q = belief.container_states.get(container.name, 0.0)
-    # standing close, the head may not turn all the way: it looks as near as it can
-    best_effort(
-        "looking at a handle", lambda: motion(type="pointing_head", coordinates=list(container.handle_position(q)))
-    )
-    motion(type="detecting")
+def _measure(belief: Any, container: Any, expected: float | None = None) -> float | None:
+    """Look at the handle; the opening [m or rad] perception measured (None when it could not).
+
+    With `expected` (where the container should be now, far from where it is believed to be) the
+    head looks there first and then where it was believed to be: perception measures the
+    container whenever its handle is in view, so the belief ends with what was seen."""
+    believed = belief.container_states.get(container.name, 0.0)
+    looks = [believed]
+    if expected is not None and abs(expected - believed) > DOOR_TOLERANCE:
+        looks.insert(0, expected)
+    for q in looks:
+        # standing close, the head may not turn all the way: it looks as near as it can
+        best_effort(
+            "looking at a handle",
+            partial(motion, type="pointing_head", coordinates=list(container.handle_position(q))),
+        )
+        motion(type="detecting")
     measured = belief.container_states.get(container.name)
     return None if measured is None else float(measured)
 
 
-def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> float:
+def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> float:
     """One attempt: stand at `location`, grasp the handle, move it to `goal` [m], let go, look."""
     arm, grasp = location.arm, location.grasp
     gripper = gripper_of(arm)
@@ -228,13 +246,6 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     return measured
 
 
-def _door_refusal() -> str | None:
-    """Why the active robot does not open and close doors (its description's `DOOR_REFUSAL`;
-    None: it does)."""
-    refusal = getattr(getattr(current_robot(), "description", None), "DOOR_REFUSAL", None)
-    return None if refusal is None else str(refusal)
-
-
 def _yaw_quat(yaw: float) -> list[float]:
     """Orientation (w, x, y, z) of a tool pointing along `yaw` [rad], fingers opening horizontally."""
     return [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
@@ -267,6 +278,9 @@ def _swing_door(location: Any, belief: Any, container: Any, start: float, goal: 
     back = math.dist(poses[0][0], poses[1][0]) if len(poses) >= 2 else DOOR_BACK_OFF
     pre, orientation = _door_pose(container, start, back)
     handle, _ = _door_pose(container, start)
+    grip_opening = getattr(getattr(current_robot(), "description", None), "DOOR_GRIP_OPENING", None)
+    if grip_opening is not None:  # the robot closes on a handle's bar best from this far open
+        motion(type="setting_gripper", gripper=gripper, position=float(grip_opening))
     motion(type="reaching", arm=arm, target=pre, phase="pre_grasp", orientation=orientation)
     motion(type="reaching", arm=arm, target=handle, phase="grasp", orientation=orientation)
     opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
@@ -329,11 +343,24 @@ def _let_go_of_door(arm: str, gripper: str, container: Any, q: float, back: floa
         lambda: motion(type="reaching", arm=arm, target=past_edge(away), phase="retreat", orientation=orientation),
         lambda: motion(type="reaching", arm=arm, target=past_edge(beyond), phase="retreat", orientation=orientation),
     ]
+
+    def back_off() -> None:
+        try:
+            motion(type="reaching", arm=arm, target=away, phase="retreat", orientation=orientation)
+        except RECOVERABLE as error:  # e.g. no IK solution that close to the base: the base backs off
+            log.info("%s: backing the hand off %.2f m: %s", container.name, back, unwrap(error))
+            here = base_pose_fluent().get_value()
+            heading = _door_heading(container, q) - (here.yaw if here is not None else 0.0)
+            motion(
+                type="moving", pose=(-back * math.cos(heading), -back * math.sin(heading), 0.0), frame="base_footprint"
+            )
+
     best_effort(
         "letting go of a handle",
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
-        lambda: motion(type="reaching", arm=arm, target=away, phase="retreat", orientation=orientation),
-        *(around if q > DOOR_CLOSED else []),  # a closed door has no edge to reach round
+        back_off,
+        # a door open only a little: the arm comes back in front of it; else round its free edge
+        *(around if q > DOOR_AROUND_FROM else []),
         lambda: motion(type="moving", pose=(-DOOR_BASE_BACK_OFF, 0.0, 0.0), frame="base_footprint"),
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
     )
@@ -396,22 +423,109 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
     belief, _, container = _container(action, designator)
     arm = arm_name(action, designator.prop_value("arm"))
     goal = goal_of(container)
+    if container.kind == "door":
+        return _operate_door(action, designator, belief, container, arm, goal)
+    travel = max(goal, belief.container_states.get(container.name, 0.0), 0.05)
+    poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=action == "closing")
+    measured = _try_poses(
+        action, designator, container, poses, partial(_move_handle, belief=belief, container=container, goal=goal)
+    )
+    return measured
+
+
+def _operate_door(
+    action: str, designator: ActionDesignator, belief: Any, container: Any, arm: str | None, goal: float
+) -> float:
+    """Open or close the door `container` to `goal` [rad].
+
+    Opening: by the handle along the arc -- for a robot whose grip carries a door only part of
+    the way (its description's `DOOR_PULL_LIMIT`), by the handle that far and then pushed on
+    from inside (`pycram.locations.doors`) from a standing pose of its own. Closing: by the
+    handle from the pose it was opened from (when it was opened by the handle alone), else
+    pushed shut by its outside face from where location reasoning finds, else by the handle
+    from a new standing pose."""
+    move = partial(_move_handle, belief=belief, container=container)
+    if container.name not in belief.container_states:  # never seen: how far is it open?
+        best_effort("looking at a door", partial(_measure, belief, container))
+    if action == "closing":
+        remembered = _remembered_handle_pose(container, arm)
+        if remembered:
+            try:
+                return _try_poses(action, designator, container, remembered, partial(move, goal=0.0))
+            except RECOVERABLE as error:
+                log.info("%s: closing by the handle from where it was opened: %s", container.name, unwrap(error))
+        if getattr(getattr(current_robot(), "description", None), "DOOR_PUSH", None) is None:
+            return _try_poses(
+                action, designator, container, _standing_poses(container, arm, 0.0), partial(move, goal=0.0)
+            )
+        # pushed shut by its outside face, at most `DOOR_PUSH_ARC` per standing pose
+        measured = belief.container_states.get(container.name, 0.0)
+        for _ in range(CONTAINER_ATTEMPTS):
+            if measured < DOOR_CLOSED:
+                break
+            target = max(0.0, measured - DOOR_PUSH_ARC)
+            target = 0.0 if target < DOOR_TOLERANCE else target
+            measured = _try_poses(
+                action,
+                designator,
+                container,
+                _push_poses(container, arm, target, "outside"),
+                lambda location, target=target: _push_door(location, belief, container, target),
+            )
+        if measured >= DOOR_CLOSED:  # never silently: still open after every stage
+            raise ContainerStuck(
+                f"closing {container.name!r}: still open {math.degrees(measured):.0f} deg after "
+                f"{CONTAINER_ATTEMPTS} pushes",
+                container.name,
+                designator,
+            )
+        return measured
+    limit = _door_pull_limit()
+    if limit is None or goal <= limit:
+        measured = _try_poses(
+            action, designator, container, _standing_poses(container, arm, goal), partial(move, goal=goal)
+        )
+        return measured
+    if belief.container_states.get(container.name, 0.0) < limit - DOOR_TOLERANCE / 2:
+        # as far as the grip carries the door (measured at least `limit - DOOR_TOLERANCE`)
+        _try_poses(
+            action,
+            designator,
+            container,
+            _standing_poses(container, arm, limit),
+            partial(move, goal=limit),
+            remember=False,
+        )
+    return _try_poses(
+        action,
+        designator,
+        container,
+        _push_poses(container, arm, goal, "inside"),
+        lambda location: _push_door(location, belief, container, goal),
+        remember=False,
+    )
+
+
+def _try_poses(
+    action: str, designator: ActionDesignator, container: Any, poses: Any, run: Any, remember: bool = True
+) -> float:
+    """Try `run(location)` from each standing pose of `poses` in turn (at most
+    `CONTAINER_ATTEMPTS`), each as an attempt of its own; the measured opening of the first that
+    succeeds (opening: its pose remembered for closing, with `remember`). Raises the last typed
+    failure with every attempt's reason, `ObjectOutOfReach` when there was no standing pose."""
     attempts: list[str] = []
     last: BaseException | None = None
-    travel = max(goal, belief.container_states.get(container.name, 0.0), 0.05)
     try:
-        if container.kind == "door" and action == "closing":
-            travel = 0.0  # ('to_open', door) validates the arc from the believed angle to `travel`
-        poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=action == "closing")
         for number, location in enumerate(poses, start=1):
             if number > CONTAINER_ATTEMPTS:
                 break
+            how = "pushing" if getattr(location, "push", None) else f"with the {location.arm} arm"
             try:
                 measured = attempt(
-                    f"{action} {container.name} from ({location.x:.2f}, {location.y:.2f}) with the {location.arm} arm",
-                    partial(_move_handle, location, belief, container, goal),
+                    f"{action} {container.name} from ({location.x:.2f}, {location.y:.2f}) {how}",
+                    partial(run, location),
                 )
-                if action == "opening":
+                if action == "opening" and remember:
                     _opened_from.setdefault(current_robot(), {})[container.name] = location
                 return float(measured)
             except RECOVERABLE as error:
@@ -427,6 +541,124 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
     if isinstance(last, ContainerFailure):
         raise type(last)(message, container.name, designator, last.reason, attempts) from last
     raise ContainerStuck(message, container.name, designator, getattr(last, "reason", None), attempts) from last
+
+
+def _remembered_handle_pose(container: Any, arm: str | None) -> list[Any]:
+    """The standing pose the door `container` was last opened from by its handle alone (valid
+    for closing it by the handle), if any."""
+    remembered = _opened_from.get(current_robot(), {}).get(container.name)
+    if (
+        remembered is None
+        or getattr(remembered, "push", None) is not None
+        or (arm is not None and remembered.arm != arm)
+    ):
+        return []
+    return [remembered]
+
+
+def _door_pull_limit() -> float | None:
+    """How far [rad] the active robot's grip carries a door by its handle (its description's
+    `DOOR_PULL_LIMIT`; None: all the way)."""
+    limit = getattr(getattr(current_robot(), "description", None), "DOOR_PULL_LIMIT", None)
+    return None if limit is None else float(limit)
+
+
+def _door_push_contact() -> Any:
+    """How the active robot's hand meets a door's faces (its description's `DOOR_PUSH`)."""
+    contact = getattr(getattr(current_robot(), "description", None), "DOOR_PUSH", None)
+    if contact is None:
+        raise ContainerFailure(f"the {getattr(current_robot(), 'name', 'robot')} does not push doors (no DOOR_PUSH)")
+    return contact
+
+
+def _push_poses(container: Any, arm: str | None, goal: float, side: str) -> Any:
+    """Solutions of ``('to_open', door), ('pushing', side)``: where to stand to push the door's
+    `side` face from its believed angle to `goal` [rad]. The grippers are set as the robot
+    pushes with them first (``DOOR_PUSH[side]['gripper']``, a fraction open; default closed):
+    the reasoning checks the robot as it is."""
+    fraction = float(_door_push_contact()[side].get("gripper", 0.0))
+    for hand in [arm] if arm is not None else arms():
+        best_effort(
+            "setting a hand to push",
+            partial(motion, type="setting_gripper", gripper=gripper_of(hand), position=fraction),
+        )
+    properties: list[tuple[str, Any]] = [("to_open", container.name), ("opening", goal), ("pushing", side)]
+    if arm is not None:
+        properties.append(("arm", arm))
+    yield from solutions(LocationDesignator(properties))
+
+
+def _push_door(location: Any, belief: Any, container: Any, goal: float) -> float:
+    """One attempt: stand at `location`, look, push the door's `location.push` face along its arc
+    from where it is measured to `goal` [rad] with the hand (no grasp; the gripper as the robot's
+    `DOOR_PUSH` says), back off, arm parked, look. Returns the measured angle [rad]: opened at
+    least `DOOR_USEFUL` or within `DOOR_TOLERANCE` of `goal`, shut below `DOOR_CLOSED`, part of the
+    way shut at most `DOOR_TOLERANCE` beyond `goal` -- else `ContainerStuck`."""
+    arm, side = location.arm, location.push
+    contact = _door_push_contact()
+    gripper = gripper_of(arm)
+    fraction = float(contact[side].get("gripper", 0.0))
+    best_effort(
+        "before pushing a door",
+        lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
+        lambda: motion(type="setting_gripper", gripper=gripper, position=fraction),
+    )
+    if location.torso is not None:
+        motion(type="setting_torso", position=location.torso)
+    here = base_pose_fluent().get_value()
+    if (
+        here is None
+        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
+        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
+    ):
+        motion(type="moving", pose=location)
+    start = _measure(belief, container)
+    start = belief.container_states.get(container.name, 0.0) if start is None else start
+    closing = goal <= 0.0
+    if abs(start - goal) < DOOR_TOLERANCE / 2 or (closing and start < DOOR_CLOSED):
+        return start
+    reached = start
+    try:
+        for pose in doors.push_sequence(container, contact, start, goal, side):
+            try:
+                motion(type="reaching", arm=arm, target=list(pose.position), orientation=list(pose.orientation))
+            except RECOVERABLE as error:
+                if getattr(unwrap(error), "reason", None) != "blocked":
+                    raise
+                # an approach that brushed the door goes on; a push that stopped: the door stopped
+                log.info("%s: %s pose stopped short: %s", container.name, pose.phase, unwrap(error))
+                if pose.phase == "push":
+                    break
+                continue
+            if pose.phase == "push":
+                reached = pose.angle
+    finally:
+        q = max(min(reached, container.limits[1]), 0.0)
+        retreat = [
+            partial(motion, type="reaching", arm=arm, target=list(p.position), orientation=list(p.orientation))
+            for p in doors.retreat_sequence(container, contact, q, side)
+        ]
+        best_effort(
+            "letting go of a door",
+            *retreat,
+            lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
+        )
+    measured = _measure(belief, container, expected=reached)
+    if measured is None:
+        raise ContainerFailure(f"could not see the handle of {container.name!r} after pushing it", container.name)
+    if closing:
+        done = measured < DOOR_CLOSED
+    elif goal < start:  # part of the way shut
+        done = measured <= goal + DOOR_TOLERANCE
+    else:
+        done = measured >= min(goal - DOOR_TOLERANCE, DOOR_USEFUL)
+    if not done:
+        raise ContainerStuck(
+            f"{container.name!r} is open {math.degrees(measured):.0f} deg after pushing its {side} face from "
+            f"{math.degrees(start):.0f} towards {math.degrees(goal):.0f} deg",
+            container.name,
+        )
+    return measured
 
 
 @action_plan("opening")

@@ -69,7 +69,8 @@ OBJECTS = ("plate", "bowl", "cup", "milk")
 #: kitchen counter and of the drawer cabinet's top. Measured: the counter's back half is out of
 #: both robots' reach; side grasps of tall objects need the pre-grasp off the counter; objects
 #: inside the drawers cannot be picked up yet (side grasps hit the drawer's walls, the robot does
-#: not fit in front of a fully opened drawer) and the fridge's door cannot be opened -- so the
+#: not fit in front of a fully opened drawer) and the fridge was left out (doors could not be
+#: opened when these figures were measured) -- so the
 #: drawers are searched (with the ``missed`` fault) but no object starts in them. The milk
 #: carton starts on the counter only: on the cabinet top the PR2's arm knocked it over in 2 of
 #: 12 seeds.

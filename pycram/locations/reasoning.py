@@ -13,6 +13,9 @@ designator                           solutions
                                      (at least half of it, unoccluded)
 ``('to_open', c)`` [``('arm', a)``,   `BaseLocation` from which the arm grasps the handle of the
 ``('opening', q)``]                   drawer or door ``c`` and follows its opening trajectory
+``('to_open', door), ('pushing', s)``  `BaseLocation` from which the hand pushes the door's face
+[``('opening', q)``, ``('arm', a)``]  ``s`` (``'inside'``/``'outside'``) along its arc to ``q``
+                                     (`pycram.locations.doors`; ``push`` names the side)
 ``('on', s)`` [``('near', o)``,       `Spot`: a free spot on surface ``s`` where an object of that
 ``('for', type/object)``]             type fits without touching the known objects
 ``('in', c)`` [same options]         `Spot` inside container ``c`` (its interior surfaces)
@@ -50,6 +53,7 @@ from pycram.designators.core import NoSolutionError
 from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Surface, Vec3
 from pycram.world.objects import Grasp, ObjectType, object_type
 
+from . import doors
 from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, ring_layer
 from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation, Spot
@@ -61,7 +65,7 @@ log = logging.getLogger(__name__)
 
 #: The keys location reasoning understands; a designator with any other key is left to others.
 VOCABULARY = frozenset(
-    {"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for", "action", "opening"}
+    {"to_reach", "to_see", "to_open", "on", "in", "arm", "grasp", "near", "for", "action", "opening", "pushing"}
 )
 #: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
 #: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
@@ -89,6 +93,12 @@ FACING_SCALE = 0.6
 APPROACH_TOLERANCE = 0.45
 #: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
 TOP_PENALTY = 0.3
+#: Pushing a door: base headings tried per cell, relative to the one that puts the push's first
+#: tool pose at the arm's comfortable reach point [rad] (the hand then sweeps across the front).
+PUSH_YAW_OFFSETS = (0.0, -0.4, 0.4, -0.8, 0.8)
+#: ... and the cells are ranked by how far [rad, as a scale] their bearing from the hinge is from
+#: the door's direction half way through the push (the robot stands in front of the swing).
+PUSH_BEARING_SCALE = 0.5
 #: Default opening [m for drawers, rad for doors] followed by ``to_open``.
 DRAWER_OPENING, DOOR_OPENING = 0.3, 1.2
 #: Grasp phases of ``to_reach`` by action.
@@ -417,6 +427,9 @@ class LocationReasoner:
         )
         if not lo <= opening <= hi:
             raise ValueError(f"opening {opening} of {container.name!r} is outside its limits {container.limits}")
+        side = desig.prop_value("pushing")
+        if side is not None:
+            return self._to_push(desig, container, opening, side)
         # from where the handle is believed to be now (a drawer already partly open moves on
         # from there, or back to `opening`)
         start = float(self.container_states().get(container.name, 0.0))
@@ -495,6 +508,94 @@ class LocationReasoner:
 
         target = Target(container.handle, "container", container.name, thing=container)
         return self._search(desig, heapq.merge(*streams), validate, "to_open", target, maps)
+
+    def _to_push(self, desig: Any, container: Container, goal: float, side: str) -> Iterator[BaseLocation]:
+        """Solutions of ``('to_open', door), ('pushing', side)``: base poses from which the hand
+        pushes the door's `side` face from its believed angle to `goal` [rad]. Each tool pose is
+        checked with the door where it will be then (the door moves ahead of the hand)."""
+        if container.kind != "door":
+            raise self._fail(desig, f"only doors are pushed open or shut, {container.name!r} is a {container.kind}")
+        if side not in doors.PUSH_SIDES:
+            raise ValueError(f"('pushing', {side!r}): a door is pushed from {' or '.join(doors.PUSH_SIDES)}")
+        contact = self.geometry.door_push
+        if contact is None:
+            raise self._fail(desig, f"the {self.geometry.name} does not push doors (its description has no DOOR_PUSH)")
+        env = self.environment()
+        start = float(self.container_states().get(container.name, 0.0))
+        poses = doors.push_sequence(container, contact, start, goal, side)
+        # the hardest pose to reach is the first (from inside: past the door's free edge)
+        first = poses[0].position
+        arms = self._arms(desig.prop_value("arm"))
+        grid = FloorGrid.of(env)
+        occupancy = occupancy_layer(env, grid, self._base_radius).copy()
+        assert container.hinge is not None  # a door (checked above)
+        hx, hy = container.hinge
+        # the base keeps clear of the panel wherever it will be during the push (the door swings
+        # only between where it is and `goal`, not all round the hinge)
+        low, high = sorted((start, goal))
+        for q in np.linspace(low, high, max(2, int(math.degrees(high - low) / 3) + 1)):
+            for distance in np.linspace(0.0, container.door_width, 8):
+                (px, py), _, _ = container.door_face(float(q), float(distance), "outside")
+                occupancy[np.hypot(grid.x - px, grid.y - py) < self._base_radius] = np.inf
+        # in front of the middle of the swing: around the hinge, where the door points half way
+        (mx, my), _, _ = container.door_face((start + goal) / 2, 1.0, "outside")
+        bearing = np.arctan2(grid.y - hy, grid.x - hx) - math.atan2(my - hy, mx - hx)
+        swing_layer = (np.abs((bearing + np.pi) % (2 * np.pi) - np.pi) / PUSH_BEARING_SCALE) ** 2
+        maps, streams = {}, []
+        for i, arm in enumerate(arms):
+            d0 = self.geometry.reach_distance(arm)
+            maps[arm] = Costmap(
+                grid,
+                {
+                    "occupancy": occupancy,
+                    "reach": ring_layer(grid, first, d0, 2 * REACH_SIGMA, max(0.2, d0 - 0.4), d0 + 0.4),
+                    "swing": swing_layer,
+                },
+            )
+            streams.append(_ranked(maps[arm], i, arm))
+        self.last_costmaps = maps
+        joint = container.joint_name
+
+        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+            cost, _, arm, r, c = cell
+            x, y = maps[arm].xy(r, c)
+            natural = math.atan2(first[1] - y, first[0] - x) - self.geometry.reach_bearing(arm)
+            prosp = self.prospection()
+            failure: tuple[str, str | None] = ("in collision", None)
+            for offset in PUSH_YAW_OFFSETS:
+                yaw = _wrap(natural + offset)
+                if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+                    continue
+                solved, reason = self._reachable_along(prosp, arm, (x, y, yaw), poses, joint)
+                if reason is None:
+                    location = BaseLocation(
+                        x, y, yaw, arm, "push", cost, joints=tuple(solved), tool_poses=tuple(poses), push=side
+                    )
+                    return location, None
+                failure = (f"unreachable for arm {arm!r}", reason)
+            return None, failure
+
+        target = Target(container.handle, "container", container.name, thing=container)
+        return self._search(desig, heapq.merge(*streams), validate, f"pushing the {side} of", target, maps)
+
+    def _reachable_along(
+        self, prosp: Any, arm: str, base: tuple[float, float, float], poses: Sequence[Any], joint: str
+    ) -> tuple[list[tuple[float, ...]], str | None]:
+        """IK for each tool pose of `poses` in turn (each with its `angle`: the position of the
+        container's `joint` then), seeded with the previous solution; (solutions, None) or
+        (the solutions so far, why the next pose failed)."""
+        joints = self.geometry.arm_joints[arm]
+        solutions: list[tuple[float, ...]] = []
+        for pose in poses:
+            configuration = dict(self.geometry.tucked)
+            if solutions:
+                configuration.update(zip(joints, solutions[-1]))
+            configuration[joint] = pose.angle
+            answer = prosp.reachable(arm, [pose], base, configuration)
+            if not answer:
+                return solutions, f"{pose.phase}: {answer.reason}"
+            solutions.append(tuple(answer.solutions[0]))
+        return solutions, None
 
     def _other_torso_heights(self) -> list[tuple[str, float]]:
         """The robot's named torso heights other than the one it has now, nearest first."""

@@ -4,7 +4,8 @@ Location reasoning is robot-agnostic: it asks a `RobotGeometry` how big the base
 arm reaches comfortably, how the grasp phases are offset and how the arms are tucked away. Every
 number comes from the description module (``pycram.robots.<name>.description``): ``BASE``
 (``radius``: circumscribed, ``inscribed_radius``), ``ARMS``, ``ARM_ALIASES``, ``DEFAULT_ARM``,
-``REACH_POINT_IN_BASE``, ``APPROACH_OFFSETS``, ``ARM_CONFIGURATIONS`` (``park``). Lengths in [m].
+``REACH_POINT_IN_BASE``, ``APPROACH_OFFSETS``, ``ARM_CONFIGURATIONS`` (``park``), optionally
+``DOOR_PUSH``. Lengths in [m].
 """
 
 from __future__ import annotations
@@ -32,7 +33,9 @@ class RobotGeometry:
     the furniture), joint name -> position. `contact_margin` [m]: how far below a grasp pose the
     arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
     pass through configurations IK did not check). `torso_joint` and `torso_positions` (name ->
-    height [m]): the torso lift, for solutions that need another torso height.
+    height [m]): the torso lift, for solutions that need another torso height. `door_push`: how
+    the hand meets a door's face when it pushes one (``DOOR_PUSH``, see `pycram.locations.doors`;
+    None: the robot does not push doors).
     """
 
     name: str
@@ -49,6 +52,7 @@ class RobotGeometry:
     contact_margin: float = 0.0
     torso_joint: str | None = None
     torso_positions: Mapping[str, float] = None  # type: ignore[assignment]
+    door_push: Mapping[str, Any] | None = None
 
     @classmethod
     def from_description(cls, d: Any) -> RobotGeometry:
@@ -78,6 +82,7 @@ class RobotGeometry:
             contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)),
             torso_joint=getattr(d, "TORSO", {}).get("joint"),
             torso_positions={k: float(v) for k, v in getattr(d, "TORSO_POSITIONS", {}).items()},
+            door_push=getattr(d, "DOOR_PUSH", None),
         )
 
     def arm(self, name: Any) -> str:

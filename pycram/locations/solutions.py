@@ -18,7 +18,8 @@ class BaseLocation:
     solutions of the validated sequence; `cost` its rank in the costmap (lower is better);
     `visible` the fraction of the target the head camera sees (``to_see``); `tool_poses` the
     validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order;
-    `torso` the named torso position the solution needs (None: the torso as it is).
+    `torso` the named torso position the solution needs (None: the torso as it is); `push` the
+    face of a door the hand pushes from there (``'inside'``/``'outside'``; None: not a push).
     """
 
     x: float
@@ -31,6 +32,7 @@ class BaseLocation:
     joints: tuple = field(default=(), repr=False, compare=False)
     tool_poses: tuple = field(default=(), repr=False, compare=False)
     torso: str | None = None
+    push: str | None = None
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))

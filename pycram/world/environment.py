@@ -187,6 +187,56 @@ class Container:
         rx, ry = hx - cx, hy - cy
         return (cx + c * rx - s * ry, cy + s * rx + c * ry, hz)
 
+    def _door_axes(self) -> tuple[XY, XY]:
+        """A door's unit vectors when closed: along the panel from the hinge towards the free edge,
+        and the outward normal (`opening_direction`)."""
+        if self.hinge is None:
+            raise ValueError(f"container {self.name!r} is a {self.kind}, not a door")
+        nx, ny = self.opening_direction
+        rx, ry = self.handle[0] - self.hinge[0], self.handle[1] - self.hinge[1]
+        along = (-ny, nx) if -ny * rx + nx * ry > 0 else (ny, -nx)
+        return along, (nx, ny)
+
+    def _door_extent(self, axis: XY) -> tuple[float, float]:
+        """(min, max) [m] of the closed panel's corners along `axis`, measured from the hinge."""
+        assert self.hinge is not None  # callers check
+        x0, y0, x1, y1 = self.body.footprint
+        values = [
+            (x - self.hinge[0]) * axis[0] + (y - self.hinge[1]) * axis[1]
+            for x, y in ((x0, y0), (x0, y1), (x1, y0), (x1, y1))
+        ]
+        return min(values), max(values)
+
+    @property
+    def door_width(self) -> float:
+        """A door's width [m]: from its hinge axis to its free edge."""
+        return self._door_extent(self._door_axes()[0])[1]
+
+    def door_face(self, q: float, distance: float, side: Literal["outside", "inside"]) -> tuple[XY, XY, XY]:
+        """The point of a door's `side` face `distance` [m] from its hinge axis when the door is open
+        by `q` [rad], with the face's unit vectors there: (point, along the panel towards the free
+        edge, the face's normal pointing away from the panel). ``'outside'`` is the face with the
+        handle, ``'inside'`` the one facing the interior when closed."""
+        along0, normal0 = self._door_axes()
+        inner, outer = self._door_extent(normal0)
+        a = self.hinge_sign * q
+        c, s = math.cos(a), math.sin(a)
+        along = (c * along0[0] - s * along0[1], s * along0[0] + c * along0[1])
+        normal = (c * normal0[0] - s * normal0[1], s * normal0[0] + c * normal0[1])
+        if side == "inside":
+            offset, normal = inner, (-normal[0], -normal[1])
+        elif side == "outside":
+            offset = outer
+        else:
+            raise ValueError(f"a door has the faces 'outside' and 'inside', not {side!r}")
+        assert self.hinge is not None  # checked by _door_axes
+        sign = 1.0 if side == "outside" else -1.0  # `offset` is along the outward normal
+        point = (
+            self.hinge[0] + distance * along[0] + sign * offset * normal[0],
+            self.hinge[1] + distance * along[1] + sign * offset * normal[1],
+        )
+        return point, along, normal
+
 
 @dataclass(frozen=True)
 class Place:

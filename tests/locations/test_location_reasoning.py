@@ -273,3 +273,44 @@ def test_believed_objects_and_object_designators_are_targets():
     rs, _ = resolver_set()
     with rs:
         assert LocationDesignator([("to_reach", cup)]).reference().grasp == "side"
+
+
+def test_pushing_a_door_checks_each_tool_pose_with_the_door_where_it_will_be_and_stands_clear_of_its_swing():
+    import dataclasses
+
+    from pycram.designators.core import NoSolutionError
+    from pycram.locations import doors
+
+    asked = []
+
+    class Recording(ScriptedProspection):
+        def reachable(self, arm, poses, pose, configuration=None):
+            asked.append((pose, [p.angle for p in poses], dict(configuration or {})))
+            return Answer()
+
+    geometry = RobotGeometry.from_description(tiago)
+    reasoner = LocationReasoner(geometry, lambda: APARTMENT, Recording, container_states=lambda: {"fridge": 0.3})
+    rs = ResolverSet("test locations")
+    rs.location_generators.append(reasoner.generator)
+    fridge = APARTMENT.container("fridge")
+    with rs:
+        found = LocationDesignator([("to_open", "fridge"), ("opening", 1.2), ("pushing", "inside")]).reference()
+    assert found.push == "inside" and found.grasp == "push" and found.arm == "right"
+    assert list(found.tool_poses) == doors.push_sequence(fridge, tiago.DOOR_PUSH, 0.3, 1.2, "inside")
+    # one pose at a time, the door's joint where that pose expects it, seeded with the previous solution
+    for _, angles, configuration in asked:
+        assert len(angles) == 1 and configuration[fridge.joint_name] == angles[0]
+    angles = [a[0] for _, a, _ in asked]
+    assert angles[0] == pytest.approx(0.3) and angles[-1] == pytest.approx(1.2)
+    for q in np.linspace(0.3, 1.2, 10):  # clear of the panel anywhere on its way
+        for d in np.linspace(0.0, fridge.door_width, 8):
+            (px, py), _, _ = fridge.door_face(q, d, "outside")
+            assert math.hypot(found.x - px, found.y - py) >= geometry.inscribed_radius
+    # a robot that does not push doors, a drawer
+    no_push = LocationReasoner(
+        dataclasses.replace(geometry, door_push=None), lambda: APARTMENT, Recording, container_states=dict
+    )
+    with pytest.raises(NoSolutionError, match="does not push doors.*DOOR_PUSH"):
+        next(no_push.generator(LocationDesignator([("to_open", "fridge"), ("pushing", "outside")])))
+    with pytest.raises(NoSolutionError, match="only doors are pushed"):
+        next(reasoner.generator(LocationDesignator([("to_open", "drawer 1"), ("pushing", "outside")])))

@@ -89,6 +89,22 @@ def test_container_handle_follows_the_opening_trajectory():
     assert door.joint == "hinge"
     opened = door.handle_position(math.pi / 2)  # a quarter turn: the handle swings out in front
     assert opened[0] > 1.5 and opened[1] == pytest.approx(-0.3, abs=0.05)
+    # the door's faces: the outside one (with the handle) on the hinge line, the inside 4 cm behind
+    assert door.door_width == pytest.approx(0.6)
+    point, along, normal = door.door_face(0.0, 0.5, "outside")
+    assert (
+        point == pytest.approx((1.02, 0.2)) and along == pytest.approx((0.0, 1.0)) and normal == pytest.approx((1, 0))
+    )
+    point, along, normal = door.door_face(0.0, 0.5, "inside")
+    assert point == pytest.approx((0.98, 0.2)) and normal == pytest.approx((-1.0, 0.0))
+    point, along, normal = door.door_face(math.pi / 2, 0.5, "outside")  # turned with the handle
+    assert point == pytest.approx((1.52, -0.3)) and along == pytest.approx((1.0, 0.0), abs=1e-9)
+    assert normal == pytest.approx((0.0, -1.0), abs=1e-9)
+    assert door.door_face(math.pi / 2, 0.5, "inside")[0] == pytest.approx((1.52, -0.26))
+    with pytest.raises(ValueError, match="faces 'outside' and 'inside'"):
+        door.door_face(0.0, 0.5, "top")
+    with pytest.raises(ValueError, match="is a drawer, not a door"):
+        drawer.door_face(0.0, 0.1, "outside")
     with pytest.raises(ValueError, match="needs a hinge"):
         Container("x", "door", door.body, door.handle, (1.0, 0.0), (0.0, 1.0))
     with pytest.raises(ValueError, match="kind must be"):

@@ -114,17 +114,25 @@ APPROACH_OFFSETS = {
     "place": (0.0, 0.01),
     "retreat": (0.10, 0.02),
 }
-#: Doors: why this robot does not open or close them (read by `pycram.actions.containers`; a
-#: robot without this entry does). Measured on the apartment's fridge (issue 16).
-DOOR_REFUSAL = (
-    "the TIAGo does not open doors yet: closing in on the fridge door's vertical handle its wrist "
-    "ends rolled about 110 deg about the approach axis, off the commanded orientation, so the gripper "
-    "closes on the handle's standoffs (81 mm open) instead of the bar and the door follows to 3-12 deg "
-    "only; with the grip turned 180 deg about that axis it holds the bar, but the bar slips out of its "
-    "finger tips at 34 deg (the arm then stops 19 mm short of the next pose on the arc), and a grasp "
-    "15-25 mm deeper stalls against the door; the IK finds no solution on the arc beyond 35-43 deg "
-    "from the one standing pose found"
-)
+#: Doors (read by `pycram.actions.containers`; measured on the apartment's fridge, issue 16): its
+#: parallel gripper holds a vertical handle bar by friction only (the pull runs along the
+#: fingers), and the bar creeps towards the finger tips as the door follows -- about 1 deg behind
+#: per 9 deg step, out of the fingers between 27 and 35 deg, sooner when pulled slowly. So it
+#: pulls a door by its handle this far [rad] (20 deg: the door ends 18-19 deg open), lets go and
+#: pushes the door on from inside (`DOOR_PUSH`).
+DOOR_PULL_LIMIT = 0.35
+#: Before closing on a door's handle bar the gripper opens this far (a fraction of its 90 mm):
+#: closing from wide open, its fingers sank 2.7 mm into the 24 mm bar and then stayed there when
+#: told to open (measured on the fridge; from half open they sink 0.7 mm and let go).
+DOOR_GRIP_OPENING = 0.5
+#: How the hand meets a door's faces when it pushes them (see `pycram.locations.doors`). Inside:
+#: the tool points along the face towards the hinge (heading pi), the side of the palm (0.05 m
+#: from the tool axis, its centre 0.07 m behind the tool frame) against the face -- the back of a
+#: hand sweeping a door open. Outside: the finger tips (0.04 m beyond the tool frame) into the face.
+DOOR_PUSH = {
+    "inside": {"heading": 3.14159, "offset": (-0.07, 0.05)},
+    "outside": {"heading": -1.5708, "offset": (0.0, 0.04)},
+}
 
 #: Position tolerance [m] of the tool per phase.
 REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place": 0.02, "default": 0.01}
