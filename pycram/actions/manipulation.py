@@ -19,8 +19,10 @@ designator that was picked up) is put at `target` -- a location designator (``('
 a `Spot`, a point or a surface's name. Each attempt drives to a standing pose from which the arm
 places there, lowers the object until the place pose or until it touches down (the arm is
 blocked), lets go, retreats, and looks: the object must be seen within `PLACE_TOLERANCE` of
-the spot, and -- for milk cartons, cereal boxes and mugs, whose measured height tells --
-standing (`toppled_height`, looked at again with the arm parked; reason ``'toppled'``). While
+the spot, and standing on the surface: not measured taller than it is (reason
+``'not_resting'``: still held, or on something) and -- for milk cartons, cereal boxes and mugs,
+whose measured height tells -- not toppled over (``'toppled'``); `resting_problem`, looked at
+again with the arm parked before it is believed. While
 the base drives, the gripper's opening is watched: an object slipping out raises
 `ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
@@ -91,7 +93,8 @@ __all__ = [
     "PLACE_TOLERANCE",
     "HELD_FRACTION",
     "executable_grasps",
-    "toppled_height",
+    "resting_problem",
+    "RESTING_SLACK",
 ]
 
 log = logging.getLogger("pycram.actions")
@@ -116,6 +119,8 @@ WIDE_MARGIN = 0.03
 NEAR_SIDE_INSET = 0.15
 #: A placed object must be seen this close [m] (horizontally) to its spot.
 PLACE_TOLERANCE = 0.05
+#: A placed object measured taller than it is by more than this [m] does not rest on the surface.
+RESTING_SLACK = 0.05
 #: The gripper holds the object when its opening is at least this fraction of the grasp's opening.
 HELD_FRACTION = 0.5
 
@@ -532,41 +537,49 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     motion(type="pointing_head", coordinates=list(spot))
     motion(type="detecting", object=obj.type)
-    measured = None if obj.gone else toppled_height(obj)
-    if measured is not None:  # the arm in its carry pose may hide the object's top: park it, look again
-        log.info("placing %s: measured %.2f m tall; parking the %s arm and looking again", obj.name, measured, arm)
+    problem = None if obj.gone else resting_problem(obj)
+    if problem is not None:  # the arm in its carry pose may hide the object's top: park it, look again
+        log.info("placing %s: %s; parking the %s arm and looking again", obj.name, problem[1], arm)
         motion(type="setting_arm_configuration", arm=arm, configuration="park")
         motion(type="pointing_head", coordinates=list(spot))
         motion(type="detecting", object=obj.type)
-        measured = None if obj.gone else toppled_height(obj)
-    if measured is not None:
-        kind = object_type(obj.type)
-        raise PlacingFailed(
-            f"{obj.name} does not stand upright at {_xyz(spot)}: measured {measured * 100:.0f} cm tall, "
-            f"{kind.height * 100:.0f} cm standing, at most {kind.lying_height * 100:.0f} cm toppled over",
-            obj,
-            "toppled",
-        )
+        problem = None if obj.gone else resting_problem(obj)
+    if problem is not None:
+        reason, why = problem
+        raise PlacingFailed(f"{obj.name} does not rest upright at {_xyz(spot)}: {why}", obj, reason)
     if obj.gone or math.dist(obj.pose[:2], spot[:2]) > PLACE_TOLERANCE:
         where = "not seen" if obj.gone else f"seen at {_xyz(obj.pose)}"
         raise PlacingFailed(f"{obj.name} does not rest at {_xyz(spot)}: {where}", obj)
     return obj
 
 
-def toppled_height(obj: PerceivedObject) -> float | None:
-    """The measured height [m] of `obj` when perception shows it toppled over, else None.
+def resting_problem(obj: PerceivedObject) -> tuple[str, str] | None:
+    """Why the measured `obj` does not stand upright on its surface -- ``('toppled', why)`` or
+    ``('not_resting', why)`` -- or None when its measured height fits.
 
-    Only for types whose standing and lying heights differ clearly (`ObjectType.topples_visibly`:
-    milk, cereal, mug) and objects measured on a surface: toppled means measured below the
-    middle between the two heights. Something between the camera and the object's top (the
-    robot's own arm in its carry pose) makes a standing object look short: `Place` looks again
-    with the arm parked before it believes a toppled measurement."""
+    Perception measures an object's height from the surface it is over to its top. Taller than
+    the object by more than `RESTING_SLACK`: it does not rest on the surface (still in the
+    gripper, or on something). For types whose standing and lying heights differ clearly
+    (`ObjectType.topples_visibly`: milk, cereal, mug): nearer the lying than the standing height
+    means toppled. Something between the camera and the object's top (the robot's own arm in
+    its carry pose) makes a standing object look short: `Place` looks again with the arm parked
+    before it believes either."""
     kind = object_type(obj.type)
     size = obj.properties.get("size")
-    if not kind.topples_visibly or not size or obj.properties.get("on") is None:
+    if not size or obj.properties.get("on") is None:
         return None
     measured = float(size[2])
-    return measured if measured < (kind.height + kind.lying_height) / 2.0 else None
+    if measured > kind.height + RESTING_SLACK:
+        return "not_resting", (
+            f"its top is measured {measured * 100:.0f} cm above the {obj.properties['on']}, "
+            f"a {kind.name} is {kind.height * 100:.0f} cm tall (still held, or on something)"
+        )
+    if kind.topples_visibly and measured < (kind.height + kind.lying_height) / 2.0:
+        return "toppled", (
+            f"measured {measured * 100:.0f} cm tall, {kind.height * 100:.0f} cm standing, "
+            f"at most {kind.lying_height * 100:.0f} cm toppled over"
+        )
+    return None
 
 
 @action_plan("placing")

@@ -39,7 +39,7 @@ from pycram.actions import (
     Transport,
     held_objects,
 )
-from pycram.actions.manipulation import toppled_height
+from pycram.actions.manipulation import resting_problem
 from pycram.designator import LocationDesignator, ObjectDesignator, perform
 from pycram.failures import (
     GoalUnreachable,
@@ -228,15 +228,16 @@ def test_perception_tells_a_toppled_milk_carton_from_a_standing_one():
     with apartment_with("pr2", {"milk": TABLE}) as (world, robot):
         ready()
         milk = perform(Search(ObjectDesignator(type="milk")))
-        assert toppled_height(milk) is None  # standing: measured ~20 cm tall
+        assert resting_problem(milk) is None  # standing: measured ~20 cm tall
         x, y = TABLE[1]
         lying = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # 90 deg about x
         height = world.environment.surface("table").height
         ok(world.move_item("milk", (x, y, height + object_type("milk").lying_height / 2 + 0.002), lying))
         perform(LookAt(milk))
         perform(Detect("milk"))
-        measured = toppled_height(milk)
-        assert measured is not None and measured < 0.1
+        problem = resting_problem(milk)
+        assert problem is not None and problem[0] == "toppled", problem
+        assert float(milk.properties["size"][2]) < 0.1
 
 
 def test_placing_raises_placing_failed_when_the_object_ends_toppled_over():
@@ -246,7 +247,7 @@ def test_placing_raises_placing_failed_when_the_object_ends_toppled_over():
         ready()
         held = perform(PickUp(ObjectDesignator(type="milk")))
         person = KnockOverOnceLetGo(world, "milk", held.arm, "table")
-        with pytest.raises(PlacingFailed, match="does not stand upright") as raised:
+        with pytest.raises(PlacingFailed, match="does not rest upright") as raised:
             perform(Place(held, "table"))
         assert raised.value.reason == "toppled"
         assert person.join() is True
