@@ -533,6 +533,9 @@ def _place_locations(held: Held, spot: tuple[float, float, float], point: list[f
 def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
     arm, gripper, obj = held.arm, held.gripper, held.object
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    torso = getattr(location, "torso", None)
+    if torso is not None:  # validated at another torso height (e.g. lowered for a drawer before)
+        motion(type="setting_torso", position=torso)
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:
         raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)

@@ -6,6 +6,11 @@ finds the object (search when the belief does not hold it), picks it up (`PickUp
 it is searched for and fetched again, at most `TRANSPORT_ROUNDS` times; then the failure of the
 last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Returns the
 believed object where it was put.
+
+With ``close_opened=True`` the containers the transport opened (believed closed before it,
+believed open once the object is placed: drawers searched or pulled out further to pick) are
+closed again afterwards, with `Close`, the highest first (its failures are raised: the transport
+is not done while they stand open).
 """
 
 from __future__ import annotations
@@ -17,7 +22,9 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.object import ObjectDesignator
 from pycram.designators.perform import perform
 from pycram.failures import GripperEmpty, ObjectSlipped
+from pycram.robot import current_robot
 
+from .containers import CLOSED, DOOR_CLOSED, Close
 from .core import ActionParameterError, action_plan, attempt, make_action
 from .manipulation import PickUp, Place, believed_object
 
@@ -25,15 +32,33 @@ __all__ = ["Transport", "TRANSPORT_ROUNDS"]
 
 log = logging.getLogger("pycram.actions")
 
+#: A container counts as open above this believed opening [m or rad] (a drawer: 3 cm, a door: 4 deg).
+OPEN_ABOVE = max(CLOSED, DOOR_CLOSED)
 #: Fetch-and-deliver rounds (the object lost on the way starts a new round).
 TRANSPORT_ROUNDS = 3
 
 
-def Transport(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
+def Transport(object: Any, target: Any, arm: str | None = None, close_opened: bool = False) -> ActionDesignator:
     """Bring `object` (an object designator, a believed object or a type name) to `target` (as
     for `Place`: a location designator, a `Spot`, a point or a surface's name) with `arm`
-    (None: chosen by the reasoning)."""
-    return make_action("transporting", object=object, target=target, arm=arm)
+    (None: chosen by the reasoning); with `close_opened`, close the containers it opened."""
+    return make_action("transporting", object=object, target=target, arm=arm, close_opened=close_opened)
+
+
+def _open_containers() -> dict[str, float]:
+    """The containers the active robot believes open (name -> measured opening [m or rad])."""
+    belief = getattr(current_robot(), "belief", None)
+    states = dict(getattr(belief, "container_states", {}) or {})
+    return {name: q for name, q in states.items() if q >= OPEN_ABOVE}
+
+
+def _top_down(names: set[str]) -> list[str]:
+    """`names` of containers, the highest handle first (an open drawer covers the handle of the
+    drawer below it)."""
+    environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
+    if environment is None:
+        return sorted(names)
+    return sorted(names, key=lambda name: (-environment.container(name).handle[2], name))
 
 
 @action_plan("transporting")
@@ -43,6 +68,7 @@ def transporting(designator: ActionDesignator) -> Any:
     if wanted is None or target is None:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
     arm = designator.prop_value("arm")
+    opened_before = set(_open_containers())
     last: BaseException | None = None
     for round_number in range(1, TRANSPORT_ROUNDS + 1):
         if round_number > 1 and isinstance(wanted, ObjectDesignator):
@@ -54,9 +80,15 @@ def transporting(designator: ActionDesignator) -> Any:
             return perform(Place(held, target, arm=held.arm))
 
         try:
-            return attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
+            placed = attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
         except (ObjectSlipped, GripperEmpty) as error:
             log.info("transporting: %s; fetching it again", error)
             last = error
+            continue
+        if designator.prop_value("close_opened"):
+            for name in _top_down(set(_open_containers()) - opened_before):
+                log.info("transporting: closing %s, opened on the way", name)
+                perform(Close(name))
+        return placed
     assert last is not None
     raise last

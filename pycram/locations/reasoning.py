@@ -43,6 +43,7 @@ import math
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -266,7 +267,9 @@ class LocationReasoner:
             streams.append(_ranked(costmap, arms.index(arm), arm))
         self.last_costmaps = maps
 
-        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+        def validate(cell: tuple, torsos: str = "current") -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+            """`torsos`: which torso heights to validate at -- the ``current`` one, the ``other``
+            named ones, or ``both`` (the current one first)."""
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
             natural = _wrap(
@@ -274,11 +277,7 @@ class LocationReasoner:
             )
             prosp = self.prospection()
             tucked = dict(self.geometry.tucked)
-            if prosp.in_collision((x, y, natural), tucked):
-                return None, ("in collision", None)
             raised = self.geometry.raised(arm)
-            if prosp.in_collision((x, y, natural), raised):
-                return None, (f"arm {arm!r} hits the furniture when raised to approach", None)
 
             def sequences(configuration: dict[str, float]) -> tuple[BaseLocation | None, tuple[str, str | None]]:
                 failure: tuple[str, str | None] = ("no fitting grasp", None)
@@ -305,25 +304,63 @@ class LocationReasoner:
                     failure = (f"unreachable for arm {arm!r}", answer.reason)
                 return None, failure
 
-            found, failure = sequences(raised)
-            if found is not None or drawer is None:
-                return found, (None if found is not None else failure)
-            # in a drawer the object lies low (or high) for the torso as it is: another torso height
+            failure: tuple[str, str | None] = ("in collision at every other torso height", None)
+            if torsos != "other":
+                if prosp.in_collision((x, y, natural), tucked):
+                    return None, ("in collision", None)
+                if prosp.in_collision((x, y, natural), raised):
+                    failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
+                    if torsos == "current":
+                        return None, failure
+                else:
+                    found, failure = sequences(raised)
+                    if found is not None or torsos == "current":
+                        return found, (None if found is not None else failure)
+            # the target lies low or high for the torso as it is: another torso height
             joint = self.geometry.torso_joint
-            others = self._other_torso_heights()
             back = self._nearest_torso_height()
-            for torso, height in others:
+            for torso, height in self._other_torso_heights():
                 assert joint is not None  # there are other torso heights only with a torso joint
                 if prosp.in_collision((x, y, natural), {**tucked, joint: height}) or prosp.in_collision(
                     (x, y, natural), {**raised, joint: height}
                 ):
                     continue
-                other, _ = sequences({**raised, joint: height})
+                other, why = sequences({**raised, joint: height})
                 if other is not None:
                     return replace(other, torso=torso, torso_after=back), None
+                failure = why
             return None, failure
 
-        return self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps)
+        if drawer is not None:  # in a drawer the torso height is part of every candidate's question
+            return self._search(
+                desig, heapq.merge(*streams), partial(validate, torsos="both"), "to_reach", target, maps
+            )
+        first = self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps)
+        if not self._other_torso_heights():
+            return first
+
+        def again() -> Iterator[BaseLocation]:
+            cells = heapq.merge(*(_ranked(maps[arm], arms.index(arm), arm) for arm in arms))
+            return self._search(desig, cells, partial(validate, torsos="other"), "to_reach", target, maps)
+
+        return self._or_else(desig, first, again)
+
+    def _or_else(
+        self, desig: Any, first: Iterator[BaseLocation], second: Callable[[], Iterator[BaseLocation]]
+    ) -> Iterator[BaseLocation]:
+        """The solutions of `first` (the torso as it is); only when it has none at all, those of
+        `second()` (another torso height) -- `NoSolutionError` saying why neither had any."""
+        try:
+            yield from first
+            return
+        except NoSolutionError as error:
+            why = str(error)
+        try:
+            yield from second()
+        except NoSolutionError as error:
+            raise NoSolutionError(
+                f"{why}; with another torso height: {str(error).split(': ', 1)[-1]}", designator=desig
+            ) from error
 
     def _arms(self, requested: Any) -> list[str]:
         if requested is not None:

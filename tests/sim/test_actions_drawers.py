@@ -1,0 +1,88 @@
+"""Picking objects out of drawers and transporting them from a closed drawer to the table (issue
+16), on both robots in the apartment, judged with the simulator's truth.
+
+A drawer's walls rise above the side grasps of what lies in it: cups and mugs are taken from the
+top by their body, bowls by the rim; the robot stands in front of the pulled-out drawer with its
+torso lowered where the reasoning found that it must. Objects lie at (0.4, 2.9) in the closed
+drawer's frame: 20 cm behind its front panel, mid-width.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from action_helpers import apartment_with, holding, rests_upright_at, run_as_task, tasks_named
+
+from pycram.actions import MoveTorso, Open, ParkArms, PickUp, Place, Transport
+from pycram.designator import ObjectDesignator, perform
+from pycram.failures import ObjectOutOfReach
+
+#: Where the objects lie: in the closed drawer's frame (x, y) [m] (see the module docstring).
+IN_DRAWER = (0.4, 2.9)
+
+
+def opening_of(world, name: str) -> float:
+    return world.container_states.get_value()[name]
+
+
+def ready() -> None:
+    perform(ParkArms())
+    perform(MoveTorso("up"))
+
+
+def in_drawer(number: int) -> tuple[str, tuple[float, float]]:
+    return (f"drawer {number} inside", IN_DRAWER)
+
+
+@pytest.mark.parametrize(
+    ("robot_name", "drawer", "arm"),
+    [("pr2", 2, None), ("pr2", 3, "left"), ("tiago", 2, None), ("tiago", 3, None)],
+)
+def test_a_cup_is_picked_from_the_top_out_of_an_opened_drawer_and_placed_upright(robot_name, drawer, arm):
+    name = f"drawer {drawer}"
+    with apartment_with(robot_name, {"cup": in_drawer(drawer)}) as (world, robot):
+        ready()
+        perform(Open(name))  # 0.3 m: the cup is still under the drawer above
+        held = perform(PickUp(ObjectDesignator(type="cup"), arm=arm))
+        assert held.grasp.approach == "top" and holding(world) == {"cup"}
+        assert arm is None or held.arm == arm
+        rim = world.environment.container(name).rim_height
+        assert world.item_poses.get_value()["cup"].position[2] > rim  # out of the drawer
+        assert opening_of(world, name) > 0.3  # pulled out further: the cup came out from under
+        obj = perform(Place(held, "table"))
+        assert rests_upright_at(world, "cup", "table", obj.pose[:2])
+
+
+@pytest.mark.parametrize("robot_name", ["pr2"])
+def test_a_bowl_is_picked_by_its_rim_out_of_an_opened_drawer(robot_name):
+    with apartment_with(robot_name, {"bowl": in_drawer(2)}) as (world, robot):
+        ready()
+        perform(Open("drawer 2"))
+        held = perform(PickUp(ObjectDesignator(type="bowl")))
+        assert held.grasp.approach == "top" and holding(world) == {"bowl"}
+        assert world.item_poses.get_value()["bowl"].position[2] > world.environment.container("drawer 2").rim_height
+
+
+@pytest.mark.parametrize("robot_name", ["pr2", "tiago"])
+def test_transport_from_a_closed_drawer_to_the_table_closes_the_drawer(robot_name):
+    with apartment_with(robot_name, {"cup": in_drawer(2)}) as (world, robot):
+        ready()
+        assert opening_of(world, "drawer 2") < 0.01
+        obj, task = run_as_task(lambda: perform(Transport(ObjectDesignator(type="cup"), "table", close_opened=True)))
+        assert rests_upright_at(world, "cup", "table", obj.pose[:2])
+        assert holding(world) == set()
+        assert opening_of(world, "drawer 2") < 0.03  # closed again
+        assert tasks_named(task, "perform searching") and tasks_named(task, "perform opening")
+        assert tasks_named(task, "perform closing")
+
+
+def test_an_object_without_a_grasp_over_the_walls_is_out_of_reach_and_says_why():
+    with apartment_with("pr2", {"milk": in_drawer(3)}) as (world, robot):
+        ready()
+        perform(Open("drawer 3", opening=0.4))
+        with pytest.raises(ObjectOutOfReach, match=r"walls rise to 0\.86 m") as caught:
+            perform(PickUp(ObjectDesignator(type="milk")))
+        assert caught.value.designator is not None
+        assert holding(world) == set()
+        assert math.isclose(world.environment.container("drawer 3").rim_height, 0.86)
