@@ -269,10 +269,12 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     planned = tuple(obj.pose)
     motion(type="setting_gripper", gripper=gripper, position=1)
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    motion(type="moving", pose=location)
     torso = getattr(location, "torso", None)
     if torso is not None:  # e.g. in a low drawer: the sequence was validated at another torso height
+        # only once there: a torso lowered where the robot stood would sweep its raised arm over
+        # the table or counter beside it
         motion(type="setting_torso", position=torso)
-    motion(type="moving", pose=location)
     _look_again(obj)
     if obj.gone:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")

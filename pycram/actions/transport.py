@@ -7,10 +7,10 @@ it is searched for and fetched again, at most `TRANSPORT_ROUNDS` times; then the
 last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Returns the
 believed object where it was put.
 
-With ``close_opened=True`` the containers the transport opened (believed closed before it,
-believed open once the object is placed: drawers searched or pulled out further to pick) are
-closed again afterwards, with `Close`, the highest first (its failures are raised: the transport
-is not done while they stand open).
+With ``close_container=True`` the container the object was taken from (a drawer the search
+opened) is closed again once the object is placed, with `Close`, unless it was believed open
+before the transport; its failures are raised (the transport is not done while it stands open).
+Other containers the search opened on the way stay open.
 """
 
 from __future__ import annotations
@@ -38,11 +38,12 @@ OPEN_ABOVE = max(CLOSED, DOOR_CLOSED)
 TRANSPORT_ROUNDS = 3
 
 
-def Transport(object: Any, target: Any, arm: str | None = None, close_opened: bool = False) -> ActionDesignator:
+def Transport(object: Any, target: Any, arm: str | None = None, close_container: bool = False) -> ActionDesignator:
     """Bring `object` (an object designator, a believed object or a type name) to `target` (as
     for `Place`: a location designator, a `Spot`, a point or a surface's name) with `arm`
-    (None: chosen by the reasoning); with `close_opened`, close the containers it opened."""
-    return make_action("transporting", object=object, target=target, arm=arm, close_opened=close_opened)
+    (None: chosen by the reasoning); with `close_container`, close the container it was taken
+    from when the transport opened it."""
+    return make_action("transporting", object=object, target=target, arm=arm, close_container=close_container)
 
 
 def _open_containers() -> dict[str, float]:
@@ -50,15 +51,6 @@ def _open_containers() -> dict[str, float]:
     belief = getattr(current_robot(), "belief", None)
     states = dict(getattr(belief, "container_states", {}) or {})
     return {name: q for name, q in states.items() if q >= OPEN_ABOVE}
-
-
-def _top_down(names: set[str]) -> list[str]:
-    """`names` of containers, the highest handle first (an open drawer covers the handle of the
-    drawer below it)."""
-    environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
-    if environment is None:
-        return sorted(names)
-    return sorted(names, key=lambda name: (-environment.container(name).handle[2], name))
 
 
 @action_plan("transporting")
@@ -69,6 +61,7 @@ def transporting(designator: ActionDesignator) -> Any:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
     arm = designator.prop_value("arm")
     opened_before = set(_open_containers())
+    source: list[str | None] = []  # the container the object lay in, per round
     last: BaseException | None = None
     for round_number in range(1, TRANSPORT_ROUNDS + 1):
         if round_number > 1 and isinstance(wanted, ObjectDesignator):
@@ -76,6 +69,7 @@ def transporting(designator: ActionDesignator) -> Any:
 
         def fetch_and_deliver(wanted: Any = wanted) -> Any:
             obj = believed_object("transporting", wanted)
+            source.append(obj.properties.get("in"))
             held = perform(PickUp(obj, arm=arm))
             return perform(Place(held, target, arm=held.arm))
 
@@ -85,10 +79,10 @@ def transporting(designator: ActionDesignator) -> Any:
             log.info("transporting: %s; fetching it again", error)
             last = error
             continue
-        if designator.prop_value("close_opened"):
-            for name in _top_down(set(_open_containers()) - opened_before):
-                log.info("transporting: closing %s, opened on the way", name)
-                perform(Close(name))
+        container = source[-1] if source else None
+        if designator.prop_value("close_container") and container and container not in opened_before:
+            log.info("transporting: closing %s, where %s was taken from", container, getattr(placed, "name", "it"))
+            perform(Close(container))
         return placed
     assert last is not None
     raise last
