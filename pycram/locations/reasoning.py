@@ -335,7 +335,8 @@ class LocationReasoner:
             return self._search(
                 desig, heapq.merge(*streams), partial(validate, torsos="both"), "to_reach", target, maps
             )
-        first = self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps)
+        tally = _Tally()
+        first = self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps, tally)
         if not self._other_torso_heights():
             return first
 
@@ -343,17 +344,25 @@ class LocationReasoner:
             cells = heapq.merge(*(_ranked(maps[arm], arms.index(arm), arm) for arm in arms))
             return self._search(desig, cells, partial(validate, torsos="other"), "to_reach", target, maps)
 
-        return self._or_else(desig, first, again)
+        return self._or_else(desig, first, tally, again)
 
     def _or_else(
-        self, desig: Any, first: Iterator[BaseLocation], second: Callable[[], Iterator[BaseLocation]]
+        self,
+        desig: Any,
+        first: Iterator[BaseLocation],
+        tally: _Tally,
+        second: Callable[[], Iterator[BaseLocation]],
     ) -> Iterator[BaseLocation]:
-        """The solutions of `first` (the torso as it is); only when it has none at all, those of
-        `second()` (another torso height) -- `NoSolutionError` saying why neither had any."""
+        """The solutions of `first` (the torso as it is); only when it has none at all and not
+        every candidate was in collision (`tally`: the base itself; another torso height would
+        not help), those of `second()` (another torso height) -- `NoSolutionError` saying why
+        neither had any."""
         try:
             yield from first
             return
         except NoSolutionError as error:
+            if set(tally.reasons) <= {"in collision"}:
+                raise
             why = str(error)
         try:
             yield from second()
@@ -809,11 +818,13 @@ class LocationReasoner:
         kind: str,
         target: Target,
         maps: dict[str, Costmap],
+        tally: _Tally | None = None,
     ) -> Iterator[BaseLocation]:
         """Walk `cells` (cost, tie, arm, row, col) cheapest first; validate each; yield the valid
         ones at least `SPACING` apart; after `max_candidates` checks or when the costmap is used
-        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
-        tally = _Tally()
+        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed
+        (counted in `tally` when given)."""
+        tally = _Tally() if tally is None else tally
         given: list[BaseLocation] = []
         failed: list[tuple[str | None, float, float]] = []
         for cell in cells:
