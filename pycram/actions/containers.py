@@ -164,26 +164,22 @@ def _move_handle(location: Any, belief: Any, container: Any, goal: float) -> flo
     arm, grasp = location.arm, location.grasp
     gripper = gripper_of(arm)
     motion(type="setting_gripper", gripper=gripper, position=1)
-    here = base_pose_fluent().get_value()
-    drive = (
-        here is None
-        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
-        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
-    )
     # a door stands open beside the pose: the arm goes in (the standing pose was checked with the
-    # arms parked); for a drawer it is up, ready -- raised once there when the robot drives (an
-    # arm raised where the robot stands, e.g. at the table, would sweep over what stands there)
-    raised = "park" if container.kind == "door" or drive else "carry"
+    # arms parked); for a drawer it is up, ready
+    raised = "park" if container.kind == "door" else "carry"
     try:
         motion(type="setting_arm_configuration", arm=arm, configuration=raised)
     except RECOVERABLE as error:  # e.g. close to the furniture after a failed attempt
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
-    if drive:
-        motion(type="moving", pose=location)
     if location.torso is not None:  # the handle is too low or too high for the torso as it was
         motion(type="setting_torso", position=location.torso)
-    if container.kind == "drawer" and raised != "carry":
-        motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    here = base_pose_fluent().get_value()
+    if (
+        here is None
+        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
+        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
+    ):
+        motion(type="moving", pose=location)
     start = _measure(belief, container)
     start = 0.0 if start is None else start
     if container.kind == "door":

@@ -8,9 +8,10 @@ last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Re
 believed object where it was put.
 
 With ``close_container=True`` the container the object was taken from (a drawer the search
-opened) is closed again once the object is placed, with `Close`, unless it was believed open
-before the transport; its failures are raised (the transport is not done while it stands open).
-Other containers the search opened on the way stay open.
+opened) is closed again with `Close`, unless it was believed open before the transport: right
+after picking up, with a free arm (the PR2), or once the object is placed (a one-armed robot).
+Its failures are raised (the transport is not done while it stands open). Other containers the
+search opened on the way stay open.
 """
 
 from __future__ import annotations
@@ -25,8 +26,8 @@ from pycram.failures import GripperEmpty, ObjectSlipped
 from pycram.robot import current_robot
 
 from .containers import CLOSED, DOOR_CLOSED, Close
-from .core import ActionParameterError, action_plan, attempt, make_action
-from .manipulation import PickUp, Place, believed_object
+from .core import ActionParameterError, action_plan, arms, attempt, make_action
+from .manipulation import PickUp, Place, believed_object, held_objects
 
 __all__ = ["Transport", "TRANSPORT_ROUNDS"]
 
@@ -53,6 +54,11 @@ def _open_containers() -> dict[str, float]:
     return {name: q for name, q in states.items() if q >= OPEN_ABOVE}
 
 
+def _close(container: str, arm: str | None, obj: Any) -> None:
+    log.info("transporting: closing %s, where %s was taken from", container, getattr(obj, "name", "it"))
+    perform(Close(container, arm=arm))
+
+
 @action_plan("transporting")
 def transporting(designator: ActionDesignator) -> Any:
     wanted = designator.prop_value("object")
@@ -61,7 +67,6 @@ def transporting(designator: ActionDesignator) -> Any:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
     arm = designator.prop_value("arm")
     opened_before = set(_open_containers())
-    source: list[str | None] = []  # the container the object lay in, per round
     last: BaseException | None = None
     for round_number in range(1, TRANSPORT_ROUNDS + 1):
         if round_number > 1 and isinstance(wanted, ObjectDesignator):
@@ -69,9 +74,18 @@ def transporting(designator: ActionDesignator) -> Any:
 
         def fetch_and_deliver(wanted: Any = wanted) -> Any:
             obj = believed_object("transporting", wanted)
-            source.append(obj.properties.get("in"))
+            container = str(obj.properties.get("in") or "")
+            close = (
+                bool(designator.prop_value("close_container")) and bool(container) and container not in opened_before
+            )
             held = perform(PickUp(obj, arm=arm))
-            return perform(Place(held, target, arm=held.arm))
+            free = [a for a in arms() if a not in held_objects()]
+            if close and free:  # a free hand closes it at once, standing there
+                _close(container, free[0], obj)
+            placed = perform(Place(held, target, arm=held.arm))
+            if close and not free:  # a one-armed robot closes it once its hand is free again
+                _close(container, None, obj)
+            return placed
 
         try:
             placed = attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
@@ -79,10 +93,6 @@ def transporting(designator: ActionDesignator) -> Any:
             log.info("transporting: %s; fetching it again", error)
             last = error
             continue
-        container = source[-1] if source else None
-        if designator.prop_value("close_container") and container and container not in opened_before:
-            log.info("transporting: closing %s, where %s was taken from", container, getattr(placed, "name", "it"))
-            perform(Close(container))
         return placed
     assert last is not None
     raise last
