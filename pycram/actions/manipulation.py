@@ -536,7 +536,9 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     arm, gripper, obj = held.arm, held.gripper, held.object
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     torso = getattr(location, "torso", None)
-    if torso is not None:  # validated at another torso height (e.g. lowered for a drawer before)
+    if torso is not None:  # validated at another torso height (e.g. lowered for a drawer before):
+        # set before driving -- the arm raised to carry stands over the table at the goal, and with
+        # the torso still low the robot would not fit there (measured: TIAGo, goal_in_collision)
         motion(type="setting_torso", position=torso)
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:
