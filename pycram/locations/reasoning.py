@@ -267,9 +267,11 @@ class LocationReasoner:
             streams.append(_ranked(costmap, arms.index(arm), arm))
         self.last_costmaps = maps
 
-        def validate(cell: tuple, torsos: str = "current") -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+        def validate(
+            cell: tuple, torsos: str = "current", heights: list[tuple[str, float]] | None = None
+        ) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
             """`torsos`: which torso heights to validate at -- the ``current`` one, the ``other``
-            named ones, or ``both`` (the current one first)."""
+            named ones (`heights`, default: every other one), or ``both`` (the current one first)."""
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
             natural = _wrap(
@@ -319,7 +321,7 @@ class LocationReasoner:
             # the target lies low or high for the torso as it is: another torso height
             joint = self.geometry.torso_joint
             back = self._nearest_torso_height()
-            for torso, height in self._other_torso_heights():
+            for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
                 if prosp.in_collision((x, y, natural), {**tucked, joint: height}) or prosp.in_collision(
                     (x, y, natural), {**raised, joint: height}
@@ -337,12 +339,14 @@ class LocationReasoner:
             )
         tally = _Tally()
         first = self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps, tally)
-        if not self._other_torso_heights():
+        higher = self._higher_torso_heights()
+        if not higher:
             return first
 
         def again() -> Iterator[BaseLocation]:
             cells = heapq.merge(*(_ranked(maps[arm], arms.index(arm), arm) for arm in arms))
-            return self._search(desig, cells, partial(validate, torsos="other"), "to_reach", target, maps)
+            check = partial(validate, torsos="other", heights=higher)
+            return self._search(desig, cells, check, "to_reach", target, maps)
 
         return self._or_else(desig, first, tally, again)
 
@@ -355,8 +359,8 @@ class LocationReasoner:
     ) -> Iterator[BaseLocation]:
         """The solutions of `first` (the torso as it is); only when it has none at all and not
         every candidate was in collision (`tally`: the base itself; another torso height would
-        not help), those of `second()` (another torso height) -- `NoSolutionError` saying why
-        neither had any."""
+        not help), those of `second()` (a higher torso) -- `NoSolutionError` saying why neither
+        had any."""
         try:
             yield from first
             return
@@ -368,7 +372,7 @@ class LocationReasoner:
             yield from second()
         except NoSolutionError as error:
             raise NoSolutionError(
-                f"{why}; with another torso height: {str(error).split(': ', 1)[-1]}", designator=desig
+                f"{why}; with the torso higher: {str(error).split(': ', 1)[-1]}", designator=desig
             ) from error
 
     def _arms(self, requested: Any) -> list[str]:
@@ -641,6 +645,18 @@ class LocationReasoner:
             return None
         now = prosp.joint_position(joint)
         return min(named, key=lambda name: abs(named[name] - now))
+
+    def _higher_torso_heights(self) -> list[tuple[str, float]]:
+        """The robot's named torso heights above its torso now, nearest first (none when the
+        height now is unknown): out in the open a torso left low (e.g. by opening a low drawer)
+        is raised when nothing works as it is -- never lowered, which would rarely help and
+        would double the time of every query that fails."""
+        joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
+        prosp = self.prospection()
+        if joint is None or not named or not hasattr(prosp, "joint_position"):
+            return []
+        now = prosp.joint_position(joint)
+        return sorted(((n, h) for n, h in named.items() if h > now + 0.01), key=lambda o: o[1] - now)
 
     def _other_torso_heights(self) -> list[tuple[str, float]]:
         """The robot's named torso heights other than the one it has now, nearest first."""

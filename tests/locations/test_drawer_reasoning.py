@@ -27,7 +27,7 @@ class TorsoProspection(ScriptedProspection):
 
     def __init__(self, reach_at: float | None = None, now: float = 0.28):
         super().__init__()
-        self.reach_at, self.now, self.asked_poses = reach_at, now, []
+        self.reach_at, self.now, self.asked_poses, self.torsos_asked = reach_at, now, [], []
 
     def joint_position(self, name):
         assert name == pr2.TORSO["joint"]
@@ -36,6 +36,7 @@ class TorsoProspection(ScriptedProspection):
     def reachable(self, arm, poses, pose, configuration=None):
         self.asked_poses.append(list(poses))
         torso = (configuration or {}).get(pr2.TORSO["joint"], self.now)
+        self.torsos_asked.append(torso)
         return super().reachable(arm, poses, pose, configuration) if self._ok(torso) else _No()
 
     def _ok(self, torso):
@@ -97,14 +98,17 @@ def test_a_drawer_too_low_for_the_torso_as_it_is_gives_a_solution_with_the_torso
     assert found[0].torso == "down" and found[0].torso_after == "up"
 
 
-def test_out_in_the_open_other_torso_heights_only_when_none_works_as_it_is():
-    prospection = TorsoProspection(reach_at=pr2.TORSO_POSITIONS["down"], now=pr2.TORSO_POSITIONS["up"])
-    with resolver_set(prospection):
+def test_out_in_the_open_a_low_torso_is_raised_only_when_nothing_works_as_it_is():
+    up, down = pr2.TORSO_POSITIONS["up"], pr2.TORSO_POSITIONS["down"]
+    with resolver_set(TorsoProspection(reach_at=up, now=down)):
         found = first(LocationDesignator([("to_reach", CUP_ON_TABLE)]), 1)
-    assert found[0].torso == "down" and found[0].grasp == "side"
-    prospection = TorsoProspection()  # reaches at any height: the torso stays
-    with resolver_set(prospection):
+    assert found[0].torso == "up" and found[0].grasp == "side"
+    with resolver_set(TorsoProspection(now=down)):  # reaches at any height: the torso stays
         assert first(LocationDesignator([("to_reach", CUP_ON_TABLE)]), 1)[0].torso is None
+    prospection = TorsoProspection(reach_at=down, now=up)  # never lowered out in the open
+    with resolver_set(prospection), pytest.raises(NoSolutionError, match="no base pose"):
+        LocationDesignator([("to_reach", CUP_ON_TABLE)]).reference()
+    assert {round(a, 2) for a in prospection.torsos_asked} == {up}
 
 
 def test_an_object_without_a_grasp_over_the_walls_is_refused_naming_them():
