@@ -61,7 +61,7 @@ from pycram.language import State, pursue
 from pycram.locations.targets import KnownObject
 from pycram.robot import current_robot
 from pycram.world.belief import PerceivedObject
-from pycram.world.objects import Grasp, object_type
+from pycram.world.objects import OBJECT_TYPES, Grasp, object_type
 
 from .core import (
     RECOVERABLE,
@@ -115,6 +115,10 @@ PLACE_STANDING_POSES = 2
 #: Picking from a drawer that is not far enough out: it is pulled to this much [m] short of its
 #: slide's end.
 WIDE_MARGIN = 0.03
+#: Picking from a drawer: it is pulled out until the object's footprint is this far [m] out from
+#: under the furniture (the hand is wider than the object, and the handles of the drawers above
+#: stick out 4 cm).
+OUT_FROM_UNDER = 0.12
 #: A surface named as a placing target: spots near the side facing the robot, this far in [m].
 NEAR_SIDE_INSET = 0.15
 #: A placed object must be seen this close [m] (horizontally) to its spot.
@@ -274,6 +278,11 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     motion(type="setting_gripper", gripper=gripper, position=1)
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     motion(type="moving", pose=location)
+    torso = getattr(location, "torso", None)
+    if torso is not None:  # e.g. in a low drawer: the sequence was validated at another torso height
+        # only once there: a torso lowered where the robot stood would sweep its raised arm over
+        # the table or counter beside it
+        motion(type="setting_torso", position=torso)
     _look_again(obj)
     if obj.gone:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
@@ -302,6 +311,9 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         )
     _reach(arm, location, 2, "lift", point)
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    torso_after = getattr(location, "torso_after", None)
+    if torso is not None and torso_after is not None:
+        motion(type="setting_torso", position=torso_after)
     opening = gripper_opening(gripper)
     if opening < held.held_opening:
         raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting", obj)
@@ -317,36 +329,52 @@ def _xyz(p: Any) -> str:
 
 @action_plan("picking_up")
 def picking_up(designator: ActionDesignator) -> Held:
+    from .containers import Open
+
+    wanted = designator.prop_value("object")
+    if wanted is not None:
+        # in a drawer pulled out only part of the way, the object may still be under the furniture
+        obj = believed_object("picking_up", wanted)
+        needed = _wider_opening(obj, as_far_as_needed=True)
+        if needed is not None:
+            log.info("%s is still under the furniture in %s: opening it further", obj.name, obj.properties["in"])
+            perform(Open(obj.properties["in"], opening=needed))
+            _look_again(obj)
     try:
         return _pick_up(designator)
     except ObjectOutOfReach:
-        # in a drawer pulled out only part of the way, the object may still be under the furniture
+        # still out of reach: the drawer all the way out (the object farther from the furniture)
         obj = believed_object("picking_up", designator.prop_value("object"))
         wider = _wider_opening(obj)
         if wider is None:
             raise
-        from .containers import Open
-
         log.info("%s is out of reach in %s: opening it further", obj.name, obj.properties["in"])
         perform(Open(obj.properties["in"], opening=wider))
         _look_again(obj)
         return _pick_up(designator)
 
 
-def _wider_opening(obj: PerceivedObject) -> float | None:
-    """How far to pull out the drawer `obj` lies in so that it comes out from under the
-    furniture (near the slide's end); None when it is in no drawer or the drawer is that far out."""
+def _wider_opening(obj: PerceivedObject, as_far_as_needed: bool = False) -> float | None:
+    """How far [m] to pull out the drawer `obj` lies in: near the slide's end, or -- with
+    `as_far_as_needed` -- just so far that the object is `OUT_FROM_UNDER` out from under the
+    furniture (its footprint past the closed drawer's front). None when it is in no drawer or the
+    drawer is (about) that far out already."""
     name = obj.properties.get("in")
     belief = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
-    if not name or belief is None or environment is None:
+    if not name or belief is None or environment is None or obj.pose is None:
         return None
     container = environment.container(name)
     if container.kind != "drawer":
         return None
     wide = container.limits[1] - WIDE_MARGIN
-    now = belief.container_states.get(name, 0.0)
-    return wide if now < wide - WIDE_MARGIN else None
+    now = float(belief.container_states.get(name, 0.0))
+    goal = wide
+    if as_far_as_needed:
+        radius = object_type(obj.type).footprint_radius if obj.type in OBJECT_TYPES else 0.05
+        out = container.along_slide(obj.pose[0], obj.pose[1]) - radius - container.front  # [m] past the front now
+        goal = min(container.limits[1], now + OUT_FROM_UNDER - out)
+    return goal if now < goal - WIDE_MARGIN else None
 
 
 def _pick_up(designator: ActionDesignator) -> Held:
@@ -515,6 +543,11 @@ def _place_locations(held: Held, spot: tuple[float, float, float], point: list[f
 def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
     arm, gripper, obj = held.arm, held.gripper, held.object
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
+    torso = getattr(location, "torso", None)
+    if torso is not None:  # validated at another torso height (e.g. lowered for a drawer before):
+        # set before driving -- the arm raised to carry stands over the table at the goal, and with
+        # the torso still low the robot would not fit there (measured: TIAGo, goal_in_collision)
+        motion(type="setting_torso", position=torso)
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:
         raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)

@@ -6,6 +6,12 @@ finds the object (search when the belief does not hold it), picks it up (`PickUp
 it is searched for and fetched again, at most `TRANSPORT_ROUNDS` times; then the failure of the
 last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Returns the
 believed object where it was put.
+
+With ``close_container=True`` the container the object was taken from (a drawer the search
+opened) is closed again with `Close`, unless it was believed open before the transport: right
+after picking up, with a free arm (the PR2), or once the object is placed (a one-armed robot).
+Its failures are raised (the transport is not done while it stands open). Other containers the
+search opened on the way stay open.
 """
 
 from __future__ import annotations
@@ -17,23 +23,40 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.object import ObjectDesignator
 from pycram.designators.perform import perform
 from pycram.failures import GripperEmpty, ObjectSlipped
+from pycram.robot import current_robot
 
-from .core import ActionParameterError, action_plan, attempt, make_action
-from .manipulation import PickUp, Place, believed_object
+from .containers import CLOSED, DOOR_CLOSED, Close
+from .core import ActionParameterError, action_plan, arms, attempt, make_action
+from .manipulation import PickUp, Place, believed_object, held_objects
 
 __all__ = ["Transport", "TRANSPORT_ROUNDS"]
 
 log = logging.getLogger("pycram.actions")
 
+#: A container counts as open above this believed opening [m or rad] (a drawer: 3 cm, a door: 4 deg).
+OPEN_ABOVE = max(CLOSED, DOOR_CLOSED)
 #: Fetch-and-deliver rounds (the object lost on the way starts a new round).
 TRANSPORT_ROUNDS = 3
 
 
-def Transport(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
+def Transport(object: Any, target: Any, arm: str | None = None, close_container: bool = False) -> ActionDesignator:
     """Bring `object` (an object designator, a believed object or a type name) to `target` (as
     for `Place`: a location designator, a `Spot`, a point or a surface's name) with `arm`
-    (None: chosen by the reasoning)."""
-    return make_action("transporting", object=object, target=target, arm=arm)
+    (None: chosen by the reasoning); with `close_container`, close the container it was taken
+    from when the transport opened it."""
+    return make_action("transporting", object=object, target=target, arm=arm, close_container=close_container)
+
+
+def _open_containers() -> dict[str, float]:
+    """The containers the active robot believes open (name -> measured opening [m or rad])."""
+    belief = getattr(current_robot(), "belief", None)
+    states = dict(getattr(belief, "container_states", {}) or {})
+    return {name: q for name, q in states.items() if q >= OPEN_ABOVE}
+
+
+def _close(container: str, arm: str | None, obj: Any) -> None:
+    log.info("transporting: closing %s, where %s was taken from", container, getattr(obj, "name", "it"))
+    perform(Close(container, arm=arm))
 
 
 @action_plan("transporting")
@@ -43,6 +66,7 @@ def transporting(designator: ActionDesignator) -> Any:
     if wanted is None or target is None:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
     arm = designator.prop_value("arm")
+    opened_before = set(_open_containers())
     last: BaseException | None = None
     for round_number in range(1, TRANSPORT_ROUNDS + 1):
         if round_number > 1 and isinstance(wanted, ObjectDesignator):
@@ -50,13 +74,25 @@ def transporting(designator: ActionDesignator) -> Any:
 
         def fetch_and_deliver(wanted: Any = wanted) -> Any:
             obj = believed_object("transporting", wanted)
+            container = str(obj.properties.get("in") or "")
+            close = (
+                bool(designator.prop_value("close_container")) and bool(container) and container not in opened_before
+            )
             held = perform(PickUp(obj, arm=arm))
-            return perform(Place(held, target, arm=held.arm))
+            free = [a for a in arms() if a not in held_objects()]
+            if close and free:  # a free hand closes it at once, standing there
+                _close(container, free[0], obj)
+            placed = perform(Place(held, target, arm=held.arm))
+            if close and not free:  # a one-armed robot closes it once its hand is free again
+                _close(container, None, obj)
+            return placed
 
         try:
-            return attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
+            placed = attempt(f"fetch and deliver (round {round_number})", fetch_and_deliver)
         except (ObjectSlipped, GripperEmpty) as error:
             log.info("transporting: %s; fetching it again", error)
             last = error
+            continue
+        return placed
     assert last is not None
     raise last

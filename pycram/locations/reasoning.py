@@ -45,6 +45,8 @@ import logging
 import math
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -54,7 +56,7 @@ from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Sur
 from pycram.world.objects import Grasp, ObjectType, object_type
 
 from . import doors
-from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, ring_layer
+from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, rect_distance, ring_layer
 from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation, Spot
 from .targets import KnownObject, Target, as_target
@@ -91,6 +93,14 @@ REACH_SIGMA, REACH_INSIDE, REACH_OUTSIDE = 0.12, 0.35, 0.30
 #: [rad] from the base heading.
 FACING_SCALE = 0.6
 APPROACH_TOLERANCE = 0.45
+#: In a drawer, a tool without the object passes this far [m] above the top of its walls, and a
+#: held object's bottom as far (the approach and the lift of top grasps).
+RIM_CLEARANCE = 0.04
+#: Free space [m] kept between the base's inscribed circle and an open drawer (the base stands
+#: close to reach over it; its footprint is checked with prospection).
+DRAWER_CLEARANCE = 0.08
+#: How far [m] a drawer's handle bar reaches beyond its grasp point (the bar's half thickness).
+HANDLE_DEPTH = 0.015
 #: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
 TOP_PENALTY = 0.3
 #: Pushing a door: base headings tried per cell, relative to the one that puts the push's first
@@ -236,8 +246,19 @@ class LocationReasoner:
         arms = self._arms(desig.prop_value("arm"))
         grasps = self._grasps(target, desig.prop_value("grasp"))
         env = self.environment()
+        drawer = self._drawer_around(target)
+        if drawer is not None:
+            grasps = self._over_the_rim(desig, target, grasps, drawer)
+        elif desig.prop_value("grasp") is None:  # out in the open, a cup is taken by its side
+            grasps = [g for g in grasps if not _body_from_the_top(g)] or grasps
         grid = FloorGrid.of(env)
-        occupancy = occupancy_layer(env, grid, self._base_radius, self._open_drawers(env))
+        occupancy = occupancy_layer(env, grid, self._base_radius)
+        open_drawers = self._open_drawers(env)
+        if open_drawers:  # the base may come closer to an open drawer than to the furniture
+            occupancy = occupancy.copy()
+            near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
+            for rect in open_drawers:
+                occupancy[rect_distance(grid, rect) < near] = np.inf
         facing = self._facing_yaws(env, target)
         streams = []
         maps = {}
@@ -256,7 +277,11 @@ class LocationReasoner:
             streams.append(_ranked(costmap, arms.index(arm), arm))
         self.last_costmaps = maps
 
-        def validate(cell: tuple) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+        def validate(
+            cell: tuple, torsos: str = "current", heights: list[tuple[str, float]] | None = None
+        ) -> tuple[BaseLocation | None, tuple[str, str | None] | None]:
+            """`torsos`: which torso heights to validate at -- the ``current`` one, the ``other``
+            named ones (`heights`, default: every other one), or ``both`` (the current one first)."""
             cost, _, arm, r, c = cell
             x, y = maps[arm].xy(r, c)
             natural = _wrap(
@@ -264,33 +289,101 @@ class LocationReasoner:
             )
             prosp = self.prospection()
             tucked = dict(self.geometry.tucked)
-            if prosp.in_collision((x, y, natural), tucked):
-                return None, ("in collision", None)
             raised = self.geometry.raised(arm)
-            if prosp.in_collision((x, y, natural), raised):
-                return None, (f"arm {arm!r} hits the furniture when raised to approach", None)
-            failure = None
-            for grasp, heading in self._grasp_options(grasps, target, natural):
-                yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
-                point = self._grasp_point(target, grasp)
-                if grasp.approach == "top":
-                    point, heading = self._top_grasp(target, grasp, x, y)
-                poses = grasp_sequence(
-                    self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
-                )
-                margin = self.geometry.contact_margin if action == "grasp" else 0.0
-                if margin:  # room to spare below the grasp
-                    (gx, gy, gz), q = poses[1]
-                    poses.insert(2, ((gx, gy, gz - margin), q))
-                answer = prosp.reachable(arm, poses, (x, y, yaw), raised)
-                if answer:
-                    joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
-                    tool = tuple(p for i, p in enumerate(poses) if not (margin and i == 2))
-                    return BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints, tool_poses=tool), None
-                failure = (f"unreachable for arm {arm!r}", answer.reason)
-            return None, failure or ("no fitting grasp", None)
 
-        return self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps)
+            def sequences(configuration: dict[str, float]) -> tuple[BaseLocation | None, tuple[str, str | None]]:
+                failure: tuple[str, str | None] = ("no fitting grasp", None)
+                for grasp, heading in self._grasp_options(grasps, target, natural):
+                    yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
+                    point = self._grasp_point(target, grasp)
+                    if grasp.approach == "top":
+                        point, heading = self._top_grasp(target, grasp, x, y)
+                    poses = grasp_sequence(
+                        self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
+                    )
+                    if drawer is not None:
+                        poses = self._clear_of_the_rim(poses, grasp, drawer.rim_height, action)
+                    margin = self.geometry.contact_margin if action == "grasp" else 0.0
+                    if margin:  # room to spare below the grasp
+                        (gx, gy, gz), q = poses[1]
+                        poses.insert(2, ((gx, gy, gz - margin), q))
+                    answer = prosp.reachable(arm, poses, (x, y, yaw), configuration)
+                    if answer:
+                        joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
+                        tool = tuple(p for i, p in enumerate(poses) if not (margin and i == 2))
+                        location = BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints, tool_poses=tool)
+                        return location, failure
+                    failure = (f"unreachable for arm {arm!r}", answer.reason)
+                return None, failure
+
+            failure: tuple[str, str | None] = ("in collision at every other torso height", None)
+            if torsos != "other":
+                if prosp.in_collision((x, y, natural), tucked):
+                    return None, ("in collision", None)
+                if prosp.in_collision((x, y, natural), raised):
+                    failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
+                    if torsos == "current":
+                        return None, failure
+                else:
+                    found, failure = sequences(raised)
+                    if found is not None or torsos == "current":
+                        return found, (None if found is not None else failure)
+            # the target lies low or high for the torso as it is: another torso height
+            joint = self.geometry.torso_joint
+            back = self._nearest_torso_height()
+            for torso, height in self._other_torso_heights() if heights is None else heights:
+                assert joint is not None  # there are other torso heights only with a torso joint
+                if prosp.in_collision((x, y, natural), {**tucked, joint: height}) or prosp.in_collision(
+                    (x, y, natural), {**raised, joint: height}
+                ):
+                    continue
+                other, why = sequences({**raised, joint: height})
+                if other is not None:
+                    return replace(other, torso=torso, torso_after=back), None
+                failure = why
+            return None, failure
+
+        if drawer is not None:  # in a drawer the torso height is part of every candidate's question
+            return self._search(
+                desig, heapq.merge(*streams), partial(validate, torsos="both"), "to_reach", target, maps
+            )
+        tally = _Tally()
+        first = self._search(desig, heapq.merge(*streams), validate, "to_reach", target, maps, tally)
+        higher = self._higher_torso_heights()
+        if not higher:
+            return first
+
+        def again() -> Iterator[BaseLocation]:
+            cells = heapq.merge(*(_ranked(maps[arm], arms.index(arm), arm) for arm in arms))
+            check = partial(validate, torsos="other", heights=higher)
+            return self._search(desig, cells, check, "to_reach", target, maps)
+
+        return self._or_else(desig, first, tally, again)
+
+    def _or_else(
+        self,
+        desig: Any,
+        first: Iterator[BaseLocation],
+        tally: _Tally,
+        second: Callable[[], Iterator[BaseLocation]],
+    ) -> Iterator[BaseLocation]:
+        """The solutions of `first` (the torso as it is); only when it has none at all and not
+        every candidate was in collision (`tally`: the base itself; another torso height would
+        not help), those of `second()` (a higher torso) -- `NoSolutionError` saying why neither
+        had any."""
+        try:
+            yield from first
+            return
+        except NoSolutionError as error:
+            if set(tally.reasons) <= {"in collision"}:
+                raise
+            why = str(error)
+        try:
+            yield from second()
+        except NoSolutionError as error:
+            raise NoSolutionError(
+                f"{why}; with the torso higher: {str(error).split(': ', 1)[-1]}", designator=desig
+            ) from error
 
     def _arms(self, requested: Any) -> list[str]:
         if requested is not None:
@@ -309,6 +402,52 @@ class LocationReasoner:
             return chosen
         return grasps
 
+    def _drawer_around(self, target: Target) -> Container | None:
+        """The drawer `target` (an object) lies in, as far as the environment's description and
+        the believed openings (`container_states`) say; None when it lies in none."""
+        if target.kind != "object":
+            return None
+        above = (target.type.half_height if target.type is not None else 0.0) + 0.05
+        states = self.container_states()
+        for container in self.environment().containers:
+            q = float(states.get(container.name, 0.0))
+            if container.surface_holding(target.position, q, above) is not None:
+                return container
+        return None
+
+    def _over_the_rim(self, desig: Any, target: Target, grasps: list[Grasp], drawer: Container) -> list[Grasp]:
+        """The grasps of `target` lying in `drawer` that do not pass through its walls: from the
+        top, or horizontal ones whose grasp point lies `RIM_CLEARANCE` above the walls' top.
+        `NoSolutionError` when none is left."""
+        rim = drawer.rim_height
+        bottom = target.position[2] - (target.type.half_height if target.type is not None else 0.0)
+        fitting = [g for g in grasps if g.approach == "top" or bottom + g.height > rim + RIM_CLEARANCE]
+        if not fitting:
+            raise self._fail(
+                desig,
+                f"{target.describe()} lies in {drawer.name!r}, whose walls rise to {rim:.2f} m, above the "
+                f"grasp points of its grasps {[g.approach for g in grasps]} (from the side the fingers "
+                f"would pass through the walls; a grasp from the top would not)",
+            )
+        return fitting
+
+    @staticmethod
+    def _clear_of_the_rim(
+        poses: list[tuple[tuple[float, float, float], tuple]], grasp: Grasp, rim: float, action: str
+    ) -> list[tuple[tuple[float, float, float], tuple]]:
+        """A top grasp's or placing's sequence in a drawer with walls up to `rim` [m]: the tool
+        comes in and leaves above them -- empty (pre_grasp, retreat) `RIM_CLEARANCE` above, holding
+        the object (lift, pre_place) with the object's bottom that much above."""
+        if grasp.approach != "top":
+            return poses
+        holding = {"grasp": (False, True), "place": (True, False)}[action]  # (first pose, last pose)
+        out = list(poses)
+        for index, carries in ((0, holding[0]), (len(out) - 1, holding[1])):
+            (x, y, z), q = out[index]
+            lowest = rim + RIM_CLEARANCE + (grasp.height if carries else 0.0)
+            out[index] = ((x, y, max(z, lowest)), q)
+        return out
+
     @staticmethod
     def _grasp_point(target: Target, grasp: Grasp) -> tuple[float, float, float]:
         x, y, z = target.position
@@ -320,12 +459,14 @@ class LocationReasoner:
     def _top_grasp(target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
         """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at
         (x, y): a rim (``radius``) is taken at its point nearest the base, the fingers closing
-        across the wall; otherwise at the centre, the fingers closing across the object's
-        ``across`` axis. The tool points down; its fingers open along heading + 90 deg."""
+        across the wall; a body (``across='radial'`` without a radius: cups and mugs) at its
+        axis, the fingers closing along the line from the base; otherwise at the centre, the
+        fingers closing across the object's ``across`` axis. The tool points down; its fingers
+        open along heading + 90 deg."""
         cx, cy, cz = target.position
         half = target.type.half_height if target.type is not None else 0.0
         z = cz - half + grasp.height
-        if grasp.radius > 0.0:
+        if grasp.radius > 0.0 or grasp.across == "radial":
             toward = math.atan2(y - cy, x - cx)
             point = (cx + grasp.radius * math.cos(toward), cy + grasp.radius * math.sin(toward), z)
             fingers = toward
@@ -597,6 +738,27 @@ class LocationReasoner:
             solutions.append(tuple(answer.solutions[0]))
         return solutions, None
 
+    def _nearest_torso_height(self) -> str | None:
+        """The robot's named torso height nearest to its torso now (None: no torso, or unknown)."""
+        joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
+        prosp = self.prospection()
+        if joint is None or not named or not hasattr(prosp, "joint_position"):
+            return None
+        now = prosp.joint_position(joint)
+        return min(named, key=lambda name: abs(named[name] - now))
+
+    def _higher_torso_heights(self) -> list[tuple[str, float]]:
+        """The robot's named torso heights above its torso now, nearest first (none when the
+        height now is unknown): out in the open a torso left low (e.g. by opening a low drawer)
+        is raised when nothing works as it is -- never lowered, which would rarely help and
+        would double the time of every query that fails."""
+        joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
+        prosp = self.prospection()
+        if joint is None or not named or not hasattr(prosp, "joint_position"):
+            return []
+        now = prosp.joint_position(joint)
+        return sorted(((n, h) for n, h in named.items() if h > now + 0.01), key=lambda o: o[1] - now)
+
     def _other_torso_heights(self) -> list[tuple[str, float]]:
         """The robot's named torso heights other than the one it has now, nearest first."""
         joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
@@ -616,14 +778,17 @@ class LocationReasoner:
         return math.atan2(-dy, -dx)
 
     def _open_drawers(self, env: Environment) -> list[tuple[float, float, float, float]]:
-        """Floor rectangles of the drawers believed open (where they stick out now)."""
+        """Floor rectangles of the drawers believed open (where they stick out now, handle
+        included)."""
         rects: list[tuple[float, float, float, float]] = []
         for name, q in self.container_states().items():
             if abs(q) > 0.01:
                 try:
-                    rects += self._swept_rects(env.container(name), float(q))
+                    container = env.container(name)
                 except KeyError:
                     continue
+                handle = max(0.0, container.along_slide(*container.handle[:2]) - container.front) + HANDLE_DEPTH
+                rects += self._swept_rects(container, float(q) + handle)
         return rects
 
     @staticmethod
@@ -770,11 +935,13 @@ class LocationReasoner:
         kind: str,
         target: Target,
         maps: dict[str, Costmap],
+        tally: _Tally | None = None,
     ) -> Iterator[BaseLocation]:
         """Walk `cells` (cost, tie, arm, row, col) cheapest first; validate each; yield the valid
         ones at least `SPACING` apart; after `max_candidates` checks or when the costmap is used
-        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed."""
-        tally = _Tally()
+        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed
+        (counted in `tally` when given)."""
+        tally = _Tally() if tally is None else tally
         given: list[BaseLocation] = []
         failed: list[tuple[str | None, float, float]] = []
         for cell in cells:
@@ -800,6 +967,12 @@ class LocationReasoner:
             raise self._fail(
                 desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: {tally.summary()}"
             )
+
+
+def _body_from_the_top(grasp: Grasp) -> bool:
+    """A grasp of a round body from the top (cups, mugs): for where its sides are walled in (in a
+    drawer), or when asked for; elsewhere its horizontal grasps are used."""
+    return grasp.approach == "top" and grasp.across == "radial" and grasp.radius == 0.0
 
 
 def _layer_summary(maps: dict[str, Costmap]) -> str:

@@ -184,6 +184,13 @@ class SimProspection(Prospection):
         name = self.model.geom(g).name
         return name or self.model.body(int(self.model.geom_bodyid[g])).name
 
+    def joint_position(self, name: str) -> float:
+        """The position [rad or m] of joint `name` in the latest snapshot (the world as it is now)."""
+        address = self._joint_qpos.get(name)
+        if address is None:
+            raise ValueError(f"unknown joint {name!r} of {self.scene.robot}; valid joints: {sorted(self._joint_qpos)}")
+        return float(self._snapshot().qpos[address])
+
     # ------------------------------------------------------------------ collision
     def collisions(
         self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None

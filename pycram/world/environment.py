@@ -9,7 +9,7 @@ Polygons are convex and counter-clockwise (checked on construction).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol, TypeVar
 
@@ -175,6 +175,37 @@ class Container:
             return 1.0
         rx, ry = self.handle[0] - self.hinge[0], self.handle[1] - self.hinge[1]
         return 1.0 if -ry * self.opening_direction[0] + rx * self.opening_direction[1] > 0 else -1.0
+
+    def along_slide(self, x: float, y: float) -> float:
+        """How far [m] the floor point (x, y) lies along the opening direction (from the origin)."""
+        return x * self.opening_direction[0] + y * self.opening_direction[1]
+
+    @property
+    def front(self) -> float:
+        """Where the closed body ends along the opening direction [m, `along_slide`]: the
+        furniture's front, beyond which a drawer's contents are out from under it."""
+        return max(self.along_slide(x, y) for x, y in _rect_corners(self.body.footprint))
+
+    @property
+    def rim_height(self) -> float:
+        """Height [m] of the top of a drawer's walls (its body's top)."""
+        return self.body.z_range[1]
+
+    def surface_holding(self, point: Sequence[float], q: float, above: float = 0.3) -> Surface | None:
+        """The interior surface of this drawer, opened by `q` [m], that `point` (x, y, z) [m, map:
+        an object's centre] rests on or in -- its footprint over the surface moved out by `q` and
+        its height within `above` [m] of the surface and below its clearance. None for a door
+        (its shelves do not move) and for a point in none of them."""
+        if self.kind != "drawer":
+            return None
+        x, y, z = (float(v) for v in point[:3])
+        dx, dy = self.opening_direction
+        for surface in self.interior:
+            if not surface.contains(x - dx * q, y - dy * q):
+                continue
+            if surface.height - 0.01 <= z <= surface.height + min(above, surface.clearance):
+                return surface
+        return None
 
     def handle_position(self, q: float) -> Vec3:
         """Where the handle is when the joint is at `q` [m or rad] (the opening trajectory)."""
@@ -361,6 +392,11 @@ def _find(kind: str, name: str, things: Iterable[_N]) -> _N:
         if t.name == name:
             return t
     raise UnknownNameError(kind, name, [t.name for t in found])
+
+
+def _rect_corners(rect: Rect) -> list[XY]:
+    x0, y0, x1, y1 = rect
+    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
 
 
 def rect_around(center: XY, half: XY) -> Rect:

@@ -40,7 +40,8 @@ class Grasp:
     between the finger pads when they close on the object; `height` [m] is the grasp point above
     the object's bottom; `radius` [m] moves the grasp point off the object's axis towards the
     gripper (rim grasps of bowls and plates: the fingers pinch the wall); `across` says which
-    object axis the fingers close across for a top grasp ("x", "y", or "radial" for a rim).
+    object axis the fingers close across for a top grasp ("x", "y", or "radial": along the line
+    from the robot -- a rim at `radius`, or, without one, a round body at its axis).
     """
 
     approach: str
@@ -143,9 +144,9 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (0.035, 0.045),
             0.2,
             (0.80, 0.18, 0.15, 1.0),
-            (Grasp("side", 0.07, 0.05),),
+            (Grasp("side", 0.07, 0.05), Grasp("top", 0.07, 0.06, across="radial")),
             _ANY_SURFACE,
-            "a drinking cup, 7 cm wide, 9 cm tall",
+            "a drinking cup, 7 cm wide, 9 cm tall; from the top (in drawers) by its body",
         ),
         ObjectType(
             "mug",
@@ -153,7 +154,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (0.03, 0.05),
             0.25,
             (1.0, 0.82, 0.05, 1.0),
-            (Grasp("side", 0.06, 0.05),),
+            (Grasp("side", 0.06, 0.05), Grasp("top", 0.06, 0.07, across="radial")),
             ("counter", "table", "shelf"),
             "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)",
         ),
