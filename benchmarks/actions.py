@@ -3,7 +3,8 @@
 Issue 16 asks for the success rate and the simulated and wall time of ``transporting`` for each
 object type and robot over >= 20 random apartment scenes each. Each scene: the object (and two
 other objects in the way) starts at a random spot of an open surface (counter, cabinet top,
-table, cookers; closed drawers and the fridge are left out while the robot cannot open them),
+table, cookers; drawers and the fridge are left out: out of drawers only cups, mugs and bowls
+are picked, see docs/actions.md, and tests/sim/test_actions_drawers.py covers them),
 the robot starts at the apartment's start pose knowing nothing, and is asked to
 ``Transport(ObjectDesignator(type=T), "table")`` -- or to the counter for an object that starts
 on the table. Success is judged with the simulator's truth: the object stands upright (< 20 deg)
