@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from pycram.demos.set_table_plan import PlaceSetting, SettingOutcome
+from pycram.demos.set_table_plan import PlaceSetting, PlanRecord, SettingOutcome
 
 __all__ = [
     "OBJECTS",
@@ -191,6 +191,9 @@ class SetTableResult:
     wall_time: float = 0.0
     faults_injected: list[str] = field(default_factory=list)
     error: str | None = None  # what stopped the plan as a whole (a time limit, a bug), if anything
+    #: What the plan's concurrency did (`PlanRecord.as_dict`), and -- measured with the
+    #: simulator's truth -- the most objects the robot's grippers held at the same time.
+    concurrency: dict[str, Any] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -236,6 +239,7 @@ class SetTableResult:
             "wall_time": self.wall_time,
             "error": self.error,
             "summary": self.summary(),
+            "concurrency": dict(self.concurrency),
         }
 
 
@@ -462,11 +466,35 @@ class Faults:
 # -- running ---------------------------------------------------------------------------------------
 
 
+class _HeldAtOnce:
+    """Measures, with the simulator's truth (for judging, never for the plan), the most objects
+    the robot's grippers held at the same time, and which."""
+
+    def __init__(self, world: Any) -> None:
+        self.world = world
+        self.most: list[str] = []
+        self._lock = threading.Lock()
+        self._handles = [s.on_change(self._changed) for s in world.gripper_states.values()]
+
+    def _changed(self, _: Any) -> None:
+        holding = sorted(
+            {s.get_value().holding for s in self.world.gripper_states.values()} - {None}
+        )
+        with self._lock:
+            if len(holding) > len(self.most):
+                self.most = holding
+
+    def stop(self) -> None:
+        for handle in self._handles:
+            handle.remove()
+
+
 class _PlanThread:
     """The plan in a thread of its own (a task tree root), so the driver can watch time limits."""
 
     def __init__(self, robot: Any, settings: list[PlaceSetting]) -> None:
         self.robot, self.settings = robot, settings
+        self.record = PlanRecord()
         self.task: Any = None
         self.error: BaseException | None = None
         self.outcomes: list[SettingOutcome] | None = None
@@ -479,7 +507,7 @@ class _PlanThread:
         def whole_plan() -> Any:
             self.task = current_task()
             with self.robot:
-                self.outcomes = set_table(self.settings)
+                self.outcomes = set_table(self.settings, self.record)
 
         try:
             run_subtask("set_table", whole_plan, kind="plan")
@@ -606,6 +634,7 @@ def run_scenario(
             if animation:
                 world.start_recording(camera, fps=4.0, width=480, height=360, caption=_caption)
         injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
+        held_at_once = _HeldAtOnce(world)
         plan = _PlanThread(robot_handle, settings)
         sim_start = world.sim_time.get_value()
         injector.start()
@@ -623,6 +652,8 @@ def run_scenario(
                 plan.stop()
                 break
         injector.stop()
+        held_at_once.stop()
+        result.concurrency = {**plan.record.as_dict(), "most_held_at_once": held_at_once.most}
         result.sim_time = world.sim_time.get_value() - sim_start
         if plan.error is not None and result.error is None:
             result.error = f"{type(plan.error).__name__}: {plan.error}"

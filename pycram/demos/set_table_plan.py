@@ -8,43 +8,83 @@ action library's designators.
 
 For each place setting, in order:
 
-* ``Transport(ObjectDesignator(type=...), point)`` -- search (drawers are opened when the
-  object is not found on open surfaces), pick up, place; the action library recovers inside
-  (next standing pose, perceiving again, searching again when the object was taken);
-* each transport round runs under `with_timeout` (a budget of simulated time), with one more
-  round for the failures that a second look may fix (the
-  object was moved, missed by perception, a drawer was stuck and is free now);
+* the object is found: from the belief, else searched for (``search_for``: open surfaces first,
+  then inside the drawers, one drawer open at a time) -- under ``pursue`` with a wait on a
+  fluent of the belief, so the search ends as soon as the object is believed, whoever saw it;
+* it is brought: ``Transport(found, point)`` -- pick up, place, with the action library's
+  recoveries inside (next standing pose, perceiving again, searching again when the object was
+  taken). When the robot has an arm to spare once it holds this object (from its description
+  and `held_objects()`: the PR2, never the one-armed TIAGo) and the next object is believed, it
+  picks this one up, brings the next one with the free arm (``Transport(next, arm=free)``),
+  and then puts this one down: two objects carried at once, one trip to the table fewer;
+* each round runs under `with_timeout` (a budget of simulated time), with one more round for
+  the failures that a second look may fix (the object was moved, missed by perception, a
+  drawer was stuck and is free now);
 * afterwards, with empty hands, every container the robot believes open is closed again
   (`Close`), so no drawer is left sticking out into the room.
 
+Throughout, every drive of the action library has a companion (`while_driving`): the head looks
+along the surfaces within reach of the camera for the objects still to be brought that the
+belief does not hold yet (`look_for_the_next`) -- a person glances at the counter on the way
+past. What it sees goes into the belief, so later searches end early or are not needed.
+The head is used only while the base drives; the companion is evaporated when the drive ends,
+before the action uses the head again.
+
 The outcome of each setting (placed, or the typed failure that stopped it) is returned; the plan
-raises nothing for a failed object, so the other objects are still brought.
+raises nothing for a failed object, so the other objects are still brought. What the
+concurrency did is written into a `PlanRecord` when one is given.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
-from pycram.actions import Close, Detect, LookAt, MoveTorso, Navigate, Open, ParkArms, Transport, search_for
-from pycram.actions.core import base_pose_fluent
+from pycram.actions import (
+    Close,
+    Detect,
+    Held,
+    LookAt,
+    MoveTorso,
+    Navigate,
+    Open,
+    ParkArms,
+    PickUp,
+    Place,
+    Transport,
+    held_objects,
+    lookouts,
+    search_for,
+)
+from pycram.actions.core import arms, base_pose_fluent, motion, while_driving
+from pycram.actions.search import LOOK_RANGE
 from pycram.designator import ObjectDesignator, perform
 from pycram.designators.core import DesignatorError
-from pycram.failures import GraspFailed, ObjectOutOfReach, PlanFailure
+from pycram.failures import GraspFailed, GripperEmpty, ObjectOutOfReach, ObjectSlipped, PlanFailure
 from pycram.fluent import Fluent
-from pycram.language import State, with_timeout
+from pycram.language import State, pursue, with_timeout
 from pycram.process_module import ProcessModuleError
 from pycram.robot import current_robot
+from pycram.world.belief import PerceivedObject
 
 __all__ = [
     "PlaceSetting",
     "SettingOutcome",
+    "PlanRecord",
     "set_table",
+    "find",
+    "believed",
+    "believed_fluent",
+    "look_for_the_next",
     "close_opened_containers",
     "ROUND_TIME_BUDGET",
     "ROUNDS",
+    "RESCAN_DISTANCE",
     "current_object",
     "WORLD_FAILURES",
     "objects_done",
@@ -63,6 +103,9 @@ ROUND_TIME_BUDGET = 300.0
 ELSEWHERE = 0.5
 #: Transport rounds per object (a second round after a failure a new search may fix).
 ROUNDS = 2
+#: Looking while driving: once every place in view range has been looked at, the next looks
+#: wait until the base has moved this far [m].
+RESCAN_DISTANCE = 1.0
 
 #: The object type being brought now (None between objects), for people watching and for the
 #: simulated person of the scenario's faults.
@@ -93,10 +136,66 @@ class SettingOutcome:
     attempts: list[str] = field(default_factory=list)
 
 
+@dataclass
+class PlanRecord:
+    """What the plan's concurrency did in one run (filled from several tasks; thread-safe):
+
+    * `found_while_driving`: objects first believed from a look taken while the base drove
+      ("cup-1 on counter");
+    * `searches_ended_by_belief`: searches that `pursue` ended because the belief fluent said
+      the object is believed (the search itself had not returned it yet);
+    * `carried_together`: (held, fetched) type pairs: the second object was brought with the
+      free arm while the first was held.
+    """
+
+    found_while_driving: list[str] = field(default_factory=list)
+    searches_ended_by_belief: list[str] = field(default_factory=list)
+    carried_together: list[tuple[str, str]] = field(default_factory=list)
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False, compare=False)
+
+    def note(self, entries: list[Any], entry: Any) -> None:
+        """Append `entry` to `entries` (one of this record's lists) under the record's lock."""
+        with self._lock:
+            entries.append(entry)
+
+    def as_dict(self) -> dict[str, Any]:
+        """A JSON-serialisable copy."""
+        with self._lock:
+            return {
+                "found_while_driving": list(self.found_while_driving),
+                "searches_ended_by_belief": list(self.searches_ended_by_belief),
+                "carried_together": [list(p) for p in self.carried_together],
+            }
+
+
+def _belief() -> Any:
+    return getattr(current_robot(), "belief", None)
+
+
+def believed(type_name: str) -> PerceivedObject | None:
+    """The object of `type_name` the robot believes present (not gone), best first; None when
+    it believes none."""
+    belief = _belief()
+    if belief is None:
+        return None
+    return next((o for o in belief.present() if o.type == type_name), None)
+
+
+def believed_fluent(type_name: str) -> Fluent:
+    """A fluent network that is True while the robot believes an object of `type_name` present
+    (None otherwise), re-evaluated after every look (the belief's ``updated`` pulse). The caller
+    must hold it while waiting (networks are held weakly)."""
+    network = Fluent(lambda: True if believed(type_name) is not None else None, name=f"{type_name} believed")
+    belief = _belief()
+    if belief is not None:
+        belief.updated.add_child(network)
+    return network
+
+
 def close_opened_containers() -> list[str]:
     """Close every container the robot believes open (from its last look); returns their
     names. A container that will not close is logged and left (its failure is not raised)."""
-    belief = getattr(current_robot(), "belief", None)
+    belief = _belief()
     environment = getattr(belief, "environment", None)
     if belief is None or environment is None:
         return []
@@ -120,24 +219,133 @@ def open_alone(container: str) -> Any:
     return perform(Open(container))
 
 
-def find(type_name: str) -> Any:
+@dataclass(frozen=True)
+class _SeenMeanwhile:
+    """What the belief branch of `find` returns: the object believed meanwhile."""
+
+    object: PerceivedObject
+
+
+def find(type_name: str, record: PlanRecord | None = None) -> PerceivedObject:
     """The believed object of `type_name`: from the belief, else searched for (open surfaces
-    first, then inside the drawers, one drawer open at a time)."""
-    return search_for(ObjectDesignator(type=type_name), open_container=open_alone)
+    first, then inside the drawers, one drawer open at a time).
+
+    The search runs under ``pursue`` with a wait on `believed_fluent`: as soon as any look --
+    the search's own, or one taken while driving -- makes the robot believe such an object,
+    the search is evaporated (its drive or look stops) and that object is the answer. Not while
+    the search opens or closes a drawer (an arm on a handle is not let go half way): the wait
+    fires once that is over. Raises `ObjectNotFound` (from the search) when the object is
+    neither found nor seen.
+    """
+    known = believed(type_name)
+    if known is not None:
+        return known
+    handling = Fluent(False, name="opening a drawer")
+
+    def open_a_drawer(container: str) -> Any:
+        handling.set_value(True)
+        try:
+            return open_alone(container)
+        finally:
+            handling.set_value(False)
+
+    seen = believed_fluent(type_name)
+    # True once the object is believed and no drawer is being handled
+    settled = Fluent(lambda: True if seen.get_value() and not handling.get_value() else None, name="seen, hands free")
+    seen.add_child(settled)
+    handling.add_child(settled)
+
+    def search() -> PerceivedObject:
+        found: PerceivedObject = search_for(ObjectDesignator(type=type_name), open_container=open_a_drawer)
+        return found
+
+    def until_believed() -> _SeenMeanwhile:
+        settled.wait_for()
+        obj = believed(type_name)
+        assert obj is not None  # believed objects are not forgotten between two looks
+        return _SeenMeanwhile(obj)
+
+    errors: list[BaseException] = []
+    state = pursue(search, until_believed, errors=errors, name=f"search for the {type_name}")
+    if state.get_value() is not State.SUCCEEDED:
+        raise errors[0] if errors else PlanFailure(f"the search for the {type_name} did not succeed")
+    result = state.result
+    if isinstance(result, _SeenMeanwhile):
+        log.info("set table: the search for the %s ended: %s is believed", type_name, result.object)
+        if record is not None:
+            record.note(record.searches_ended_by_belief, f"{type_name}: {result.object.name}")
+        return result.object
+    assert isinstance(result, PerceivedObject)
+    return result
+
+
+def look_for_the_next(wanted: Callable[[], list[str]], record: PlanRecord | None = None) -> None:
+    """Look along the open surfaces within the camera's range (`LOOK_RANGE` [m]) for objects
+    of the `wanted()` types the belief does not hold yet: nearest place first, each looked at
+    once; when every place in range has been looked at, wait until the base has moved
+    `RESCAN_DISTANCE`. Returns when every wanted type is believed. Runs alongside a drive
+    (`while_driving`): it points the head and detects, nothing else; a place the head cannot
+    turn to is skipped. Objects first seen here are noted in `record.found_while_driving`."""
+    belief = _belief()
+    environment = getattr(belief, "environment", None)
+    if belief is None or environment is None:
+        return
+    base = base_pose_fluent()
+    looked: set[str] = set()
+    while True:
+        types = [t for t in wanted() if believed(t) is None]
+        if not types:
+            return
+        here = base.get_value()
+        if here is None:
+            return
+        candidates = []
+        for type_name in types:
+            for lookout in lookouts(environment, type_name, (here.x, here.y)):
+                if lookout.container is not None or lookout.name in looked:
+                    continue
+                distance = math.dist((here.x, here.y), lookout.target[:2])
+                if distance <= LOOK_RANGE:
+                    candidates.append((distance, lookout.name, lookout))
+        if not candidates:
+            start = (here.x, here.y)
+            moved = Fluent(
+                lambda start=start: (
+                    True if math.dist(start, (base.get_value().x, base.get_value().y)) > RESCAN_DISTANCE else None
+                ),
+                name=f"moved {RESCAN_DISTANCE} m",
+            )
+            base.add_child(moved)
+            moved.wait_for()
+            looked.clear()
+            continue
+        _, _, lookout = min(candidates)
+        looked.add(lookout.name)
+        before = {o.name for o in belief.present()}
+        try:
+            motion(type="pointing_head", coordinates=list(lookout.target))
+            seen = motion(type="detecting")
+        except WORLD_FAILURES as failure:
+            log.info("set table: looking at %s while driving: %s", lookout.name, failure)
+            continue
+        for obj in seen:
+            if obj.type in types and obj.name not in before:
+                log.info("set table: saw %s on %s while driving", obj.name, lookout.surface)
+                if record is not None:
+                    record.note(record.found_while_driving, f"{obj.name} on {lookout.surface}")
 
 
 def look_from_elsewhere(type_name: str) -> None:
     """Look at the believed object of `type_name` from the named place of the environment
     nearest to it that the robot does not stand at: a pose perceived from one view (the object
     partly hidden, e.g. by the robot's own arm) is measured again from another. Best effort."""
-    belief = getattr(current_robot(), "belief", None)
+    belief = _belief()
     environment = getattr(belief, "environment", None)
     if belief is None or environment is None:
         return
-    believed = [o for o in belief.present() if o.type == type_name]
-    if not believed:
+    target = believed(type_name)
+    if target is None:
         return
-    target = believed[0]
     here = base_pose_fluent().get_value()
     places = [
         p.pose
@@ -155,13 +363,63 @@ def look_from_elsewhere(type_name: str) -> None:
         log.info("set table: looking at the %s from elsewhere: %s", type_name, failure)
 
 
-def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
-    """Transport rounds for one setting, each bounded by the time budget."""
+def _held(type_name: str) -> Held | None:
+    """What a gripper holds of `type_name` (from an earlier, interrupted round), if anything."""
+    return next((h for h in held_objects().values() if h.object.type == type_name), None)
+
+
+def _arms_to_spare() -> int:
+    """How many of the robot's arms hold nothing (from its description and `held_objects()`)."""
+    holding = held_objects()
+    return sum(1 for arm in arms() if arm not in holding)
+
+
+def _carry_two(found: PerceivedObject, outcome: SettingOutcome, partner: SettingOutcome, record: PlanRecord) -> Any:
+    """Pick up `found` (for `outcome`'s setting); with an arm to spare and `partner`'s object
+    believed, bring the partner's object with that arm (`Transport`, while this one is held);
+    then put this one at its setting. The partner's failure is noted in its outcome, not raised
+    (it gets its own turn). Raises this object's failures."""
+    setting, other = outcome.setting, partner.setting
+    held: Held = perform(PickUp(found))
+    free = [arm for arm in arms() if arm not in held_objects()]
+    partner_object = believed(other.type)
+    if free and partner_object is not None:
+        current_object.set_value(other.type)
+        log.info("set table: the %s in the %s arm; the %s with the %s arm", setting.type, held.arm, other.type, free[0])
+        try:
+            perform(Transport(partner_object, other.point, arm=free[0]))
+            partner.placed, partner.failure = True, None
+            record.note(record.carried_together, (setting.type, other.type))
+            objects_done.set_value(objects_done.get_value() + 1)
+        except WORLD_FAILURES as failure:
+            partner.failure = failure
+            partner.attempts.append(f"carried with the {setting.type}: {type(failure).__name__}: {failure}")
+            log.warning(
+                "set table: the %s with the %s: %s: %s", other.type, setting.type, type(failure).__name__, failure
+            )
+        finally:
+            current_object.set_value(setting.type)
+    try:
+        return perform(Place(held, setting.point, arm=held.arm))
+    except (ObjectSlipped, GripperEmpty) as error:  # taken or dropped on the way: fetch it again
+        log.info("set table: the %s was lost on the way (%s); fetching it again", setting.type, error)
+        return perform(Transport(ObjectDesignator(type=setting.type), setting.point))
+
+
+def _bring(outcome: SettingOutcome, partner: SettingOutcome | None, record: PlanRecord) -> None:
+    """Transport rounds for one setting, each bounded by the time budget; in the first round,
+    `partner` (the next setting) may be brought along with an arm to spare."""
+    setting = outcome.setting
     for round_number in range(1, ROUNDS + 1):
         errors: list[BaseException] = []
 
-        def transport() -> Any:
-            found = find(setting.type)
+        def transport(round_number: int = round_number) -> Any:
+            held = _held(setting.type)
+            if held is not None:  # still in a gripper after an interrupted round: put it down
+                return perform(Place(held, setting.point, arm=held.arm))
+            found = find(setting.type, record)
+            if round_number == 1 and partner is not None and not partner.placed and _arms_to_spare() >= 2:
+                return _carry_two(found, outcome, partner, record)
             return perform(Transport(found, setting.point))
 
         state = with_timeout(ROUND_TIME_BUDGET, transport, errors, name=f"bring the {setting.type}")
@@ -179,23 +437,34 @@ def _bring(setting: PlaceSetting, outcome: SettingOutcome) -> None:
             look_from_elsewhere(setting.type)  # perceived from one view only: measure it again
 
 
-def set_table(settings: list[PlaceSetting]) -> list[SettingOutcome]:
+def set_table(settings: list[PlaceSetting], record: PlanRecord | None = None) -> list[SettingOutcome]:
     """Bring every object of `settings` to its place; close the containers opened on the way.
 
-    Returns one `SettingOutcome` per setting, in order. Raises only for bugs (a failure of the
-    world is an outcome) and evaporation.
+    Every drive looks for the objects still to be brought (`look_for_the_next`); what the
+    concurrency did is noted in `record` when given. Returns one `SettingOutcome` per setting,
+    in order. Raises only for bugs (a failure of the world is an outcome) and evaporation.
     """
+    record = record if record is not None else PlanRecord()
     objects_done.set_value(0)
     outcomes = [SettingOutcome(s) for s in settings]
     perform(ParkArms())
     perform(MoveTorso("up"))
-    for outcome in outcomes:
-        current_object.set_value(outcome.setting.type)
-        log.info("set table: bringing the %s to %s", outcome.setting.type, outcome.setting.point)
-        _bring(outcome.setting, outcome)
-        current_object.set_value(None)
-        if outcome.placed:
-            objects_done.set_value(objects_done.get_value() + 1)
-        close_opened_containers()
-    close_opened_containers()  # a drawer that would not close is tried once more, from afresh
+
+    def still_wanted() -> list[str]:
+        holding = {h.object.type for h in held_objects().values()}
+        return [o.setting.type for o in outcomes if not o.placed and o.setting.type not in holding]
+
+    with while_driving(partial(look_for_the_next, still_wanted, record)):
+        for index, outcome in enumerate(outcomes):
+            if outcome.placed:  # brought along with the one before
+                continue
+            partner = next((o for o in outcomes[index + 1 :] if not o.placed), None)
+            current_object.set_value(outcome.setting.type)
+            log.info("set table: bringing the %s to %s", outcome.setting.type, outcome.setting.point)
+            _bring(outcome, partner, record)
+            current_object.set_value(None)
+            if outcome.placed:
+                objects_done.set_value(objects_done.get_value() + 1)
+            close_opened_containers()
+        close_opened_containers()  # a drawer that would not close is tried once more, from afresh
     return outcomes
