@@ -79,7 +79,6 @@ __all__ = [
     "set_table",
     "find",
     "believed",
-    "believed_fluent",
     "look_for_the_next",
     "close_opened_containers",
     "park_idle_arms",
@@ -143,16 +142,26 @@ class PlanRecord:
 
     * `found_while_driving`: objects first believed from a look taken while the base drove
       ("cup-1 on counter");
-    * `searches_ended_by_belief`: searches that `pursue` ended because the belief fluent said
-      the object is believed (the search itself had not returned it yet);
+    * `searches_ended_by_sighting`: searches that `pursue` ended because a look taken while
+      driving turned the object up before the search itself did ("plate: plate-1");
+    * `sightings`: a fluent holding the set of types seen while driving (what `find` waits on);
     * `carried_together`: (held, fetched) type pairs: the second object was brought with the
       free arm while the first was held.
     """
 
     found_while_driving: list[str] = field(default_factory=list)
-    searches_ended_by_belief: list[str] = field(default_factory=list)
+    searches_ended_by_sighting: list[str] = field(default_factory=list)
     carried_together: list[tuple[str, str]] = field(default_factory=list)
+    sightings: Fluent = field(
+        default_factory=lambda: Fluent(frozenset(), name="seen while driving"), repr=False, compare=False
+    )
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False, compare=False)
+
+    def sighted(self, obj: PerceivedObject, surface: str) -> None:
+        """A look taken while driving saw `obj` for the first time, on `surface`."""
+        with self._lock:
+            self.found_while_driving.append(f"{obj.name} on {surface}")
+            self.sightings.set_value(self.sightings.get_value() | {obj.type})
 
     def note(self, entries: list[Any], entry: Any) -> None:
         """Append `entry` to `entries` (one of this record's lists) under the record's lock."""
@@ -164,7 +173,7 @@ class PlanRecord:
         with self._lock:
             return {
                 "found_while_driving": list(self.found_while_driving),
-                "searches_ended_by_belief": list(self.searches_ended_by_belief),
+                "searches_ended_by_sighting": list(self.searches_ended_by_sighting),
                 "carried_together": [list(p) for p in self.carried_together],
             }
 
@@ -180,17 +189,6 @@ def believed(type_name: str) -> PerceivedObject | None:
     if belief is None:
         return None
     return next((o for o in belief.present() if o.type == type_name), None)
-
-
-def believed_fluent(type_name: str) -> Fluent:
-    """A fluent network that is True while the robot believes an object of `type_name` present
-    (None otherwise), re-evaluated after every look (the belief's ``updated`` pulse). The caller
-    must hold it while waiting (networks are held weakly)."""
-    network = Fluent(lambda: True if believed(type_name) is not None else None, name=f"{type_name} believed")
-    belief = _belief()
-    if belief is not None:
-        belief.updated.add_child(network)
-    return network
 
 
 def close_opened_containers() -> list[str]:
@@ -231,13 +229,15 @@ def find(type_name: str, record: PlanRecord | None = None) -> PerceivedObject:
     """The believed object of `type_name`: from the belief, else searched for (open surfaces
     first, then inside the drawers, one drawer open at a time).
 
-    The search runs under ``pursue`` with a wait on `believed_fluent`: as soon as any look --
-    the search's own, or one taken while driving -- makes the robot believe such an object,
-    the search is evaporated (its drive or look stops) and that object is the answer. Not while
-    the search opens or closes a drawer (an arm on a handle is not let go half way): the wait
-    fires once that is over. Raises `ObjectNotFound` (from the search) when the object is
-    neither found nor seen.
+    The search runs under ``pursue`` with a wait on the record's `PlanRecord.sightings`: as
+    soon as a look taken while driving (`look_for_the_next`, concurrent with the search's
+    drives) reports such an object, the search is evaporated (its drive or look stops) and
+    that object is the answer -- not while the search opens or closes a drawer (an arm on a
+    handle is not let go half way): then the wait fires once that is over. A search that finds
+    the object with its own look returns it as usual. Raises `ObjectNotFound` (from the search)
+    when the object is neither found nor seen.
     """
+    record = record if record is not None else PlanRecord()
     known = believed(type_name)
     if known is not None:
         return known
@@ -250,31 +250,35 @@ def find(type_name: str, record: PlanRecord | None = None) -> PerceivedObject:
         finally:
             handling.set_value(False)
 
-    seen = believed_fluent(type_name)
-    # True once the object is believed and no drawer is being handled
-    settled = Fluent(lambda: True if seen.get_value() and not handling.get_value() else None, name="seen, hands free")
-    seen.add_child(settled)
-    handling.add_child(settled)
+    sightings = record.sightings
+
+    def sighted() -> bool | None:
+        seen = type_name in sightings.get_value() and believed(type_name) is not None
+        return True if seen and not handling.get_value() else None
+
+    # True once driving turned the object up (and it is still believed) and no drawer is handled
+    turned_up = Fluent(sighted, name=f"{type_name} seen while driving, hands free")
+    sightings.add_child(turned_up)
+    handling.add_child(turned_up)
 
     def search() -> PerceivedObject:
         found: PerceivedObject = search_for(ObjectDesignator(type=type_name), open_container=open_a_drawer)
         return found
 
-    def until_believed() -> _SeenMeanwhile:
-        settled.wait_for()
+    def until_seen_while_driving() -> _SeenMeanwhile:
+        turned_up.wait_for()
         obj = believed(type_name)
-        assert obj is not None  # believed objects are not forgotten between two looks
+        assert obj is not None  # checked by the fluent; nothing else forgets objects meanwhile
         return _SeenMeanwhile(obj)
 
     errors: list[BaseException] = []
-    state = pursue(search, until_believed, errors=errors, name=f"search for the {type_name}")
+    state = pursue(search, until_seen_while_driving, errors=errors, name=f"search for the {type_name}")
     if state.get_value() is not State.SUCCEEDED:
         raise errors[0] if errors else PlanFailure(f"the search for the {type_name} did not succeed")
     result = state.result
     if isinstance(result, _SeenMeanwhile):
-        log.info("set table: the search for the %s ended: %s is believed", type_name, result.object)
-        if record is not None:
-            record.note(record.searches_ended_by_belief, f"{type_name}: {result.object.name}")
+        log.info("set table: the search for the %s ended: %s was seen while driving", type_name, result.object)
+        record.note(record.searches_ended_by_sighting, f"{type_name}: {result.object.name}")
         return result.object
     assert isinstance(result, PerceivedObject)
     return result
@@ -333,7 +337,7 @@ def look_for_the_next(wanted: Callable[[], list[str]], record: PlanRecord | None
             if obj.type in types and obj.name not in before:
                 log.info("set table: saw %s on %s while driving", obj.name, lookout.surface)
                 if record is not None:
-                    record.note(record.found_while_driving, f"{obj.name} on {lookout.surface}")
+                    record.sighted(obj, lookout.surface)
 
 
 def look_from_elsewhere(type_name: str) -> None:
