@@ -67,7 +67,7 @@ from pycram.designator import ObjectDesignator, perform
 from pycram.designators.core import DesignatorError
 from pycram.failures import GraspFailed, GripperEmpty, ObjectOutOfReach, ObjectSlipped, PlanFailure
 from pycram.fluent import Fluent
-from pycram.language import State, par, pursue, with_timeout
+from pycram.language import State, pursue, with_timeout
 from pycram.process_module import ProcessModuleError
 from pycram.robot import current_robot
 from pycram.world.belief import PerceivedObject
@@ -81,7 +81,6 @@ __all__ = [
     "believed",
     "look_for_the_next",
     "close_opened_containers",
-    "park_idle_arms",
     "ROUND_TIME_BUDGET",
     "ROUNDS",
     "RESCAN_DISTANCE",
@@ -103,8 +102,8 @@ ROUND_TIME_BUDGET = 300.0
 ELSEWHERE = 0.5
 #: Transport rounds per object (a second round after a failure a new search may fix).
 ROUNDS = 2
-#: Looking while driving: once every place in view range has been looked at, the next looks
-#: wait until the base has moved this far [m].
+#: Looking while driving: once every place in view range has been looked at, the next look
+#: waits until the base has moved this far [m] (places may have come into range).
 RESCAN_DISTANCE = 1.0
 
 #: The object type being brought now (None between objects), for people watching and for the
@@ -287,10 +286,11 @@ def find(type_name: str, record: PlanRecord | None = None) -> PerceivedObject:
 def look_for_the_next(wanted: Callable[[], list[str]], record: PlanRecord | None = None) -> None:
     """Look along the open surfaces within the camera's range (`LOOK_RANGE` [m]) for objects
     of the `wanted()` types the belief does not hold yet: nearest place first, each looked at
-    once; when every place in range has been looked at, wait until the base has moved
-    `RESCAN_DISTANCE`. Returns when every wanted type is believed. Runs alongside a drive
-    (`while_driving`): it points the head and detects, nothing else; a place the head cannot
-    turn to is skipped. Objects first seen here are noted in `record.found_while_driving`."""
+    once (per call: per drive); when every place in range has been looked at, wait until the
+    base has moved `RESCAN_DISTANCE` and look at the places come into range. Returns when
+    every wanted type is believed. Runs alongside a drive (`while_driving`): it points the head
+    and detects, nothing else; a place the head cannot turn to is skipped. Objects first seen
+    here are noted with `PlanRecord.sighted` (which `find` waits on)."""
     belief = _belief()
     environment = getattr(belief, "environment", None)
     if belief is None or environment is None:
@@ -322,7 +322,6 @@ def look_for_the_next(wanted: Callable[[], list[str]], record: PlanRecord | None
             )
             base.add_child(moved)
             moved.wait_for()
-            looked.clear()
             continue
         _, _, lookout = min(candidates)
         looked.add(lookout.name)
@@ -377,21 +376,6 @@ def _arms_to_spare() -> int:
     """How many of the robot's arms hold nothing (from its description and `held_objects()`)."""
     holding = held_objects()
     return sum(1 for arm in arms() if arm not in holding)
-
-
-def park_idle_arms() -> None:
-    """On a robot with more than one arm, move every arm that holds nothing to its ``park``
-    configuration (concurrently, `par`): an idle arm left up in ``carry`` sticks out ahead of
-    the base, where it knocks over objects the other arm goes for (measured: the milk carton,
-    PR2 seed 107). A one-armed robot keeps its arm up, ready for the next object. Best effort:
-    a failure is logged."""
-    idle = [arm for arm in arms() if arm not in held_objects()]
-    if len(arms()) < 2 or not idle:
-        return
-    errors: list[BaseException] = []
-    branches = [partial(motion, type="setting_arm_configuration", arm=arm, configuration="park") for arm in idle]
-    if par(*branches, errors=errors, name="park the idle arms").get_value() is not State.SUCCEEDED:
-        log.info("set table: parking the idle arms: %s", errors[0] if errors else "failed")
 
 
 def _carry_two(found: PerceivedObject, outcome: SettingOutcome, partner: SettingOutcome, record: PlanRecord) -> Any:
@@ -485,7 +469,6 @@ def set_table(settings: list[PlaceSetting], record: PlanRecord | None = None) ->
             current_object.set_value(None)
             if outcome.placed:
                 objects_done.set_value(objects_done.get_value() + 1)
-            park_idle_arms()
             close_opened_containers()
         close_opened_containers()  # a drawer that would not close is tried once more, from afresh
     return outcomes
