@@ -19,6 +19,8 @@ from pycram.environments import load as load_environment
 #: Seeds that set the whole table, measured (never the benchmark's seeds, 100-119), with the
 #: objects each robot brings: the TIAGo's top grasps of plates and bowls on the counter fail
 #: (see docs/set-table.md), so it sets the cup and the milk.
+#: Arms per robot (their descriptions' ARMS).
+ARMS = {"pr2": 2, "tiago": 1}
 END_TO_END = [("pr2", 2, OBJECTS), ("pr2", 4, OBJECTS), ("tiago", 2, ("cup", "milk")), ("tiago", 3, ("cup", "milk"))]
 
 
@@ -88,6 +90,11 @@ def test_the_table_is_set_end_to_end(robot, seed, objects):
     out = run_set_table(robot, seed, objects=objects)
     _assert_set(out, objects)
     assert out["robot"] == robot and out["seed"] == seed and out["faults"] == []
+    # the same plan file: the one-armed TIAGo carries one object at a time (simulator's truth)
+    held_at_once = out["concurrency"]["most_held_at_once"]
+    assert 1 <= len(held_at_once) <= ARMS[robot], held_at_once
+    if robot == "tiago":
+        assert out["concurrency"]["carried_together"] == []
 
 
 @pytest.mark.timeout(400)
@@ -194,3 +201,22 @@ def test_a_search_is_ended_by_pursue_when_a_look_while_driving_turns_the_object_
         (search,) = tasks_named(root, "search for the cup")
         assert _statuses(search) == {"search": "EVAPORATED", "until_seen_while_driving": "SUCCEEDED"}
         assert tasks_named(search, "drive, looking around")  # the search was driving when it ended
+
+
+@pytest.mark.timeout(400)
+def test_the_pr2_carries_two_objects_at_once_and_looks_for_the_next_while_driving():
+    """PR2, seed 2 (measured): after picking one object it brings the next with its free arm,
+    both held at once (the simulator's truth), and the looks taken while driving find objects
+    the belief did not hold. Every drive ran with its look alongside, ended with the drive."""
+    from action_helpers import tasks_named
+
+    result, task = set_table.run_scenario("pr2", 2)
+    assert result.success, result.summary()
+    concurrency = result.concurrency
+    assert len(concurrency["most_held_at_once"]) == 2, concurrency
+    assert concurrency["carried_together"], concurrency
+    assert set(concurrency["most_held_at_once"]) in [set(pair) for pair in concurrency["carried_together"]]
+    assert concurrency["found_while_driving"], concurrency
+    drives = tasks_named(task, "drive, looking around")
+    assert drives
+    assert all(_statuses(drive)["look_while_driving"] == "EVAPORATED" for drive in drives)
