@@ -363,20 +363,28 @@ class Faults:
 
     def _free_counter_spot(self, name: str, near: tuple[float, float] | None = None) -> tuple[float, float, float]:
         """A spot [m] for `name` standing upright in its counter start region, clear of every
-        object (and at least 0.15 m from `near`, within 0.6 m of it, when given)."""
+        object standing around (objects in a gripper do not count) by 0.4 m if possible, else
+        the clearest spot tried (and at least 0.15 m from `near`, within 0.6 m of it, when
+        given)."""
         from pycram.world.objects import object_type
 
         surface = self.world.environment.surface("counter")
         x0, y0, x1, y1 = START_REGIONS[name]["counter"]
-        poses = self.world.item_poses.get_value()
+        held = self._holding()
+        poses = {n: p for n, p in self.world.item_poses.get_value().items() if n != name and n not in held}
         z = surface.height + object_type(name).half_height + 0.002
+        best: tuple[float, float, float] | None = None
         for _ in range(300):
             x, y = self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)
             if near is not None and not 0.15 < math.hypot(x - near[0], y - near[1]) < 0.6:
                 continue
-            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.4 for n, p in poses.items()):
-                continue
-            return (x, y, z)
+            clearance = min((math.hypot(p.position[0] - x, p.position[1] - y) for p in poses.values()), default=9.0)
+            if clearance >= 0.4:
+                return (x, y, z)
+            if best is None or clearance > best[0]:
+                best = (clearance, x, y)
+        if best is not None:  # no spot 0.4 m clear: the clearest one (never one next to an object)
+            return (best[1], best[2], z)
         return ((x0 + x1) / 2, (y0 + y1) / 2, z)
 
     def _move_object(self) -> None:
@@ -477,9 +485,7 @@ class _HeldAtOnce:
         self._handles = [s.on_change(self._changed) for s in world.gripper_states.values()]
 
     def _changed(self, _: Any) -> None:
-        holding = sorted(
-            {s.get_value().holding for s in self.world.gripper_states.values()} - {None}
-        )
+        holding = sorted({s.get_value().holding for s in self.world.gripper_states.values()} - {None})
         with self._lock:
             if len(holding) > len(self.most):
                 self.most = holding

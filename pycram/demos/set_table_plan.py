@@ -15,8 +15,10 @@ For each place setting, in order:
   recoveries inside (next standing pose, perceiving again, searching again when the object was
   taken). When the robot has an arm to spare once it holds this object (from its description
   and `held_objects()`: the PR2, never the one-armed TIAGo) and the next object is believed, it
-  picks this one up, brings the next one with the free arm (``Transport(next, arm=free)``),
-  and then puts this one down: two objects carried at once, one trip to the table fewer;
+  picks this one up, picks the next one up with the free arm (``PickUp(next, arm=free)``,
+  abandoned by ``pursue`` as soon as the next one is believed gone: no searching with full
+  hands) and puts it at its setting, then puts this one down: two objects carried at once,
+  one trip to the table fewer;
 * each round runs under `with_timeout` (a budget of simulated time), with one more round for
   the failures that a second look may fix (the object was moved, missed by perception, a
   drawer was stuck and is free now);
@@ -65,7 +67,14 @@ from pycram.actions.core import arms, base_pose_fluent, motion, while_driving
 from pycram.actions.search import LOOK_RANGE
 from pycram.designator import ObjectDesignator, perform
 from pycram.designators.core import DesignatorError
-from pycram.failures import GraspFailed, GripperEmpty, ObjectOutOfReach, ObjectSlipped, PlanFailure
+from pycram.failures import (
+    GraspFailed,
+    GripperEmpty,
+    ObjectNotVisible,
+    ObjectOutOfReach,
+    ObjectSlipped,
+    PlanFailure,
+)
 from pycram.fluent import Fluent
 from pycram.language import State, pursue, with_timeout
 from pycram.process_module import ProcessModuleError
@@ -378,11 +387,42 @@ def _arms_to_spare() -> int:
     return sum(1 for arm in arms() if arm not in holding)
 
 
+def _bring_along(partner_object: PerceivedObject, arm: str, other: PlaceSetting) -> None:
+    """Pick up `partner_object` with `arm` and put it at `other`'s point, while the other arm
+    holds an object. The pick-up runs under ``pursue`` with a watch on the belief: as soon as
+    the object is believed gone from where it was seen (a person took it, it was moved out of
+    sight), the pick-up is evaporated -- before it would search for the object, opening drawers
+    with an object in the other hand -- and `ObjectNotVisible` is raised. Raises what
+    `PickUp` and `Place` raise."""
+    lost = Fluent(lambda: True if partner_object.gone else None, name=f"{partner_object.name} gone")
+    belief = _belief()
+    if belief is not None:
+        belief.updated.add_child(lost)
+
+    def pick_up() -> Held:
+        picked: Held = perform(PickUp(partner_object, arm=arm))
+        return picked
+
+    def until_gone() -> None:
+        lost.wait_for()
+        raise ObjectNotVisible(
+            f"{partner_object.name} is no longer where it was seen: left for its own turn", partner_object, "lost"
+        )
+
+    errors: list[BaseException] = []
+    state = pursue(pick_up, until_gone, errors=errors, name=f"pick up the {other.type} too")
+    if state.get_value() is not State.SUCCEEDED:
+        raise errors[0] if errors else PlanFailure(f"picking up the {other.type} too did not succeed")
+    held: Held = state.result
+    perform(Place(held, other.point, arm=held.arm))
+
+
 def _carry_two(found: PerceivedObject, outcome: SettingOutcome, partner: SettingOutcome, record: PlanRecord) -> Any:
     """Pick up `found` (for `outcome`'s setting); with an arm to spare and `partner`'s object
-    believed, bring the partner's object with that arm (`Transport`, while this one is held);
+    believed, bring the partner's object with that arm while this one is held (`_bring_along`);
     then put this one at its setting. The partner's failure is noted in its outcome, not raised
-    (it gets its own turn). Raises this object's failures."""
+    (it gets its own turn; an object left in its gripper is put down then). Raises this
+    object's failures."""
     setting, other = outcome.setting, partner.setting
     held: Held = perform(PickUp(found))
     free = [arm for arm in arms() if arm not in held_objects()]
@@ -391,7 +431,7 @@ def _carry_two(found: PerceivedObject, outcome: SettingOutcome, partner: Setting
         current_object.set_value(other.type)
         log.info("set table: the %s in the %s arm; the %s with the %s arm", setting.type, held.arm, other.type, free[0])
         try:
-            perform(Transport(partner_object, other.point, arm=free[0]))
+            _bring_along(partner_object, free[0], other)
             partner.placed, partner.failure = True, None
             record.note(record.carried_together, (setting.type, other.type))
             objects_done.set_value(objects_done.get_value() + 1)
