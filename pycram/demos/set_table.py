@@ -707,7 +707,10 @@ def run_set_table(
     `objects`: the object types to bring (a subset of `OBJECTS`, in that order). Returns
     a JSON-serialisable dict: ``success``, ``objects`` (per object: ``placed``, ``failure`` (a
     failure type's name or None), ``reason``), ``failure_causes``, ``sim_time`` [s],
-    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``.
+    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``, and
+    ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
+    driving, searches ended by a sighting, objects carried together) and
+    ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
     Raises `ValueError` for an unknown robot or fault name.
     """
     import os
