@@ -343,9 +343,10 @@ def look_for_the_next(wanted: Callable[[], list[str]], record: PlanRecord | None
             continue
         for obj in seen:
             if obj.type in types and obj.name not in before:
-                log.info("set table: saw %s on %s while driving", obj.name, lookout.surface)
+                surface = str(obj.properties.get("on") or "an unknown surface")  # perceived support
+                log.info("set table: saw %s on %s while driving (looking at %s)", obj.name, surface, lookout.name)
                 if record is not None:
-                    record.sighted(obj, lookout.surface)
+                    record.sighted(obj, surface)
 
 
 def look_from_elsewhere(type_name: str) -> None:
