@@ -208,15 +208,16 @@ def believed(type_name: str) -> PerceivedObject | None:
 
 
 def close_opened_containers() -> list[str]:
-    """Close every container the robot believes open (from its last look); returns their
-    names. A container that will not close is logged and left (its failure is not raised)."""
+    """Close every drawer and door the robot believes open (from its last look); returns their
+    names. A container that will not close is logged and left (its failure is not raised).
+    (Doors: the search opens the fridge to look inside, on a robot that opens doors.)"""
     belief = _belief()
     environment = getattr(belief, "environment", None)
     if belief is None or environment is None:
         return []
     closed = []
     for container in environment.containers:
-        if container.kind != "drawer" or belief.container_open(container.name) is not True:
+        if container.kind not in ("drawer", "door") or belief.container_open(container.name) is not True:
             continue
         try:
             perform(Close(container.name))
