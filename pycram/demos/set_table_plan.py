@@ -116,9 +116,6 @@ ROUNDS = 2
 #: waits until the base has moved this far [m] (places may have come into range).
 RESCAN_DISTANCE = 1.0
 
-#: The arm configuration (named in every robot description) an object is held in while the
-#: other arm fetches a second one.
-TUCKED = "park"
 #: Carrying one object to fetch a second: no other object may stand closer than this [m] to
 #: the way between the two (the held object sweeps over the furniture's front).
 CARRY_CLEARANCE = 0.5
@@ -397,7 +394,7 @@ def _arms_to_spare() -> int:
     return sum(1 for arm in arms() if arm not in holding)
 
 
-def _bring_along(partner_object: PerceivedObject, arm: str, other: PlaceSetting, holding: Held) -> None:
+def _bring_along(partner_object: PerceivedObject, arm: str, other: PlaceSetting) -> None:
     """Pick up `partner_object` with `arm` and put it at `other`'s point, while the other arm
     holds an object. The pick-up runs under ``pursue`` with a watch on the belief: as soon as
     the object is believed gone from where it was seen (a person took it, it was moved out of
@@ -420,13 +417,7 @@ def _bring_along(partner_object: PerceivedObject, arm: str, other: PlaceSetting,
         )
 
     errors: list[BaseException] = []
-    # the held object tucked in while the other arm fetches: up in carry it sticks out ahead,
-    # over the object the other arm goes for
-    motion(type="setting_arm_configuration", arm=holding.arm, configuration=TUCKED)
-    try:
-        state = pursue(pick_up, until_gone, errors=errors, name=f"pick up the {other.type} too")
-    finally:
-        motion(type="setting_arm_configuration", arm=holding.arm, configuration="carry")
+    state = pursue(pick_up, until_gone, errors=errors, name=f"pick up the {other.type} too")
     if state.get_value() is not State.SUCCEEDED:
         raise errors[0] if errors else PlanFailure(f"picking up the {other.type} too did not succeed")
     held: Held = state.result
@@ -480,7 +471,7 @@ def _carry_two(
         current_object.set_value(other.type)
         log.info("set table: the %s in the %s arm; the %s with the %s arm", setting.type, held.arm, other.type, free[0])
         try:
-            _bring_along(partner_object, free[0], other, held)
+            _bring_along(partner_object, free[0], other)
             partner.placed, partner.failure = True, None
             record.note(record.carried_together, (setting.type, other.type))
             objects_done.set_value(objects_done.get_value() + 1)
