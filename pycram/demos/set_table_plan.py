@@ -10,20 +10,20 @@ For each place setting, in order:
 
 * the object is found: from the belief, else searched for (``search_for``: open surfaces first,
   then inside the drawers, one drawer open at a time) -- under ``pursue`` with a wait on a
-  fluent of the belief, so the search ends as soon as the object is believed, whoever saw it;
+  fluent that the looks taken while driving set, so the search ends as soon as one of them
+  sees the object;
 * it is brought: ``Transport(found, point)`` -- pick up, place, with the action library's
   recoveries inside (next standing pose, perceiving again, searching again when the object was
   taken). When the robot has an arm to spare once it holds this object (from its description
-  and `held_objects()`: the PR2, never the one-armed TIAGo) and the next object is believed, it
-  and no other object stands near the way to it, picks this one up, picks the next one up
-  with the free arm (``PickUp(next, arm=free)``,
-  abandoned by ``pursue`` as soon as the next one is believed gone: no searching with full
-  hands) and puts it at its setting, then puts this one down: two objects carried at once,
-  one trip to the table fewer;
+  and `held_objects()`: the PR2, never the one-armed TIAGo), the next object is believed and
+  no other object stands near the way to it, the robot picks this one up, picks the next one
+  up with the free arm (``PickUp(next, arm=free)``, abandoned by ``pursue`` as soon as the
+  next one is believed gone: no searching with full hands) and puts it at its setting, then
+  puts this one down: two objects carried at once, one trip to the table fewer;
 * each round runs under `with_timeout` (a budget of simulated time), with one more round for
   the failures that a second look may fix (the object was moved, missed by perception, a
   drawer was stuck and is free now);
-* afterwards, with empty hands, every container the robot believes open is closed again
+* afterwards, with empty hands, every drawer and door the robot believes open is closed again
   (`Close`), so no drawer is left sticking out into the room.
 
 Throughout, every drive of the action library has a companion (`while_driving`): the head looks
@@ -437,8 +437,8 @@ def _clear_to_carry(first: PerceivedObject, second: PerceivedObject, others: lis
     """Whether the robot may go from `first` to `second` with `first` in its hand: no believed
     object of the `others` types (still to be brought) stands within `CARRY_CLEARANCE` of the
     way between them. A held object sticks out ahead of the base over the furniture's front,
-    where it sweeps over what stands there (measured: a milk carton knocked over, PR2 seeds 107
-    and 115)."""
+    where it sweeps over what stands there (measured: a milk carton knocked over, PR2 seed
+    107)."""
     belief = _belief()
     if belief is None or first.pose is None or second.pose is None:
         return False
@@ -457,12 +457,11 @@ def _carry_two(
     record: PlanRecord,
     still_wanted: Callable[[], list[str]],
 ) -> Any:
-    """Pick up `found` (for `outcome`'s setting); with an arm to spare and `partner`'s object
+    """Pick up `found` (for `outcome`'s setting); with an arm to spare, `partner`'s object
     believed and the way to it clear (`_clear_to_carry`), bring the partner's object with that
-    arm while this one is held (`_bring_along`);
-    then put this one at its setting. The partner's failure is noted in its outcome, not raised
-    (it gets its own turn; an object left in its gripper is put down then). Raises this
-    object's failures."""
+    arm while this one is held (`_bring_along`); then put this one at its setting. The
+    partner's failure is noted in its outcome, not raised (it gets its own turn; an object left
+    in its gripper is put down then). Raises this object's failures."""
     setting, other = outcome.setting, partner.setting
     held: Held = perform(PickUp(found))
     free = [arm for arm in arms() if arm not in held_objects()]
