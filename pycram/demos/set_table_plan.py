@@ -81,6 +81,7 @@ from pycram.language import State, pursue, with_timeout
 from pycram.process_module import ProcessModuleError
 from pycram.robot import current_robot
 from pycram.world.belief import PerceivedObject
+from pycram.world.objects import object_type
 
 __all__ = [
     "PlaceSetting",
@@ -94,6 +95,8 @@ __all__ = [
     "ROUND_TIME_BUDGET",
     "ROUNDS",
     "RESCAN_DISTANCE",
+    "CARRY_CLEARANCE",
+    "CARRY_ALONG_HEIGHT",
     "current_object",
     "WORLD_FAILURES",
     "objects_done",
@@ -116,6 +119,10 @@ ROUNDS = 2
 #: waits until the base has moved this far [m] (places may have come into range).
 RESCAN_DISTANCE = 1.0
 
+#: Carrying one object to fetch a second: the second may be at most this tall [m] (the held
+#: object sticks out ahead over the furniture's front and knocked a 0.2 m milk carton over as
+#: the other arm reached for it: PR2 seeds 112, 115, 117 of 100-123).
+CARRY_ALONG_HEIGHT = 0.12
 #: Carrying one object to fetch a second: no other object may stand closer than this [m] to
 #: the way between the two (the held object sweeps over the furniture's front).
 CARRY_CLEARANCE = 0.5
@@ -434,14 +441,16 @@ def _segment_distance(p: tuple[float, float], a: tuple[float, float], b: tuple[f
 
 
 def _clear_to_carry(first: PerceivedObject, second: PerceivedObject, others: list[str]) -> bool:
-    """Whether the robot may go from `first` to `second` with `first` in its hand: no believed
-    object of the `others` types (still to be brought) stands within `CARRY_CLEARANCE` of the
-    way between them. A held object sticks out ahead of the base over the furniture's front,
-    where it sweeps over what stands there (measured: a milk carton knocked over, PR2 seed
-    107)."""
+    """Whether the robot may go from `first` to `second` with `first` in its hand: `second` is
+    no taller than `CARRY_ALONG_HEIGHT`, and no believed object of the `others` types (still to
+    be brought) stands within `CARRY_CLEARANCE` of the way between them. A held object sticks
+    out ahead of the base over the furniture's front, where it sweeps over what stands there
+    (measured: milk cartons knocked over, PR2 seeds 107, 112, 115, 117)."""
     belief = _belief()
     if belief is None or first.pose is None or second.pose is None:
         return False
+    if 2 * object_type(second.type).half_height > CARRY_ALONG_HEIGHT:
+        return False  # the held object sweeps over it where the other arm reaches for it
     a, b = (first.pose[0], first.pose[1]), (second.pose[0], second.pose[1])
     for obj in belief.present():
         if obj.type in others and obj is not first and obj is not second and obj.pose is not None:
