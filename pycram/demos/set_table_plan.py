@@ -15,8 +15,9 @@ For each place setting, in order:
 * it is brought: ``Transport(found, point)`` -- pick up, place, with the action library's
   recoveries inside (next standing pose, perceiving again, searching again when the object was
   taken). When the robot has an arm to spare once it holds this object (from its description
-  and `held_objects()`: the PR2, never the one-armed TIAGo), the next object is believed and
-  no other object stands near the way to it, the robot picks this one up, picks the next one
+  and `held_objects()`: the PR2, never the one-armed TIAGo), the next object is believed, low
+  (`CARRY_ALONG_HEIGHT`) and no other object stands near the way to it (`CARRY_CLEARANCE`),
+  the robot picks this one up, picks the next one
   up with the free arm (``PickUp(next, arm=free)``, abandoned by ``pursue`` as soon as the
   next one is believed gone: no searching with full hands) and puts it at its setting, then
   puts this one down: two objects carried at once, one trip to the table fewer;
