@@ -18,6 +18,11 @@ The helpers below are what the action plans share: the active robot's arms and g
 its description: data, never code of a robot package), motions by keyword, a gripper's measured
 opening, unwrapping a process module's failure into the typed failure it carries, and running
 one attempt of an action as a task of its own so that the task tree shows every recovery.
+
+A plan may give the drives of the action library a companion (`while_driving`): within its
+block, every drive (a ``moving`` motion in the map frame, through `motion`) runs as
+``pursue(drive, job)``, so a plan can look around while any action drives -- the head is free
+then -- without the actions knowing about it.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from __future__ import annotations
 import logging
 import weakref
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
@@ -33,8 +39,10 @@ from pycram.designators.motion import MotionDesignator
 from pycram.designators.perform import perform
 from pycram.failures import PlanFailure
 from pycram.fluent import Fluent
+from pycram.language import State, pursue
 from pycram.process_module import ProcessModuleError, ProcessModuleFailure
 from pycram.robot import current_robot
+from pycram.runtime.task_variables import TaskVariable
 
 __all__ = [
     "ACTION_PLANS",
@@ -44,6 +52,7 @@ __all__ = [
     "make_action",
     "resolve_action",
     "motion",
+    "while_driving",
     "arms",
     "arm_name",
     "gripper_of",
@@ -100,9 +109,53 @@ def resolve_action(designator: ActionDesignator) -> Any:
     return ACTION_PLANS.get(designator.prop_value("type"))
 
 
+#: The job bound by `while_driving` (None: drives run alone).
+_DRIVING_JOB: TaskVariable[Callable[[], Any] | None] = TaskVariable("while_driving", default=None)
+
+
+@contextmanager
+def while_driving(job: Callable[[], Any]) -> Iterator[None]:
+    """Within the block (in the calling task and every task it starts), each drive of the base
+    through `motion` -- a ``moving`` motion in the map frame, i.e. without a ``frame`` -- runs
+    as ``pursue(drive, job)``: `job` starts with the drive and is evaporated as soon as the
+    drive ends (its ``finally`` blocks run; a head motion it started is cancelled), so the drive
+    returns, or raises its own failure, exactly as it would alone. `job` may return early (the
+    drive then goes on alone); its recoverable failures (`RECOVERABLE`) are logged, never
+    raised. `job` must use only what a drive leaves free (the head, perception): it must not
+    drive (drives inside it run without a companion) or move an arm."""
+    with _DRIVING_JOB.bound(job):
+        yield
+
+
+def _companion(job: Callable[[], Any]) -> Callable[[], None]:
+    def look_while_driving() -> None:
+        with _DRIVING_JOB.bound(None):  # no companion for the companion's own motions
+            try:
+                job()
+            except RECOVERABLE as error:
+                log.info("while driving: %s", unwrap(error))
+            Fluent(None, name="until the drive ends").wait_for()  # evaporated when the drive ends
+
+    return look_while_driving
+
+
 def motion(**properties: Any) -> Any:
-    """Perform a motion designator made of `properties`; return the process module's result."""
-    return perform(MotionDesignator(**properties))
+    """Perform a motion designator made of `properties`; return the process module's result.
+
+    A drive (``type='moving'`` without ``frame``) inside a `while_driving` block runs with that
+    block's job alongside (``pursue``); it raises what the drive alone raises."""
+    job = _DRIVING_JOB.get()
+    if job is None or properties.get("type") != "moving" or "frame" in properties:
+        return perform(MotionDesignator(**properties))
+    errors: list[BaseException] = []
+
+    def drive() -> Any:
+        return perform(MotionDesignator(**properties))
+
+    state = pursue(drive, _companion(job), errors=errors, name="drive, looking around")
+    if state.get_value() is not State.SUCCEEDED:
+        raise errors[0] if errors else PlanFailure(f"the drive to {properties.get('pose')!r} did not succeed")
+    return state.result
 
 
 def _description() -> Any:

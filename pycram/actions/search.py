@@ -46,6 +46,8 @@ from pycram.world.belief import BeliefState, PerceivedObject
 from pycram.world.environment import Environment, Surface
 from pycram.world.objects import OBJECT_TYPES
 
+from .core import motion
+
 __all__ = ["Lookout", "lookouts", "look_around", "search_for", "LOOK_RANGE", "STANDOFF", "STAND_CLEARANCE"]
 
 logger = logging.getLogger(__name__)
@@ -322,7 +324,7 @@ def _visit(
         skipped[lookout.name] = f"{container} is closed"
         return None
     try:
-        perform(MotionDesignator(type="moving", pose=lookout.stand))
+        motion(type="moving", pose=lookout.stand)  # a drive: with the plan's `while_driving` job, if any
     except _FAILURES as failure:
         skipped[lookout.name] = f"could not get there: {failure}"
         return None

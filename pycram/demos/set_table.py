@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from pycram.demos.set_table_plan import PlaceSetting, SettingOutcome
+from pycram.demos.set_table_plan import PlaceSetting, PlanRecord, SettingOutcome
 
 __all__ = [
     "OBJECTS",
@@ -192,6 +192,9 @@ class SetTableResult:
     wall_time: float = 0.0
     faults_injected: list[str] = field(default_factory=list)
     error: str | None = None  # what stopped the plan as a whole (a time limit, a bug), if anything
+    #: What the plan's concurrency did (`PlanRecord.as_dict`), and -- measured with the
+    #: simulator's truth -- the most objects the robot's grippers held at the same time.
+    concurrency: dict[str, Any] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -237,6 +240,7 @@ class SetTableResult:
             "wall_time": self.wall_time,
             "error": self.error,
             "summary": self.summary(),
+            "concurrency": dict(self.concurrency),
         }
 
 
@@ -360,20 +364,28 @@ class Faults:
 
     def _free_counter_spot(self, name: str, near: tuple[float, float] | None = None) -> tuple[float, float, float]:
         """A spot [m] for `name` standing upright in its counter start region, clear of every
-        object (and at least 0.15 m from `near`, within 0.6 m of it, when given)."""
+        object standing around (objects in a gripper do not count) by 0.4 m if possible, else
+        the clearest spot tried (and at least 0.15 m from `near`, within 0.6 m of it, when
+        given)."""
         from pycram.world.objects import object_type
 
         surface = self.world.environment.surface("counter")
         x0, y0, x1, y1 = START_REGIONS[name]["counter"]
-        poses = self.world.item_poses.get_value()
+        held = self._holding()
+        poses = {n: p for n, p in self.world.item_poses.get_value().items() if n != name and n not in held}
         z = surface.height + object_type(name).half_height + 0.002
+        best: tuple[float, float, float] | None = None
         for _ in range(300):
             x, y = self.rng.uniform(x0, x1), self.rng.uniform(y0, y1)
             if near is not None and not 0.15 < math.hypot(x - near[0], y - near[1]) < 0.6:
                 continue
-            if any(n != name and math.hypot(p.position[0] - x, p.position[1] - y) < 0.4 for n, p in poses.items()):
-                continue
-            return (x, y, z)
+            clearance = min((math.hypot(p.position[0] - x, p.position[1] - y) for p in poses.values()), default=9.0)
+            if clearance >= 0.4:
+                return (x, y, z)
+            if best is None or clearance > best[0]:
+                best = (clearance, x, y)
+        if best is not None:  # no spot 0.4 m clear: the clearest one (never one next to an object)
+            return (best[1], best[2], z)
         return ((x0 + x1) / 2, (y0 + y1) / 2, z)
 
     def _move_object(self) -> None:
@@ -463,11 +475,33 @@ class Faults:
 # -- running ---------------------------------------------------------------------------------------
 
 
+class _HeldAtOnce:
+    """Measures, with the simulator's truth (for judging, never for the plan), the most objects
+    the robot's grippers held at the same time, and which."""
+
+    def __init__(self, world: Any) -> None:
+        self.world = world
+        self.most: list[str] = []
+        self._lock = threading.Lock()
+        self._handles = [s.on_change(self._changed) for s in world.gripper_states.values()]
+
+    def _changed(self, _: Any) -> None:
+        holding = sorted({s.get_value().holding for s in self.world.gripper_states.values()} - {None})
+        with self._lock:
+            if len(holding) > len(self.most):
+                self.most = holding
+
+    def stop(self) -> None:
+        for handle in self._handles:
+            handle.remove()
+
+
 class _PlanThread:
     """The plan in a thread of its own (a task tree root), so the driver can watch time limits."""
 
     def __init__(self, robot: Any, settings: list[PlaceSetting]) -> None:
         self.robot, self.settings = robot, settings
+        self.record = PlanRecord()
         self.task: Any = None
         self.error: BaseException | None = None
         self.outcomes: list[SettingOutcome] | None = None
@@ -480,7 +514,7 @@ class _PlanThread:
         def whole_plan() -> Any:
             self.task = current_task()
             with self.robot:
-                self.outcomes = set_table(self.settings)
+                self.outcomes = set_table(self.settings, self.record)
 
         try:
             run_subtask("set_table", whole_plan, kind="plan")
@@ -607,6 +641,7 @@ def run_scenario(
             if animation:
                 world.start_recording(camera, fps=4.0, width=480, height=360, caption=_caption)
         injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
+        held_at_once = _HeldAtOnce(world)
         plan = _PlanThread(robot_handle, settings)
         sim_start = world.sim_time.get_value()
         injector.start()
@@ -624,6 +659,8 @@ def run_scenario(
                 plan.stop()
                 break
         injector.stop()
+        held_at_once.stop()
+        result.concurrency = {**plan.record.as_dict(), "most_held_at_once": held_at_once.most}
         result.sim_time = world.sim_time.get_value() - sim_start
         if plan.error is not None and result.error is None:
             result.error = f"{type(plan.error).__name__}: {plan.error}"
@@ -671,7 +708,10 @@ def run_set_table(
     `objects`: the object types to bring (a subset of `OBJECTS`, in that order). Returns
     a JSON-serialisable dict: ``success``, ``objects`` (per object: ``placed``, ``failure`` (a
     failure type's name or None), ``reason``), ``failure_causes``, ``sim_time`` [s],
-    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``.
+    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``, and
+    ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
+    driving, searches ended by a sighting, objects carried together) and
+    ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
     Raises `ValueError` for an unknown robot or fault name.
     """
     import os

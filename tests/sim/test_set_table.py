@@ -19,6 +19,8 @@ from pycram.environments import load as load_environment
 #: Seeds that set the whole table, measured (never the benchmark's seeds, 100-119), with the
 #: objects each robot brings: the TIAGo's top grasps of plates and bowls on the counter fail
 #: (see docs/set-table.md), so it sets the cup and the milk.
+#: Arms per robot (their descriptions' ARMS).
+ARMS = {"pr2": 2, "tiago": 1}
 END_TO_END = [("pr2", 2, OBJECTS), ("pr2", 4, OBJECTS), ("tiago", 2, ("cup", "milk")), ("tiago", 3, ("cup", "milk"))]
 
 
@@ -88,6 +90,11 @@ def test_the_table_is_set_end_to_end(robot, seed, objects):
     out = run_set_table(robot, seed, objects=objects)
     _assert_set(out, objects)
     assert out["robot"] == robot and out["seed"] == seed and out["faults"] == []
+    # the same plan file: the one-armed TIAGo carries one object at a time (simulator's truth)
+    held_at_once = out["concurrency"]["most_held_at_once"]
+    assert 1 <= len(held_at_once) <= ARMS[robot], held_at_once
+    if robot == "tiago":
+        assert out["concurrency"]["carried_together"] == []
 
 
 @pytest.mark.timeout(400)
@@ -111,3 +118,105 @@ def test_a_run_for_the_experiment_runner_is_recorded_with_pictures(tmp_path, mon
     assert out["run_id"] is not None
     assert (tmp_path / "output" / "set-table-tiago-2" / "end.png").exists()
     assert any(str(r.id) == str(out["run_id"]) for r in query.runs(url=url))
+
+
+# -- concurrency where a person would (issue 17) ----------------------------------------------------
+#
+# Fixed seeds and scenes, not the benchmark's seeds; judged with the simulator's truth and the
+# task tree the plan left.
+
+
+def _statuses(task) -> dict[str, str]:
+    """A task's children by name (without the branch number, "1:drive" -> "drive") -> status."""
+    return {str(child.name).split(":", 1)[-1]: child.status.get_value().name for child in task.children}
+
+
+@pytest.mark.timeout(120)
+def test_while_driving_runs_the_job_alongside_each_drive_and_ends_it_with_the_drive():
+    from action_helpers import COUNTER, apartment_with, run_as_task, tasks_named
+
+    from pycram.actions import Navigate
+    from pycram.actions.core import while_driving
+    from pycram.designator import perform
+    from pycram.failures import PlanFailure
+    from pycram.fluent import Fluent
+
+    with apartment_with("pr2", {"cup": COUNTER}) as (world, robot):
+        started, ended = [], []
+
+        def job() -> None:
+            started.append(world.base_pose.get_value())
+            try:
+                Fluent(None).wait_for()  # never set: only the end of the drive stops it
+            finally:
+                ended.append(world.base_pose.get_value())
+
+        def failing_job() -> None:
+            raise PlanFailure("a look that fails")
+
+        def body():
+            with while_driving(job):
+                first = perform(Navigate((3.0, 1.2, 0.0)))
+            with while_driving(failing_job):  # the job's failure is not the drive's
+                second = perform(Navigate((2.6, 1.2, 0.0)))
+            third = perform(Navigate((2.2, 1.2, 0.0)))  # outside the block: alone
+            return first, second, third
+
+        (first, second, third), root = run_as_task(body)
+        assert math.hypot(first.x - 3.0, first.y - 1.2) < 0.05
+        assert math.hypot(second.x - 2.6, second.y - 1.2) < 0.05 and math.hypot(third.x - 2.2, third.y - 1.2) < 0.05
+        assert len(started) == 1 and len(ended) == 1  # one drive in the first block, the job ended with it
+        assert math.hypot(ended[0].x - 3.0, ended[0].y - 1.2) < 0.1  # ... where the drive ended
+        drives = tasks_named(root, "drive, looking around")
+        assert len(drives) == 2
+        assert _statuses(drives[0]) == {"drive": "SUCCEEDED", "look_while_driving": "EVAPORATED"}
+        assert _statuses(drives[1]) == {"drive": "SUCCEEDED", "look_while_driving": "EVAPORATED"}
+
+
+@pytest.mark.timeout(300)
+def test_a_search_is_ended_by_pursue_when_a_look_while_driving_turns_the_object_up():
+    """The robot stands at the table, the cup on the cabinet top beyond the camera's range (4 m
+    away): the search drives to the cabinet top, the nearest place where cups are likely that
+    it has not seen; the look taken while driving sees the cup before the drive ends, and the
+    search is evaporated."""
+    from functools import partial
+
+    from action_helpers import apartment_with, run_as_task, tasks_named
+
+    from pycram.actions.core import while_driving
+    from pycram.demos.set_table_plan import PlanRecord, find, look_for_the_next
+
+    with apartment_with("pr2", {"cup": ("cabinet top", (0.5, 2.8))}, base_pose=(4.3, 0.9, math.pi / 2)) as (world, _):
+        record = PlanRecord()
+
+        def body():
+            with while_driving(partial(look_for_the_next, lambda: ["cup"], record)):
+                return find("cup", record)
+
+        cup, root = run_as_task(body)
+        truth = world.item_poses.get_value()["cup"].position
+        assert math.dist(cup.pose[:2], truth[:2]) < 0.05, (cup, truth)
+        assert record.found_while_driving == [f"{cup.name} on cabinet top"]
+        assert record.searches_ended_by_sighting == [f"cup: {cup.name}"]
+        (search,) = tasks_named(root, "search for the cup")
+        assert _statuses(search) == {"search": "EVAPORATED", "until_seen_while_driving": "SUCCEEDED"}
+        assert tasks_named(search, "drive, looking around")  # the search was driving when it ended
+
+
+@pytest.mark.timeout(400)
+def test_the_pr2_carries_two_objects_at_once_and_looks_for_the_next_while_driving():
+    """PR2, seed 3 (measured 4 of 4 runs: the plate and the bowl carried together): after
+    picking one object it brings the next with its free arm, both held at once (the
+    simulator's truth), and the looks taken while driving find objects the belief did not
+    hold. Every drive ran with its look alongside, ended with the drive."""
+    from action_helpers import tasks_named
+
+    result, task = set_table.run_scenario("pr2", 3)
+    assert result.success, result.summary()
+    concurrency = result.concurrency
+    assert len(concurrency["most_held_at_once"]) == 2, concurrency
+    assert concurrency["carried_together"], concurrency
+    assert concurrency["found_while_driving"], concurrency
+    drives = tasks_named(task, "drive, looking around")
+    assert drives
+    assert all(_statuses(drive)["look_while_driving"] == "EVAPORATED" for drive in drives)
