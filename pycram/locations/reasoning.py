@@ -306,15 +306,16 @@ class LocationReasoner:
             return (x, y, z)
         return (x, y, z - target.type.half_height + grasp.height)
 
-    @staticmethod
-    def _top_grasp(target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
+    def _top_grasp(self, target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
         """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at
         (x, y): a rim (``radius``) is taken at its point nearest the base, the fingers closing
         across the wall; otherwise at the centre, the fingers closing across the object's
-        ``across`` axis. The tool points down; its fingers open along heading + 90 deg."""
+        ``across`` axis. The tool points down; its fingers open along heading + 90 deg; the tool
+        is raised as far as needed to keep the finger tips above the surface the object rests on
+        (`RobotGeometry.top_grasp_height`)."""
         cx, cy, cz = target.position
         half = target.type.half_height if target.type is not None else 0.0
-        z = cz - half + grasp.height
+        z = self.geometry.top_grasp_height(cz - half, cz - half + grasp.height)
         if grasp.radius > 0.0:
             toward = math.atan2(y - cy, x - cx)
             point = (cx + grasp.radius * math.cos(toward), cy + grasp.radius * math.sin(toward), z)

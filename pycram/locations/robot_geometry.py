@@ -33,6 +33,9 @@ class RobotGeometry:
     arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
     pass through configurations IK did not check). `torso_joint` and `torso_positions` (name ->
     height [m]): the torso lift, for solutions that need another torso height.
+    `fingertip_reach` [m]: how far the finger tips reach beyond the tool frame along the approach
+    (``FINGERTIP_REACH``); a top grasp keeps them `top_grasp_clearance` [m]
+    (``TOP_GRASP_CLEARANCE``) above the surface the object rests on (`top_grasp_height`).
     """
 
     name: str
@@ -49,6 +52,8 @@ class RobotGeometry:
     contact_margin: float = 0.0
     torso_joint: str | None = None
     torso_positions: Mapping[str, float] = None  # type: ignore[assignment]
+    fingertip_reach: float = 0.0
+    top_grasp_clearance: float = 0.0
 
     @classmethod
     def from_description(cls, d: Any) -> RobotGeometry:
@@ -78,7 +83,15 @@ class RobotGeometry:
             contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)),
             torso_joint=getattr(d, "TORSO", {}).get("joint"),
             torso_positions={k: float(v) for k, v in getattr(d, "TORSO_POSITIONS", {}).items()},
+            fingertip_reach=float(getattr(d, "FINGERTIP_REACH", 0.0)),
+            top_grasp_clearance=float(getattr(d, "TOP_GRASP_CLEARANCE", 0.0)),
         )
+
+    def top_grasp_height(self, bottom: float, wanted: float) -> float:
+        """Height [m] of the tool in a top grasp of an object whose bottom is at `bottom` [m]:
+        `wanted` [m] (the grasp's height), raised so that the finger tips stay
+        `top_grasp_clearance` above the surface (thin objects: spoons, plates)."""
+        return max(wanted, bottom + self.fingertip_reach + self.top_grasp_clearance)
 
     def arm(self, name: Any) -> str:
         """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""
