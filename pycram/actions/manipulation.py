@@ -225,9 +225,9 @@ def _search_again(wanted: Any, obj: PerceivedObject) -> PerceivedObject:
     return _search(description)
 
 
-def _grasp_point(obj: PerceivedObject, grasp: Grasp) -> list[float]:
-    x, y, z = obj.pose
-    return [x, y, z - object_type(obj.type).half_height + grasp.height]
+def _grasp_point(obj: PerceivedObject, grasp: Grasp, heading: float) -> list[float]:
+    """The tool point [m, map] of a horizontal `grasp` of `obj`, approached along `heading` [rad]."""
+    return list(grasp.side_point(obj.pose, object_type(obj.type).half_height, heading))
 
 
 def _pose_text(location: Any) -> str:
@@ -283,8 +283,15 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
     if math.dist(obj.pose, planned) > max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius):
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
-    point = _grasp_point(obj, grasp)
+    point = _grasp_point(obj, grasp, location.yaw)
     try:
+        if grasp.approach != "top" and grasp.radius:
+            # a deep object (a cereal box) reaches towards the robot: the raised gripper would
+            # swing into it on its way to the pre-grasp pose (measured: the TIAGo knocked the
+            # cereal box over), so it comes to a pose `radius` farther back first
+            c, s = math.cos(location.yaw), math.sin(location.yaw)
+            back = [point[0] - grasp.radius * c, point[1] - grasp.radius * s, point[2]]
+            motion(type="reaching", arm=arm, target=back, phase="pre_grasp")
         _reach(arm, location, 0, "pre_grasp", point)
         _reach(arm, location, 1, "grasp", point)
         opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
@@ -518,6 +525,9 @@ def _place_locations(held: Held, spot: tuple[float, float, float], point: list[f
 
 def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
     arm, gripper, obj = held.arm, held.gripper, held.object
+    if held.grasp.approach != "top" and held.grasp.radius:  # held off its centre, towards the robot
+        r = held.grasp.radius
+        point = [point[0] - r * math.cos(location.yaw), point[1] - r * math.sin(location.yaw), point[2]]
     motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, held.grasp))
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:

@@ -262,7 +262,7 @@ class LocationReasoner:
             failure = None
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
-                point = self._grasp_point(target, grasp)
+                point = self._grasp_point(target, grasp, yaw)
                 if grasp.approach == "top":
                     point, heading = self._top_grasp(target, grasp, x, y)
                 poses = grasp_sequence(
@@ -300,11 +300,11 @@ class LocationReasoner:
         return grasps
 
     @staticmethod
-    def _grasp_point(target: Target, grasp: Grasp) -> tuple[float, float, float]:
-        x, y, z = target.position
+    def _grasp_point(target: Target, grasp: Grasp, heading: float) -> tuple[float, float, float]:
+        """Tool point [m] of a horizontal `grasp` of `target`, the tool pointing along `heading`."""
         if target.type is None:
-            return (x, y, z)
-        return (x, y, z - target.type.half_height + grasp.height)
+            return target.position
+        return grasp.side_point(target.position, target.type.half_height, heading)
 
     def _top_grasp(self, target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
         """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at

@@ -84,6 +84,7 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
             rgba=[0.35, 0.35, 0.4, 1],
             friction=[1.5, 0.01, 0.001],
             condim=4,
+            solref=[0.004, 1.0],
         )
 
 
