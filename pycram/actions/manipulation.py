@@ -281,17 +281,27 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     _look_again(obj)
     if obj.gone:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
-    if math.dist(obj.pose, planned) > max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius):
+    moved = max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius)
+    if math.dist(obj.pose, planned) > moved:
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
+    poses = getattr(location, "tool_poses", ())
+    if location.grasp == "top" and len(poses) > 1:  # validated for where the object was then
+        off = abs(math.dist(poses[1][0][:2], obj.pose[:2]) - grasp.radius)
+        if off > moved:
+            raise _ObjectMoved(f"{obj.name} is {off:.2f} m off the grasp planned for it", obj)
     point = _grasp_point(obj, grasp, location.yaw)
     try:
         if grasp.approach != "top" and grasp.radius:
             # a deep object (a cereal box) reaches towards the robot: the raised gripper would
             # swing into it on its way to the pre-grasp pose (measured: the TIAGo knocked the
-            # cereal box over), so it comes to a pose `radius` farther back first
+            # cereal box over), so it comes to a pose `radius` farther back first -- where the
+            # arm reaches that close to the body (the PR2's often does not: then straight on)
             c, s = math.cos(location.yaw), math.sin(location.yaw)
             back = [point[0] - grasp.radius * c, point[1] - grasp.radius * s, point[2]]
-            motion(type="reaching", arm=arm, target=back, phase="pre_grasp")
+            try:
+                motion(type="reaching", arm=arm, target=back, phase="pre_grasp")
+            except RECOVERABLE as error:
+                log.info("grasping %s: no pose farther back first (%s)", obj.name, unwrap(error))
         _reach(arm, location, 0, "pre_grasp", point)
         _reach(arm, location, 1, "grasp", point)
         opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
