@@ -284,7 +284,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     moved = max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius)
     if math.dist(obj.pose, planned) > moved:
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
-    poses = getattr(location, "tool_poses", ())
+    poses: Any = getattr(location, "tool_poses", ())
     if location.grasp == "top" and len(poses) > 1:  # validated for where the object was then
         off = abs(math.dist(poses[1][0][:2], obj.pose[:2]) - grasp.radius)
         if off > moved:
