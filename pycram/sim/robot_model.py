@@ -84,6 +84,10 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
             axis=[0, sign, 0],
             range=list(grip["joint_range"]),
             limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+            # a stiff closed limit: squeezing a bowl's 8 mm rim, the fingers were pushed 16 mm
+            # past it (soft default limit), crossed over and locked onto the rim -- the gripper
+            # could no longer open to let go
+            solref_limit=[0.004, 1.0],
         )
         finger.add_geom(
             type=mujoco.mjtGeom.mjGEOM_BOX,
@@ -91,7 +95,6 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
             rgba=[0.35, 0.35, 0.4, 1],
             friction=[1.5, 0.01, 0.001],
             condim=4,
-            solref=[0.004, 1.0],
         )
 
 
