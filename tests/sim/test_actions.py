@@ -49,6 +49,7 @@ from pycram.failures import (
     ObjectSlipped,
     PlanFailure,
 )
+from pycram.world.objects import object_type
 
 ROBOTS = ("pr2", "tiago")
 
@@ -146,6 +147,26 @@ def test_pick_up_each_graspable_type_and_place_it_on_the_table(robot_name, type_
         obj = perform(Place(held, "table"))
         assert rests_upright_at(world, type_name, "table", obj.pose[:2])
         assert holding(world) == set() and held_objects() == {}
+
+
+@pytest.mark.parametrize(
+    ("robot_name", "type_name", "yaw_deg"),
+    [("pr2", "spoon", -60), ("pr2", "cereal", 30), ("tiago", "cereal", 160)],
+)
+def test_a_turned_spoon_or_cereal_box_is_grasped_as_perception_measured_its_turn(robot_name, type_name, yaw_deg):
+    # the spoon across its handle, the box across its narrow side: both need the object's turn,
+    # which perception measures from the top's longer axis
+    yaw = math.radians(yaw_deg)
+    with apartment_with(robot_name, {type_name: COUNTER}) as (world, robot):
+        x, y = COUNTER[1]
+        z = world.environment.surface("counter").height + object_type(type_name).half_height + 0.002
+        ok(world.move_item(type_name, (x, y, z), (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))))
+        ready()
+        held = perform(PickUp(ObjectDesignator(type=type_name)))
+        assert holding(world) == {type_name}
+        assert abs((held.object.yaw - yaw + math.pi / 2) % math.pi - math.pi / 2) < math.radians(10)
+        obj = perform(Place(held, "table"))
+        assert rests_upright_at(world, type_name, "table", obj.pose[:2])
 
 
 def test_the_tiago_cannot_pick_up_a_spoon():
