@@ -161,7 +161,10 @@ def add_robot(spec: mujoco.MjSpec, desc: ModuleType) -> None:
             _position_actuator(spec, joint, kp=kp, kv=kp / 8.0, force=200.0)
     for g in desc.GRIPPERS.values():
         revolute = g["effort_lever"] != 1.0
-        kp, kv = (20.0, 0.1) if revolute else (1500.0, 10.0)
+        # prismatic fingers (the TIAGo's) close at ~0.17 m/s (25 N / kv): at 2.5 m/s (kv 10) they
+        # went 5 mm into a thin object per 2 ms step, and on a 1 cm spoon the contact flipped to its
+        # top face -- a finger rode up onto the spoon and the gripper closed on nothing
+        kp, kv = (20.0, 0.1) if revolute else (1500.0, 150.0)
         _position_actuator(spec, g["joint"], kp=kp, kv=kv, force=g["default_effort"] * g["effort_lever"])
         already = {eq.name1 for eq in spec.equalities if eq.type == mujoco.mjtEq.mjEQ_JOINT}
         for other in g["coupled_joints"]:
