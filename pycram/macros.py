@@ -366,6 +366,36 @@ def _bound_names(stmts: Iterable[ast.AST]) -> set[str]:
     return {n for n in names if not n.startswith(_P)}
 
 
+def _without_annotations_of(stmts: list[ast.stmt], names: set[str]) -> list[ast.stmt]:
+    """`stmts` with annotated assignments to `names` made plain (``x: T = v`` -> ``x = v``; a
+    bare ``x: T`` -> nothing): a branch declares the names it binds nonlocal or global, and Python
+    refuses annotations of such names. The annotation stays in the source for type checkers."""
+
+    class Strip(ast.NodeTransformer):
+        def visit_AnnAssign(self, node: ast.AnnAssign) -> ast.stmt | None:
+            if not (isinstance(node.target, ast.Name) and node.target.id in names):
+                return node
+            if node.value is None:
+                return ast.copy_location(ast.Pass(), node)
+            return ast.copy_location(ast.Assign(targets=[node.target], value=node.value), node)
+
+        def _keep(self, node: ast.AST) -> ast.AST:  # a nested scope of the user's: its own names
+            return node
+
+        visit_FunctionDef = visit_AsyncFunctionDef = visit_ClassDef = visit_Lambda = _keep
+
+    strip = Strip()
+    out: list[ast.stmt] = []
+    for stmt in stmts:
+        if _is_generated_def(stmt):  # transparent: it binds in this scope too
+            new = strip.generic_visit(stmt)
+        else:
+            new = strip.visit(stmt)
+        if new is not None:
+            out.append(new)  # type: ignore[arg-type]
+    return out
+
+
 def _declared(stmts: Iterable[ast.AST], kind: type) -> set[str]:
     """Names in `global` (kind=ast.Global) or `nonlocal` statements of this scope."""
     names: set[str] = set()
@@ -678,6 +708,7 @@ class _Transformer:
     ) -> ast.FunctionDef:
         """A nested function running `body`; assigned names are shared with the real scope."""
         names = _bound_names(body)
+        body = _without_annotations_of(body, names)
         if scope.first_param is not None:
             _explicit_super(body, scope.first_param)
         decls: list[ast.stmt] = []

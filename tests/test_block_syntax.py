@@ -120,6 +120,35 @@ def f(n):
     assert ns["f"](3) == (4, 6, 10, State.SUCCEEDED, [])
 
 
+def test_branches_may_annotate_what_they_assign(tmp_path: Path) -> None:
+    # a branch declares the names it binds nonlocal (global at module level), and Python refuses
+    # annotations of such names: `x: int = 1` must still work in a branch, as in any function
+    ns = run(
+        HEADER
+        + """
+from typing import Optional
+
+def f(n):
+    with par:
+        doubled: int = n * 2
+        label: Optional[str]
+        tripled = n * 3
+    with seq:
+        def nested() -> int:
+            inner: int = 5  # a scope of its own: its annotation stays
+            return inner
+        total: int = doubled + tripled + nested()
+    return doubled, tripled, total
+
+with seq:
+    at_module: float = 1.5
+""",
+        tmp_path,
+    )
+    assert ns["f"](2) == (4, 6, 15)
+    assert ns["at_module"] == 1.5
+
+
 def test_as_name_is_bound_before_the_branches_start(tmp_path: Path) -> None:
     ns = run(
         HEADER

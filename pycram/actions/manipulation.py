@@ -18,9 +18,11 @@ measured opening after closing and after lifting (an empty gripper closes to alm
 designator that was picked up) is put at `target` -- a location designator (``('on', 'table')``),
 a `Spot`, a point or a surface's name. Each attempt drives to a standing pose from which the arm
 places there, lowers the object until the place pose or until it touches down (the arm is
-blocked), lets go, retreats, and looks: the object must be seen within
-`PLACE_TOLERANCE` of the spot. While the base drives, the gripper's opening is watched: an object
-slipping out raises `ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
+blocked), lets go, retreats, and looks: the object must be seen within `PLACE_TOLERANCE` of
+the spot, and -- for milk cartons, cereal boxes and mugs, whose measured height tells --
+standing (`toppled_height`, looked at again with the arm parked; reason ``'toppled'``). While
+the base drives, the gripper's opening is watched: an object slipping out raises
+`ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
 
 Top grasps (bowls and plates, by the rim) follow the tool poses location reasoning validated,
@@ -90,6 +92,7 @@ __all__ = [
     "PLACE_TOLERANCE",
     "HELD_FRACTION",
     "executable_grasps",
+    "toppled_height",
 ]
 
 log = logging.getLogger("pycram.actions")
@@ -561,10 +564,41 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")
     motion(type="pointing_head", coordinates=list(spot))
     motion(type="detecting", object=obj.type)
+    measured = None if obj.gone else toppled_height(obj)
+    if measured is not None:  # the arm in its carry pose may hide the object's top: park it, look again
+        log.info("placing %s: measured %.2f m tall; parking the %s arm and looking again", obj.name, measured, arm)
+        motion(type="setting_arm_configuration", arm=arm, configuration="park")
+        motion(type="pointing_head", coordinates=list(spot))
+        motion(type="detecting", object=obj.type)
+        measured = None if obj.gone else toppled_height(obj)
+    if measured is not None:
+        kind = object_type(obj.type)
+        raise PlacingFailed(
+            f"{obj.name} does not stand upright at {_xyz(spot)}: measured {measured * 100:.0f} cm tall, "
+            f"{kind.height * 100:.0f} cm standing, at most {kind.lying_height * 100:.0f} cm toppled over",
+            obj,
+            "toppled",
+        )
     if obj.gone or math.dist(obj.pose[:2], spot[:2]) > PLACE_TOLERANCE:
         where = "not seen" if obj.gone else f"seen at {_xyz(obj.pose)}"
         raise PlacingFailed(f"{obj.name} does not rest at {_xyz(spot)}: {where}", obj)
     return obj
+
+
+def toppled_height(obj: PerceivedObject) -> float | None:
+    """The measured height [m] of `obj` when perception shows it toppled over, else None.
+
+    Only for types whose standing and lying heights differ clearly (`ObjectType.topples_visibly`:
+    milk, cereal, mug) and objects measured on a surface: toppled means measured below the
+    middle between the two heights. Something between the camera and the object's top (the
+    robot's own arm in its carry pose) makes a standing object look short: `Place` looks again
+    with the arm parked before it believes a toppled measurement."""
+    kind = object_type(obj.type)
+    size = obj.properties.get("size")
+    if not kind.topples_visibly or not size or obj.properties.get("on") is None:
+        return None
+    measured = float(size[2])
+    return measured if measured < (kind.height + kind.lying_height) / 2.0 else None
 
 
 @action_plan("placing")

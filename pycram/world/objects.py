@@ -98,6 +98,18 @@ class ObjectType:
         return 2.0 * self.half_height
 
     @property
+    def lying_height(self) -> float:
+        """The tallest [m] the object stands when toppled over (on a side, not its base): a box's
+        larger horizontal size, a cylinder's or dish's diameter."""
+        return 2.0 * max(self.size[0], self.size[1]) if self.shape == "box" else 2.0 * self.size[0]
+
+    @property
+    def topples_visibly(self) -> bool:
+        """Whether standing and toppled over are told apart by the measured height alone (lying,
+        it is at most 3/4 as tall as standing): milk cartons and cereal boxes, not cups."""
+        return self.lying_height <= 0.75 * self.height
+
+    @property
     def footprint_radius(self) -> float:
         """Radius [m] of the smallest circle around the object's shadow on a surface (any yaw)."""
         return math.hypot(self.size[0], self.size[1]) if self.shape == "box" else self.size[0]

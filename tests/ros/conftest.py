@@ -80,16 +80,27 @@ def start_bridge(ros_master):
         bridge.stop()
 
 
-@pytest.fixture(scope="module", params=["pr2", "tiago"])
-def ros_robot(request, ros_master, transport):
-    """A bridge for the robot of the parameter and the robot over ROS, active for the module."""
+def _robot_behind_bridge(robot_name: str, master, transport):
+    """A bridge for `robot_name` (the demo's mug on slot 1) and the robot over ROS, active."""
     from pycram.ros.robot import make_ros_robot
 
-    bridge = _start_bridge(request.param, ros_master)
+    bridge = _start_bridge(robot_name, master)
     try:
-        robot = make_ros_robot(request.param, transport)
+        robot = make_ros_robot(robot_name, transport)
         with robot:
             yield robot
         robot.shutdown()
     finally:
         bridge.stop()
+
+
+@pytest.fixture(scope="module", params=["pr2", "tiago"])
+def ros_robot(request, ros_master, transport):
+    """A bridge for the robot of the parameter and the robot over ROS, active for the module."""
+    yield from _robot_behind_bridge(request.param, ros_master, transport)
+
+
+@pytest.fixture(scope="module")
+def pr2_with_mug(ros_master, transport):
+    """The PR2 behind a bridge with the demo's mug on slot 1, active for the module."""
+    yield from _robot_behind_bridge("pr2", ros_master, transport)

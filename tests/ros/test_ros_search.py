@@ -11,19 +11,9 @@ from pycram.designator import ObjectDesignator, perform
 
 
 @pytest.fixture(scope="module")
-def robot(ros_master, transport):
+def robot(pr2_with_mug):
     """The PR2 behind a bridge with the demo's mug on slot 1, active for the module."""
-    from pycram.ros.launch import BridgeProcess
-    from pycram.ros.robot import make_ros_robot
-
-    bridge = BridgeProcess("pr2", ros_master.uri, item_at=1)
-    try:
-        ros_robot = make_ros_robot("pr2", transport)
-        with ros_robot:
-            yield ros_robot
-        ros_robot.shutdown()
-    finally:
-        bridge.stop()
+    return pr2_with_mug
 
 
 def test_search_finds_the_mug_over_ros(robot):

@@ -127,3 +127,46 @@ class OnceHolding:
     def join(self, timeout: float = 60.0) -> Any:
         assert self.done.wait(timeout), "the person never acted"
         return self.result
+
+
+class KnockOverOnceLetGo:
+    """Lays `item` on its side on `surface`, where it stands, once the robot has held it, let go
+    and moved the tool of `arm` more than `distance` [m] away from it (a person knocking it over
+    right after it was put down). Waits on fluents only; `join()` is True when it acted."""
+
+    def __init__(self, world: World, item: str, arm: str, surface: str, distance: float = 0.12) -> None:
+        self.world, self.item, self.arm, self.surface, self.distance = world, item, arm, surface, distance
+        self.done = threading.Event()
+        self.acted = False
+        self._thread = threading.Thread(target=self._run, daemon=True, name=f"person knocking over {item}")
+        self._thread.start()
+
+    def _run(self) -> None:
+        from pycram.fluent import Fluent
+
+        w = self.world
+        held = Fluent(lambda: True if self.item in holding(w) else None)
+        for f in w.gripper_states.values():
+            f.add_child(held)
+        if held.wait_for(600.0):
+
+            def let_go_and_away() -> bool | None:
+                if self.item in holding(w):
+                    return None
+                tool = w.tool_poses.get_value()[self.arm].position
+                item = w.item_poses.get_value()[self.item].position
+                return True if math.dist(tool, item) > self.distance else None
+
+            away = Fluent(let_go_and_away)
+            w.tool_poses.add_child(away)
+            if away.wait_for(600.0):
+                x, y, _ = w.item_poses.get_value()[self.item].position
+                lying = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # 90 deg about x
+                z = w.environment.surface(self.surface).height + object_type(self.item).lying_height / 2 + 0.002
+                ok(w.move_item(self.item, (x, y, z), lying))
+                self.acted = True
+        self.done.set()
+
+    def join(self, timeout: float = 60.0) -> bool:
+        assert self.done.wait(timeout), "the person never acted"
+        return self.acted

@@ -13,6 +13,7 @@ import pytest
 from action_helpers import (
     COUNTER,
     TABLE,
+    KnockOverOnceLetGo,
     OnceHolding,
     apartment_with,
     holding,
@@ -38,6 +39,7 @@ from pycram.actions import (
     Transport,
     held_objects,
 )
+from pycram.actions.manipulation import toppled_height
 from pycram.designator import LocationDesignator, ObjectDesignator, perform
 from pycram.failures import (
     GoalUnreachable,
@@ -47,6 +49,7 @@ from pycram.failures import (
     ObjectNotVisible,
     ObjectOutOfReach,
     ObjectSlipped,
+    PlacingFailed,
     PlanFailure,
 )
 from pycram.world.objects import object_type
@@ -264,6 +267,34 @@ def test_a_standing_pose_that_cannot_be_reached_gives_way_to_the_next():
 
 
 # -- typed failures when recovery is impossible ------------------------------------------------------
+
+
+def test_perception_tells_a_toppled_milk_carton_from_a_standing_one():
+    with apartment_with("pr2", {"milk": TABLE}) as (world, robot):
+        ready()
+        milk = perform(Search(ObjectDesignator(type="milk")))
+        assert toppled_height(milk) is None  # standing: measured ~20 cm tall
+        x, y = TABLE[1]
+        lying = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # 90 deg about x
+        height = world.environment.surface("table").height
+        ok(world.move_item("milk", (x, y, height + object_type("milk").lying_height / 2 + 0.002), lying))
+        perform(LookAt(milk))
+        perform(Detect("milk"))
+        measured = toppled_height(milk)
+        assert measured is not None and measured < 0.1
+
+
+def test_placing_raises_placing_failed_when_the_object_ends_toppled_over():
+    # a person knocks the carton over as soon as the hand has let go and backed off: Place
+    # must not report success (the post-condition looks at the measured height)
+    with apartment_with("pr2", {"milk": COUNTER}) as (world, robot):
+        ready()
+        held = perform(PickUp(ObjectDesignator(type="milk")))
+        person = KnockOverOnceLetGo(world, "milk", held.arm, "table")
+        with pytest.raises(PlacingFailed, match="does not stand upright") as raised:
+            perform(Place(held, "table"))
+        assert raised.value.reason == "toppled"
+        assert person.join() is True
 
 
 @pytest.mark.parametrize("robot_name", ROBOTS)
