@@ -260,14 +260,18 @@ class LocationReasoner:
             if prosp.in_collision((x, y, natural), raised):
                 return None, (f"arm {arm!r} hits the furniture when raised to approach", None)
             failure = None
+            options = []
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
-                point = self._grasp_point(target, grasp, yaw)
-                if grasp.approach == "top":
-                    point, heading = self._top_grasp(target, grasp, x, y)
-                poses = grasp_sequence(
-                    self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
-                )
+                if grasp.approach != "top":
+                    options.append((grasp, yaw, self._grasp_point(target, grasp, yaw), yaw))
+                    continue
+                point, heading = self._top_grasp(target, grasp, x, y)
+                options.append((grasp, yaw, point, heading))
+                if grasp.radius == 0.0:  # across an axis: the gripper turned half round grasps alike
+                    options.append((grasp, yaw, point, _wrap(heading + math.pi)))
+            for grasp, yaw, point, heading in options:
+                poses = grasp_sequence(self.geometry, point, heading, grasp.approach, action)
                 margin = self.geometry.contact_margin if action == "grasp" else 0.0
                 if margin:  # room to spare below the grasp
                     (gx, gy, gz), q = poses[1]
@@ -310,7 +314,8 @@ class LocationReasoner:
         """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at
         (x, y): a rim (``radius``) is taken at its point nearest the base, the fingers closing
         across the wall; otherwise at the centre, the fingers closing across the object's
-        ``across`` axis. The tool points down; its fingers open along heading + 90 deg; the tool
+        ``across`` axis (`to_reach` also tries the gripper turned half round, which closes
+        across that axis alike). The tool points down; its fingers open along heading + 90 deg; the tool
         is raised as far as needed to keep the finger tips above the surface the object rests on
         (`RobotGeometry.top_grasp_height`)."""
         cx, cy, cz = target.position
