@@ -291,16 +291,22 @@ class LocationReasoner:
             tucked = dict(self.geometry.tucked)
             raised = self.geometry.raised(arm)
 
+            options = []  # (grasp, base yaw, tool point, tool heading)
+            for grasp, heading in self._grasp_options(grasps, target, natural):
+                yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
+                if grasp.approach != "top":
+                    options.append((grasp, yaw, self._grasp_point(target, grasp, yaw), yaw))
+                    continue
+                point, tool_heading = self._top_grasp(target, grasp, x, y)
+                options.append((grasp, yaw, point, tool_heading))
+                if grasp.radius == 0.0 and grasp.across != "radial":
+                    # across an axis: the gripper turned half round grasps alike
+                    options.append((grasp, yaw, point, _wrap(tool_heading + math.pi)))
+
             def sequences(configuration: dict[str, float]) -> tuple[BaseLocation | None, tuple[str, str | None]]:
                 failure: tuple[str, str | None] = ("no fitting grasp", None)
-                for grasp, heading in self._grasp_options(grasps, target, natural):
-                    yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
-                    point = self._grasp_point(target, grasp)
-                    if grasp.approach == "top":
-                        point, heading = self._top_grasp(target, grasp, x, y)
-                    poses = grasp_sequence(
-                        self.geometry, point, yaw if grasp.approach != "top" else heading, grasp.approach, action
-                    )
+                for grasp, yaw, point, heading in options:
+                    poses = grasp_sequence(self.geometry, point, heading, grasp.approach, action)
                     if drawer is not None:
                         poses = self._clear_of_the_rim(poses, grasp, drawer.rim_height, action)
                     margin = self.geometry.contact_margin if action == "grasp" else 0.0
@@ -449,23 +455,24 @@ class LocationReasoner:
         return out
 
     @staticmethod
-    def _grasp_point(target: Target, grasp: Grasp) -> tuple[float, float, float]:
-        x, y, z = target.position
+    def _grasp_point(target: Target, grasp: Grasp, heading: float) -> tuple[float, float, float]:
+        """Tool point [m] of a horizontal `grasp` of `target`, the tool pointing along `heading`."""
         if target.type is None:
-            return (x, y, z)
-        return (x, y, z - target.type.half_height + grasp.height)
+            return target.position
+        return grasp.side_point(target.position, target.type.half_height, heading)
 
-    @staticmethod
-    def _top_grasp(target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
+    def _top_grasp(self, target: Target, grasp: Grasp, x: float, y: float) -> tuple[tuple[float, float, float], float]:
         """Tool point [m] and heading [rad] (for `grasp_sequence`) of a top grasp from a base at
         (x, y): a rim (``radius``) is taken at its point nearest the base, the fingers closing
         across the wall; a body (``across='radial'`` without a radius: cups and mugs) at its
         axis, the fingers closing along the line from the base; otherwise at the centre, the
-        fingers closing across the object's ``across`` axis. The tool points down; its fingers
-        open along heading + 90 deg."""
+        fingers closing across the object's ``across`` axis (`to_reach` also tries the gripper
+        turned half round, which closes across that axis alike). The tool points down; its fingers
+        open along heading + 90 deg; the tool is raised as far as needed to keep the finger tips
+        above the surface the object rests on (`RobotGeometry.top_grasp_height`)."""
         cx, cy, cz = target.position
         half = target.type.half_height if target.type is not None else 0.0
-        z = cz - half + grasp.height
+        z = self.geometry.top_grasp_height(cz - half, cz - half + grasp.height)
         if grasp.radius > 0.0 or grasp.across == "radial":
             toward = math.atan2(y - cy, x - cx)
             point = (cx + grasp.radius * math.cos(toward), cy + grasp.radius * math.sin(toward), z)

@@ -36,6 +36,9 @@ class RobotGeometry:
     height [m]): the torso lift, for solutions that need another torso height. `door_push`: how
     the hand meets a door's face when it pushes one (``DOOR_PUSH``, see `pycram.locations.doors`;
     None: the robot does not push doors).
+    `fingertip_reach` [m]: how far the finger tips reach beyond the tool frame along the approach
+    (``FINGERTIP_REACH``); a top grasp keeps them `top_grasp_clearance` [m]
+    (``TOP_GRASP_CLEARANCE``) above the surface the object rests on (`top_grasp_height`).
     """
 
     name: str
@@ -53,6 +56,8 @@ class RobotGeometry:
     torso_joint: str | None = None
     torso_positions: Mapping[str, float] = None  # type: ignore[assignment]
     door_push: Mapping[str, Any] | None = None
+    fingertip_reach: float = 0.0
+    top_grasp_clearance: float = 0.0
 
     @classmethod
     def from_description(cls, d: Any) -> RobotGeometry:
@@ -83,7 +88,15 @@ class RobotGeometry:
             torso_joint=getattr(d, "TORSO", {}).get("joint"),
             torso_positions={k: float(v) for k, v in getattr(d, "TORSO_POSITIONS", {}).items()},
             door_push=getattr(d, "DOOR_PUSH", None),
+            fingertip_reach=float(getattr(d, "FINGERTIP_REACH", 0.0)),
+            top_grasp_clearance=float(getattr(d, "TOP_GRASP_CLEARANCE", 0.0)),
         )
+
+    def top_grasp_height(self, bottom: float, wanted: float) -> float:
+        """Height [m] of the tool in a top grasp of an object whose bottom is at `bottom` [m]:
+        `wanted` [m] (the grasp's height), raised so that the finger tips stay
+        `top_grasp_clearance` above the surface (thin objects: spoons, plates)."""
+        return max(wanted, bottom + self.fingertip_reach + self.top_grasp_clearance)
 
     def arm(self, name: Any) -> str:
         """The physical arm serving a request for arm `name` (ValueError listing the valid names)."""

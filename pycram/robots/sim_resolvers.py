@@ -446,7 +446,7 @@ def known_objects_of(belief: Any) -> list:
         if obj.type not in OBJECT_TYPES and size is not None:  # e.g. the thesis demo's mug: as measured
             radius, half_height = 0.5 * math.hypot(size[0], size[1]), 0.5 * size[2]
         position = cast(Vec3, tuple(float(v) for v in obj.pose[:3]))
-        known.append(KnownObject(obj.name, obj.type, position, 0.0, radius, half_height))
+        known.append(KnownObject(obj.name, obj.type, position, float(getattr(obj, "yaw", 0.0)), radius, half_height))
     return known
 
 

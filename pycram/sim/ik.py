@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 
 from .engine import Engine
+from .robot_model import NOT_IK_SEEDS
 from .types import Pose
 
 _log = logging.getLogger(__name__)
@@ -59,7 +60,7 @@ def solve_ik(
     target_q = target_q / np.linalg.norm(target_q)
     rng = np.random.default_rng(rng_seed)
     candidates = [eng.data.qpos[qadr].copy()] + [np.asarray(s, float) for s in seeds]
-    candidates += [np.asarray(c, float) for c in eng.desc.ARM_CONFIGURATIONS[arm].values()]
+    candidates += [np.asarray(c, float) for n, c in eng.desc.ARM_CONFIGURATIONS[arm].items() if n not in NOT_IK_SEEDS]
     for _ in range(6):
         r = rng.uniform(np.where(limited, lo, -np.pi), np.where(limited, hi, np.pi))
         candidates.append(r)

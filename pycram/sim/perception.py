@@ -102,6 +102,7 @@ def _measure(
         centre_b = float(b.min()) + width / 2.0
         depth = width
     x, y = (centre_a * across + centre_b * along).tolist()
+    axis = _major_axis(points, top) if view.position[2] > top + 0.05 else None
     surface = support_of(environment, x, y, lowest, container_states)
     bottom = surface.height if surface is not None else max(0.0, lowest)
     container = None if surface is None else environment.container_of(surface.name)
@@ -115,7 +116,28 @@ def _measure(
         None if surface is None else surface.name,
         None if container is None else container.name,
         int(len(points)),
+        axis,
     )
+
+
+#: The top's horizontal extent must be this much longer along its major axis than across it
+#: (ratio of the standard deviations) for `_major_axis` to name an axis.
+ELONGATION = 1.5
+
+
+def _major_axis(points: np.ndarray, top: float) -> float | None:
+    """The direction [rad, in [-pi/2, pi/2)] of the longer horizontal axis of the object's top
+    (its points within 1 cm of the highest), seen from above; None when the top is not clearly
+    longer one way than the other (round or square objects) or too few points show it."""
+    upper = points[points[:, 2] > top - 0.01, :2]
+    if len(upper) < 10:
+        return None
+    xy = upper - upper.mean(axis=0)
+    values, vectors = np.linalg.eigh(xy.T @ xy / len(xy))
+    if values[1] < ELONGATION**2 * max(float(values[0]), 1e-12):
+        return None
+    angle = math.atan2(float(vectors[1, 1]), float(vectors[0, 1]))
+    return (angle + math.pi / 2) % math.pi - math.pi / 2
 
 
 def measure_detections(

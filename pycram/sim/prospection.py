@@ -30,7 +30,7 @@ from pycram.world.prospection import Prospection, Reachability, ToolPose, Visibi
 from .ik import dls_ik
 from .occupancy import descends
 from .recording import StateSnapshot
-from .robot_model import BASE_JOINTS, HEAD_CAMERA, tool_site
+from .robot_model import BASE_JOINTS, HEAD_CAMERA, NOT_IK_SEEDS, tool_site
 from .scene import Scene
 
 #: Geom groups a camera sees (MuJoCo's default visualisation: groups 0, 1 and 2).
@@ -67,7 +67,9 @@ class _Arm:
         self.limited = limited
         self.site = scene.site(tool_site(arm))
         self.configurations = [
-            np.asarray(c, float) for _, c in sorted(scene.description.ARM_CONFIGURATIONS[arm].items())
+            np.asarray(c, float)
+            for name, c in sorted(scene.description.ARM_CONFIGURATIONS[arm].items())
+            if name not in NOT_IK_SEEDS
         ]
         rng = np.random.default_rng(0)
         self.random_seeds = [

@@ -40,6 +40,7 @@ from pycram.designators.object import Belief, BelievedObject
 from pycram.fluent import Fluent
 
 from .environment import Environment, Surface
+from .objects import OBJECT_TYPES
 
 __all__ = [
     "COLOR_NAMES",
@@ -100,7 +101,8 @@ class Detection:
     does not see the object's top, its depth is assumed equal to its width; `color` is the name of the measured
     mean colour (`rgb`, channels in [0, 1]); `support` the surface it rests on and `container`
     the container that surface is in (None when it rests on none known / an open surface);
-    `pixels` how many pixels of it were visible.
+    `pixels` how many pixels of it were visible; `axis` [rad] the direction of the longer
+    horizontal axis of its top when seen from above (None: round, square or not seen from above).
     """
 
     type: str
@@ -111,6 +113,7 @@ class Detection:
     support: str | None = None
     container: str | None = None
     pixels: int = 0
+    axis: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,6 +209,19 @@ class PerceivedObject(BelievedObject):
     pose_fluent: Fluent = field(default_factory=lambda: Fluent(None))
     gone: bool = False
     times_seen: int = 0
+
+    @property
+    def yaw(self) -> float:
+        """Its turn about the vertical [rad] as far as perception measured it: from the measured
+        direction of its top's longer axis (property "axis") and its type's shape (a box whose
+        y side is the longer one is turned by that direction - 90 deg); 0 when not measured or
+        when the shape has no longer axis."""
+        axis = self.properties.get("axis")
+        otype = OBJECT_TYPES.get(self.type)
+        if axis is None or otype is None or otype.shape != "box" or otype.size[0] == otype.size[1]:
+            return 0.0
+        yaw = float(axis) - (math.pi / 2 if otype.size[1] > otype.size[0] else 0.0)
+        return (yaw + math.pi) % (2 * math.pi) - math.pi
 
     @property
     def last_seen(self) -> float:
@@ -379,6 +395,7 @@ class BeliefState(Belief):
             **{"in": detection.container},
             last_seen=stamp,
             pixels=detection.pixels,
+            axis=detection.axis,
         )
         obj.gone = False
         obj.times_seen += 1

@@ -39,9 +39,11 @@ class Grasp:
     `approach` is where the gripper comes from (`APPROACHES`); `opening` [m] is the distance
     between the finger pads when they close on the object; `height` [m] is the grasp point above
     the object's bottom; `radius` [m] moves the grasp point off the object's axis towards the
-    gripper (rim grasps of bowls and plates: the fingers pinch the wall); `across` says which
-    object axis the fingers close across for a top grasp ("x", "y", or "radial": along the line
-    from the robot -- a rim at `radius`, or, without one, a round body at its axis).
+    gripper (rim grasps of bowls and plates: the fingers pinch the wall; side grasps of deep
+    boxes: the fingers close near the face the gripper comes from, the palm clear of the box);
+    `across` says which object axis the fingers close across for a top grasp ("x", "y", or
+    "radial": along the line from the robot -- a rim at `radius`, or, without one, a round body
+    at its axis).
     """
 
     approach: str
@@ -53,6 +55,20 @@ class Grasp:
     def __post_init__(self) -> None:
         if self.approach not in APPROACHES:
             raise ValueError(f"grasp approach {self.approach!r} is not one of {', '.join(APPROACHES)}")
+
+    def side_point(
+        self, centre: tuple[float, float, float] | list[float], half_height: float, heading: float
+    ) -> tuple[float, float, float]:
+        """The tool point [m, map] of this grasp from a horizontal approach along `heading` [rad]
+        (the direction the tool points) of an object whose centre is at `centre` [m] and whose
+        half height is `half_height` [m]: `height` above its bottom, `radius` back towards the
+        gripper."""
+        x, y, z = centre
+        return (
+            x - self.radius * math.cos(heading),
+            y - self.radius * math.sin(heading),
+            z - half_height + self.height,
+        )
 
 
 @dataclass(frozen=True)
@@ -194,9 +210,13 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (0.035, 0.095, 0.14),
             0.4,
             (0.92, 0.55, 0.12, 1.0),
-            (Grasp("+y", 0.07, 0.16), Grasp("-y", 0.07, 0.16), Grasp("top", 0.07, 0.26, across="x")),
+            (
+                Grasp("+y", 0.07, 0.16, radius=0.07),
+                Grasp("-y", 0.07, 0.16, radius=0.07),
+                Grasp("top", 0.07, 0.26, across="x"),
+            ),
             ("counter", "table", "shelf"),
-            "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side",
+            "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side, 2.5 cm in from its end",
         ),
         ObjectType(
             "milk",

@@ -148,7 +148,7 @@ def test_torso_gripper_arm_and_head_motions(robot):
     assert abs(half - 0.5 * d.GRIPPERS["right"]["max_opening"]) < 0.01
 
     for arm in ("left", "right", "0", "1"):
-        for configuration in ("park", "pre_grasp", "carry"):
+        for configuration in ("park", "pre_grasp", "carry", "carry_top"):
             motion(type="setting_arm_configuration", arm=arm, configuration=configuration)
             physical = d.ARM_ALIASES[arm]
             joints = d.ARMS[physical]["joints"]
@@ -157,7 +157,7 @@ def test_torso_gripper_arm_and_head_motions(robot):
             assert max(abs(a - b) for a, b in zip(measured, wanted)) < 0.02, (arm, configuration)
     carry = list(d.ARM_CONFIGURATIONS["right"]["carry"])
     motion(type="setting_arm_joints", arm="right", positions=carry)
-    with pytest.raises(MotionPropertyError, match="'configuration'.* must be 'carry', 'park'"):
+    with pytest.raises(MotionPropertyError, match="'configuration'.* must be 'carry', 'carry_top', 'park'"):
         motion(type="setting_arm_configuration", arm="right", configuration="wave")  # checked first
     with pytest.raises(ProcessModuleFailure, match="7 joints"):
         motion(type="setting_arm_joints", arm="right", positions=[0.0, 0.1])

@@ -124,6 +124,11 @@ KITCHEN_BASE_POSES = {
 ARM_CONFIGURATIONS["right"]["pre_grasp"] = (-0.566, -0.147, -2.211, -2.272, 2.914, -1.721, -0.982)
 ARM_CONFIGURATIONS["left"]["pre_grasp"] = (0.566, -0.137, 2.215, -2.268, -2.905, -1.723, 0.984)
 
+#: Carrying an object held from the top (spoon, bowl, plate): the tool pointing down, 0.6 m ahead
+#: of the base, 1.13 m high (torso "up"), so that the object stays level (IK from ``carry``).
+ARM_CONFIGURATIONS["right"]["carry_top"] = (-0.462, -0.524, -1.701, -1.13, 5.243, -1.685, -2.477)
+ARM_CONFIGURATIONS["left"]["carry_top"] = (0.462, -0.524, 1.701, -1.13, -5.244, -1.684, 2.478)
+
 #: Torso heights [m] of the symbolic positions of `setting_torso`.
 TORSO_POSITIONS = {"up": 0.28, "down": 0.0}
 
@@ -163,3 +168,10 @@ GRASP_CONTACT_MARGIN = 0.015
 #: face, the gripper open (with it closed or half open, location reasoning found no standing pose
 #: for the push from 30 deg to shut: 100 candidates, mostly the approach out of reach).
 DOOR_PUSH = {"outside": {"heading": -1.5708, "offset": (0.0, 0.01), "gripper": 1.0}}
+
+#: How far [m] the finger tips reach beyond the tool frame along the approach (the tool's x):
+#: a top grasp keeps them `TOP_GRASP_CLEARANCE` above the surface the object rests on (measured
+#: on the model: the finger tip links' collision hulls end 15 mm past `*_gripper_tool_frame`).
+FINGERTIP_REACH = 0.015
+#: Clearance [m] of the finger tips above the supporting surface in a top grasp.
+TOP_GRASP_CLEARANCE = 0.003

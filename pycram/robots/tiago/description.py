@@ -91,6 +91,10 @@ KITCHEN_BASE_POSES = {
 #: 0.15 m right, 0.95 m high (torso "up"), pointing forward.
 ARM_CONFIGURATIONS["right"]["pre_grasp"] = (0.277, -0.385, -1.499, 2.176, -1.794, -0.879, -0.208)
 
+#: Carrying an object held from the top (spoon, bowl, plate): the tool pointing down, 0.6 m ahead
+#: of the base, 1.07 m high (torso "up"), so that the object stays level (IK from ``carry``).
+ARM_CONFIGURATIONS["right"]["carry_top"] = (0.569, 0.797, -1.351, 1.557, 0.81, -1.414, -1.17)
+
 #: Torso heights [m] of the symbolic positions of `setting_torso`.
 TORSO_POSITIONS = {"up": 0.32, "down": 0.0}
 
@@ -142,3 +146,10 @@ REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place":
 #: pass through configurations IK
 #: did not check).
 GRASP_CONTACT_MARGIN = 0.005
+
+#: How far [m] the finger tips reach beyond the tool frame along the approach (the tool's x): the
+#: tool frame sits at the middle of the 8 cm fingers (`GRIPPER_MODEL`), their tips 40 mm beyond;
+#: a top grasp keeps them `TOP_GRASP_CLEARANCE` above the surface the object rests on.
+FINGERTIP_REACH = 0.04
+#: Clearance [m] of the finger tips above the supporting surface in a top grasp.
+TOP_GRASP_CLEARANCE = 0.003
