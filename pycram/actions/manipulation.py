@@ -96,6 +96,7 @@ __all__ = [
     "executable_grasps",
     "resting_problem",
     "RESTING_SLACK",
+    "FOOTPRINT_SLACK",
 ]
 
 log = logging.getLogger("pycram.actions")
@@ -126,6 +127,8 @@ NEAR_SIDE_INSET = 0.15
 PLACE_TOLERANCE = 0.05
 #: A placed object measured taller than it is by more than this [m] does not rest on the surface.
 RESTING_SLACK = 0.05
+#: ... and one measured wider than its standing footprint by more than this [m] lies on its side.
+FOOTPRINT_SLACK = 0.02
 #: The gripper holds the object when its opening is at least this fraction of the grasp's opening.
 HELD_FRACTION = 0.5
 
@@ -188,10 +191,13 @@ def executable_grasps(type_name: str, requested: str | None = None) -> list[Gras
 
 def carry_configuration(arm: str, grasp: Grasp) -> str:
     """The named arm configuration to carry an object held with `grasp` in: ``carry_top`` (the
-    tool pointing down, the object level) for top grasps when the robot's description has it,
-    else ``carry``."""
+    tool pointing down, the object level) for top grasps of rims and across an axis (bowls,
+    plates, spoons) when the robot's description has it, else ``carry`` -- also for the top grasp
+    of a cup's or mug's body (out of a drawer): carried in ``carry_top`` and put down on the
+    table, the PR2's cup ended tilted 75 deg (measured), in ``carry`` upright."""
     named = getattr(_description(), "ARM_CONFIGURATIONS", {}).get(arm, {})
-    return "carry_top" if grasp.approach == "top" and "carry_top" in named else "carry"
+    body = grasp.across == "radial" and grasp.radius == 0.0
+    return "carry_top" if grasp.approach == "top" and not body and "carry_top" in named else "carry"
 
 
 def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None) -> None:
@@ -627,9 +633,10 @@ def resting_problem(obj: PerceivedObject) -> tuple[str, str] | None:
 
     Perception measures an object's height from the surface it is over to its top. Taller than
     the object by more than `RESTING_SLACK`: it does not rest on the surface (still in the
-    gripper, or on something). For types whose standing and lying heights differ clearly
-    (`ObjectType.topples_visibly`: milk, cereal, mug): nearer the lying than the standing height
-    means toppled. Something between the camera and the object's top (the robot's own arm in
+    gripper, or on something). Wider than its standing footprint by more than `FOOTPRINT_SLACK`:
+    it lies on its side (a cup seen from above). For types whose standing and lying heights
+    differ clearly (`ObjectType.topples_visibly`: milk, cereal, mug): nearer the lying than the
+    standing height means toppled. Something between the camera and the object's top (the robot's own arm in
     its carry pose) makes a standing object look short: `Place` looks again with the arm parked
     before it believes either."""
     kind = object_type(obj.type)
@@ -641,6 +648,12 @@ def resting_problem(obj: PerceivedObject) -> tuple[str, str] | None:
         return "not_resting", (
             f"its top is measured {measured * 100:.0f} cm above the {obj.properties['on']}, "
             f"a {kind.name} is {kind.height * 100:.0f} cm tall (still held, or on something)"
+        )
+    wide = max(float(size[0]), float(size[1]))
+    if wide > 2.0 * kind.footprint_radius + FOOTPRINT_SLACK:
+        return "toppled", (
+            f"measured {wide * 100:.0f} cm across, standing it is at most "
+            f"{2 * kind.footprint_radius * 100:.0f} cm across"
         )
     if kind.topples_visibly and measured < (kind.height + kind.lying_height) / 2.0:
         return "toppled", (

@@ -269,20 +269,25 @@ def test_a_standing_pose_that_cannot_be_reached_gives_way_to_the_next():
 # -- typed failures when recovery is impossible ------------------------------------------------------
 
 
-def test_perception_tells_a_toppled_milk_carton_from_a_standing_one():
-    with apartment_with("pr2", {"milk": TABLE}) as (world, robot):
+@pytest.mark.parametrize(("type_name", "tells"), [("milk", "across"), ("cup", "across"), ("cereal", "across")])
+def test_perception_tells_a_toppled_object_from_a_standing_one(type_name, tells):
+    # milk and cereal by their measured height; the cup (as tall lying as standing) by its
+    # footprint seen from above
+    with apartment_with("pr2", {type_name: TABLE}) as (world, robot):
         ready()
-        milk = perform(Search(ObjectDesignator(type="milk")))
-        assert resting_problem(milk) is None  # standing: measured ~20 cm tall
+        obj = perform(Search(ObjectDesignator(type=type_name)))
+        assert resting_problem(obj) is None, obj.properties["size"]  # standing
         x, y = TABLE[1]
         lying = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # 90 deg about x
+        kind = object_type(type_name)
         height = world.environment.surface("table").height
-        ok(world.move_item("milk", (x, y, height + object_type("milk").lying_height / 2 + 0.002), lying))
-        perform(LookAt(milk))
-        perform(Detect("milk"))
-        problem = resting_problem(milk)
-        assert problem is not None and problem[0] == "toppled", problem
-        assert float(milk.properties["size"][2]) < 0.1
+        lying_height = 2 * kind.size[1] if kind.shape == "box" else kind.lying_height
+        ok(world.move_item(type_name, (x, y, height + lying_height / 2 + 0.002), lying))
+        perform(LookAt(obj))
+        perform(Detect(type_name))
+        problem = resting_problem(obj)
+        assert problem is not None and problem[0] == "toppled", (problem, obj.properties["size"])
+        assert tells in problem[1]
 
 
 def test_placing_raises_placing_failed_when_the_object_ends_toppled_over():
