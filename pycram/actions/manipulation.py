@@ -19,12 +19,12 @@ designator that was picked up) is put at `target` -- a location designator (``('
 a `Spot`, a point or a surface's name. Each attempt drives to a standing pose from which the arm
 places there, lowers the object until the place pose or until it touches down (the arm is
 blocked), lets go, retreats, and looks: the object must be seen within `PLACE_TOLERANCE` of
-the spot, and standing on the surface: not measured taller than it is (reason
-``'not_resting'``: still held, or on something) and -- for milk cartons, cereal boxes and mugs,
-whose measured height tells -- not toppled over (``'toppled'``); `resting_problem`, looked at
-again with the arm parked before it is believed. While
-the base drives, the gripper's opening is watched: an object slipping out raises
-`ObjectSlipped` at once (`pursue`). Raises `GripperEmpty` when the gripper
+the spot, and standing on the surface (`resting_problem`): not measured taller than it is
+(reason ``'not_resting'``: still held, or on something), nor lying (``'toppled'``). A look
+that does not see the object or sees it not standing is taken again with the arm parked
+before it is believed (the arm may hide the object; a look may miss it). While the base
+drives, the gripper's opening is watched: an object slipping out raises `ObjectSlipped` at
+once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
 
 Top grasps (bowls and plates, by the rim) follow the tool poses location reasoning validated,
@@ -612,8 +612,11 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     motion(type="pointing_head", coordinates=list(spot))
     motion(type="detecting", object=obj.type)
     problem = None if obj.gone else resting_problem(obj)
-    if problem is not None:  # the arm in its carry pose may hide the object's top: park it, look again
-        log.info("placing %s: %s; parking the %s arm and looking again", obj.name, problem[1], arm)
+    if obj.gone or problem is not None:
+        # the arm in its carry pose may hide the object (or its top), and a look may miss what is
+        # there (a missed detection): park the arm and look again before believing the look
+        why = "not seen" if problem is None else problem[1]
+        log.info("placing %s: %s; parking the %s arm and looking again", obj.name, why, arm)
         motion(type="setting_arm_configuration", arm=arm, configuration="park")
         motion(type="pointing_head", coordinates=list(spot))
         motion(type="detecting", object=obj.type)

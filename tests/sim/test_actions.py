@@ -290,6 +290,34 @@ def test_perception_tells_a_toppled_object_from_a_standing_one(type_name, tells)
         assert tells in problem[1]
 
 
+def test_a_look_after_placing_that_misses_the_object_is_taken_again():
+    # the first look after letting go misses the cup (a missed detection, as perception faults
+    # make them): Place parks the arm, looks again and succeeds -- not PlacingFailed 'not seen'
+    from pycram.sim.perception import PerceptionFaults
+
+    with apartment_with("pr2", {"cup": COUNTER}) as (world, robot):
+        ready()
+        held = perform(PickUp(ObjectDesignator(type="cup")))
+        original, missed = world.detect, []
+
+        def detect_missing_once(*args, **kwargs):
+            if missed or "cup" in holding(world):
+                return original(*args, **kwargs)
+            saved, world.perception_faults = world.perception_faults, PerceptionFaults(miss_probability=1.0)
+            try:
+                handle = original(*args, **kwargs)
+                report = ok(handle)
+            finally:
+                world.perception_faults = saved
+            missed.append(report)
+            return handle
+
+        world.detect = detect_missing_once
+        obj = perform(Place(held, "table"))
+        assert missed and not any(d.type == "cup" for d in missed[0].detections)
+        assert rests_upright_at(world, "cup", "table", obj.pose[:2]) and not obj.gone
+
+
 def test_placing_raises_placing_failed_when_the_object_ends_toppled_over():
     # a person knocks the carton over as soon as the hand has let go and backed off: Place
     # must not report success (the post-condition looks at the measured height)
