@@ -156,6 +156,20 @@ def _container(action: str, designator: ActionDesignator) -> tuple[Any, Any, Any
     return belief, environment, container
 
 
+def _torso_and_drive(location: Any) -> None:
+    """Set the torso `location` needs (if any), then drive there -- unless the base already
+    stands at it (within `AT_POSE` [m, rad])."""
+    if location.torso is not None:
+        motion(type="setting_torso", position=location.torso)
+    here = base_pose_fluent().get_value()
+    if (
+        here is None
+        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
+        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
+    ):
+        motion(type="moving", pose=location)
+
+
 def _measure(belief: Any, container: Any, expected: float | None = None) -> float | None:
     """Look at the handle; the opening [m or rad] perception measured (None when it could not).
 
@@ -189,15 +203,7 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
         motion(type="setting_arm_configuration", arm=arm, configuration=raised)
     except RECOVERABLE as error:  # e.g. close to the furniture after a failed attempt
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
-    if location.torso is not None:  # the handle is too low or too high for the torso as it was
-        motion(type="setting_torso", position=location.torso)
-    here = base_pose_fluent().get_value()
-    if (
-        here is None
-        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
-        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
-    ):
-        motion(type="moving", pose=location)
+    _torso_and_drive(location)  # the torso: the handle may be too low or too high for it as it was
     start = _measure(belief, container)
     start = 0.0 if start is None else start
     if container.kind == "door":
@@ -603,15 +609,7 @@ def _push_door(location: Any, belief: Any, container: Any, goal: float) -> float
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="park"),
         lambda: motion(type="setting_gripper", gripper=gripper, position=fraction),
     )
-    if location.torso is not None:
-        motion(type="setting_torso", position=location.torso)
-    here = base_pose_fluent().get_value()
-    if (
-        here is None
-        or math.hypot(here.x - location.x, here.y - location.y) > AT_POSE
-        or abs(math.remainder(here.yaw - location.yaw, math.tau)) > AT_POSE
-    ):
-        motion(type="moving", pose=location)
+    _torso_and_drive(location)
     start = _measure(belief, container)
     start = belief.container_states.get(container.name, 0.0) if start is None else start
     closing = goal <= 0.0
