@@ -253,6 +253,17 @@ def ask_for_help(request: str) -> None:
         motion(type="waiting_for_help", request=request, gripper=GRIPPER)
 
 
+def get_the_item_back() -> None:
+    """The item was taken from the gripper: stop, ask for it back, close the gripper on it, and
+    raise `ItemLost` (for `transport` to retry)."""
+    log.warning("the item was taken from the gripper: stopping")
+    motion(type="cancelling_movement")
+    motion(type="setting_gripper", gripper=GRIPPER, position=1)
+    ask_for_help("Put the item back into the gripper")
+    motion(type="setting_gripper", gripper=GRIPPER, position=0)
+    raise ItemLost("the item was taken from the gripper")
+
+
 @as_task
 @plan
 def transport() -> None:
@@ -265,13 +276,10 @@ def transport() -> None:
             arrived = within(CLOSE_ENOUGH)
             item_lost.OR(arrived).wait_for()
             if item_lost.get_value():
-                log.warning("the item was taken from the gripper: stopping")
-                motion(type="cancelling_movement")
-                motion(type="setting_gripper", gripper=GRIPPER, position=1)
-                ask_for_help("Put the item back into the gripper")
-                motion(type="setting_gripper", gripper=GRIPPER, position=0)
-                raise ItemLost("the item was taken from the gripper")
+                get_the_item_back()
             assert drive is not None  # started above: the gripper held the item, or it was lost
             drive.wait()  # the last 10 cm
+            if item_lost.get_value():  # taken on the last stretch (or its news came late, over ROS)
+                get_the_item_back()
         except ItemLost:
             retry()
