@@ -87,6 +87,16 @@ def tasks_named(root: Any, prefix: str) -> list[Any]:
     return [t for t in root.walk() if str(t.name).startswith(prefix)]
 
 
+def held_fluent(world: World, item: str) -> Any:
+    """A fluent over the world's gripper states: True while a gripper holds `item`, else None."""
+    from pycram.fluent import Fluent
+
+    held = Fluent(lambda: True if item in holding(world) else None)
+    for f in world.gripper_states.values():
+        f.add_child(held)
+    return held
+
+
 class OnceHolding:
     """Runs `action(world)` in a thread of its own once the robot holds `item` and its base has
     moved `distance` [m] from where it grasped it (a person acting while the robot carries).
@@ -102,10 +112,7 @@ class OnceHolding:
     def _run(self) -> None:
         from pycram.fluent import Fluent
 
-        held = Fluent(lambda: True if self.item in holding(self.world) else None)
-        for f in self.world.gripper_states.values():
-            f.add_child(held)
-        if not held.wait_for(600.0):
+        if not held_fluent(self.world, self.item).wait_for(600.0):
             self.done.set()
             return
         start = self.world.base_pose.get_value()
@@ -145,10 +152,7 @@ class KnockOverOnceLetGo:
         from pycram.fluent import Fluent
 
         w = self.world
-        held = Fluent(lambda: True if self.item in holding(w) else None)
-        for f in w.gripper_states.values():
-            f.add_child(held)
-        if held.wait_for(600.0):
+        if held_fluent(w, self.item).wait_for(600.0):
 
             def let_go_and_away() -> bool | None:
                 if self.item in holding(w):
