@@ -47,6 +47,7 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.location import LocationDesignator
 from pycram.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
 from pycram.locations import doors
+from pycram.locations.reasoning import DRAWER_PUSH_BEYOND
 from pycram.robot import current_robot
 
 from .core import (
@@ -90,8 +91,9 @@ HANDLE_OPENING = 0.008
 AT_POSE = 0.03
 #: A push that stopped short goes on from this much [m] nearer to the drawer.
 STEP_IN = 0.15
-#: Closing pushes the handle this far [m] beyond closed (the slide's stop holds the drawer).
-PUSH_BEYOND = 0.03
+#: Closing pushes the handle this far [m] beyond closed (the slide's stop holds the drawer; the
+#: standing poses are checked for it).
+PUSH_BEYOND = DRAWER_PUSH_BEYOND
 #: A drawer counts as closed below this opening [m], as opened when within this of its goal --
 #: or at least `USEFUL_OPENING` [m] out (enough to look and reach in).
 CLOSED, OPEN_TOLERANCE, USEFUL_OPENING = 0.03, 0.06, 0.15
@@ -210,7 +212,9 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
         if abs(start - goal) < DOOR_TOLERANCE / 2:
             return start
         return _swing_door(location, belief, container, start, goal)
-    if abs(start - goal) < OPEN_TOLERANCE / 2:
+    # closing: nothing to do only when closed (the criterion below); a drawer ajar by less than
+    # `OPEN_TOLERANCE / 2` was not pushed at all, and a push that stopped short left it so
+    if (start < CLOSED) if goal == 0.0 else (abs(start - goal) < OPEN_TOLERANCE / 2):
         return start
     handle = list(container.handle_position(start))
     motion(type="reaching", arm=arm, target=handle, phase="pre_grasp", grasp=grasp)
@@ -222,23 +226,29 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
             f"the {gripper} gripper closed beside the handle of {container.name!r} (opening {opening * 1000:.1f} mm)",
             container.name,
         )
-    reached = handle
+    # The hand lets go where it is: between the last handle position reached and the one it
+    # went for. It backs off from the one nearer the robot (the larger opening), so that the
+    # fingers come off the bar -- backing off from a push's unreached goal left them round it,
+    # and the arm going up pulled the drawer out again.
+    steps = [start + (goal - start) * k / PULL_STEPS for k in range(1, PULL_STEPS + 1)]
+    if goal == 0.0:
+        steps.append(-PUSH_BEYOND)  # against the stop (best effort): a drawer pushed to 0 may stay ajar
+    reached_q = start
+    let_go_at = start
     try:
-        for k in range(1, PULL_STEPS + 1):
-            q = start + (goal - start) * k / PULL_STEPS
-            beyond = goal == 0.0 and k == PULL_STEPS
-            if beyond:
-                q = -PUSH_BEYOND  # against the stop: a drawer pushed exactly to 0 stays ajar
-            reached = list(container.handle_position(q))
+        for k, q in enumerate(steps, start=1):
+            beyond = q < 0.0
+            let_go_at = max(reached_q, q)
             try:
-                motion(type="reaching", arm=arm, target=reached, grasp=grasp)
+                motion(type="reaching", arm=arm, target=list(container.handle_position(q)), grasp=grasp)
             except RECOVERABLE as error:
                 if getattr(unwrap(error), "reason", None) != "blocked" and not beyond:
                     raise
                 log.info("%s: the handle stopped moving at step %d: %s", container.name, k, unwrap(error))
                 break
+            reached_q = let_go_at = q
     finally:
-        _release(arm, gripper, reached, grasp)
+        _release(arm, gripper, list(container.handle_position(let_go_at)), grasp)
     measured = _measure(belief, container)
     if measured is None:
         raise ContainerFailure(f"could not see the handle of {container.name!r} after moving it", container.name)
@@ -431,8 +441,12 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
     goal = goal_of(container)
     if container.kind == "door":
         return _operate_door(action, designator, belief, container, arm, goal)
-    travel = max(goal, belief.container_states.get(container.name, 0.0), 0.05)
-    poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=action == "closing")
+    closing = action == "closing"
+    # the trajectory the reasoning checks: from where the drawer is believed to be to the goal
+    # (closing: all the way in -- checking only where the handle is now found poses from which
+    # the arm could not push the handle home)
+    travel = 0.0 if closing else max(goal, belief.container_states.get(container.name, 0.0), 0.05)
+    poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=closing)
     measured = _try_poses(
         action, designator, container, poses, partial(_move_handle, belief=belief, container=container, goal=goal)
     )

@@ -101,6 +101,10 @@ RIM_CLEARANCE = 0.04
 DRAWER_CLEARANCE = 0.08
 #: How far [m] a drawer's handle bar reaches beyond its grasp point (the bar's half thickness).
 HANDLE_DEPTH = 0.015
+#: Closing a drawer, the hand pushes its handle this far [m] beyond closed (against the slide's
+#: stop: the bar sits loose between the fingers, and a drawer pushed to exactly 0 stays ajar).
+#: Standing poses for closing a drawer are checked for it too.
+DRAWER_PUSH_BEYOND = 0.03
 #: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
 TOP_PENALTY = 0.3
 #: Pushing a door: base headings tried per cell, relative to the one that puts the push's first
@@ -584,10 +588,26 @@ class LocationReasoner:
         steps = [start + (opening - start) * k / 3 for k in range(4)]
         trajectory = [container.handle_position(q) for q in steps]
         headings = [self._pull_heading(container, q) for q in steps]
+        # closing a drawer: the push home beyond closed must be reachable too (not checked for
+        # opening: the poses that reach it stand so close that the pull stalls)
+        beyond = (
+            container.handle_position(-DRAWER_PUSH_BEYOND)
+            if container.kind == "drawer" and opening <= 0.0 < start
+            else None
+        )
         arms = self._arms(desig.prop_value("arm"))
         grid = FloorGrid.of(env)
-        swept = self._swept_rects(container, opening)
-        occupancy = occupancy_layer(env, grid, self._base_radius, swept)
+        # the drawer out as far as it is or will be: the base may come as close to it as to an
+        # open drawer in ``to_reach`` (each candidate is checked against the drawer pulled out)
+        furthest = max(opening, start)
+        occupancy = occupancy_layer(env, grid, self._base_radius)
+        swept = self._swept_rects(container, furthest)
+        if swept:
+            occupancy = occupancy.copy()
+            near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
+            for rect in swept:
+                occupancy[rect_distance(grid, rect) < near] = np.inf
+        pulled_out = {container.joint_name: furthest} if swept else {}
         if container.kind == "door":
             occupancy = occupancy.copy()
             assert container.hinge is not None  # a door has its hinge (checked by Container)
@@ -615,7 +635,7 @@ class LocationReasoner:
             x, y = maps[arm].xy(r, c)
             yaw = _wrap(math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm))
             prosp = self.prospection()
-            if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+            if prosp.in_collision((x, y, yaw), {**self.geometry.tucked, **pulled_out}):
                 return None, ("in collision", None)
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
@@ -633,7 +653,17 @@ class LocationReasoner:
             ]
             poses += [(p, hold) for p in trajectory[1:]]
             handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
-            answer = prosp.reachable(arm, poses, (x, y, yaw), self.geometry.tucked)
+
+            def reachable(configuration: dict[str, float]) -> Any:
+                answer = prosp.reachable(arm, poses, (x, y, yaw), configuration)
+                if not answer or beyond is None:
+                    return answer
+                # the push home against the stop: the hand touches the drawer's front there (a
+                # collision is expected), but the arm must reach it -- else the drawer stays ajar
+                home = prosp.reachable(arm, [(beyond, hold)], (x, y, yaw), configuration)
+                return answer if home or home.reason == "collision" else home
+
+            answer = reachable(self.geometry.tucked)
             if answer:
                 return (
                     BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions, tool_poses=tuple(poses)),
@@ -644,9 +674,9 @@ class LocationReasoner:
                 joint = self.geometry.torso_joint
                 assert joint is not None  # there are other torso heights only with a torso joint
                 configuration = {**self.geometry.tucked, joint: height}
-                if prosp.in_collision((x, y, yaw), configuration):
+                if prosp.in_collision((x, y, yaw), {**configuration, **pulled_out}):
                     continue
-                other = prosp.reachable(arm, poses, (x, y, yaw), configuration)
+                other = reachable(configuration)
                 if other:
                     location = BaseLocation(
                         x, y, yaw, arm, handle_grasp, cost, joints=other.solutions, tool_poses=tuple(poses), torso=torso
