@@ -654,7 +654,7 @@ class LocationReasoner:
             poses += [(p, hold) for p in trajectory[1:]]
             handle_grasp = "front_vertical" if container.kind == "drawer" else "front"
 
-            def reachable(configuration: dict[str, float]) -> Any:
+            def reachable(configuration: Mapping[str, float]) -> Any:
                 answer = prosp.reachable(arm, poses, (x, y, yaw), configuration)
                 if not answer or beyond is None:
                     return answer

@@ -42,14 +42,13 @@ def in_drawer(number: int) -> tuple[str, tuple[float, float]]:
         ("pr2", "cup", 3, "left"),
         ("pr2", "mug", 2, None),
         ("tiago", "cup", 2, None),
+        ("tiago", "cup", 3, None),
         ("tiago", "mug", 2, None),
     ],
 )
 def test_a_cup_or_mug_is_picked_from_the_top_out_of_an_opened_drawer_and_placed_upright(
     robot_name, type_name, drawer, arm
 ):
-    # Not the TIAGo in drawer 3: its Open of drawer 3 misses the handle in about half of the runs
-    # (HandleMissed, as on main); see docs/actions.md.
     name = f"drawer {drawer}"
     with apartment_with(robot_name, {type_name: in_drawer(drawer)}) as (world, robot):
         ready()
