@@ -173,12 +173,14 @@ def _torso_and_drive(location: Any) -> None:
 
 
 def _measure(belief: Any, container: Any, expected: float | None = None) -> float | None:
-    """Look at the handle; the opening [m or rad] perception measured (None when it could not).
+    """Look at the handle; the opening [m or rad] perception measured (None when these looks did
+    not measure it: an older value of the belief is no measurement).
 
     With `expected` (where the container should be now, far from where it is believed to be) the
     head looks there first and then where it was believed to be: perception measures the
     container whenever its handle is in view, so the belief ends with what was seen."""
     believed = belief.container_states.get(container.name, 0.0)
+    before = belief.container_stamps.get(container.name)
     looks = [believed]
     if expected is not None and abs(expected - believed) > DOOR_TOLERANCE:
         looks.insert(0, expected)
@@ -189,8 +191,9 @@ def _measure(belief: Any, container: Any, expected: float | None = None) -> floa
             partial(motion, type="pointing_head", coordinates=list(container.handle_position(q))),
         )
         motion(type="detecting")
-    measured = belief.container_states.get(container.name)
-    return None if measured is None else float(measured)
+    if belief.container_stamps.get(container.name) == before:  # not measured by these looks
+        return None
+    return float(belief.container_states[container.name])
 
 
 def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> float:
@@ -207,7 +210,7 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
         log.info("%s: arm up before driving: %s", container.name, unwrap(error))
     _torso_and_drive(location)  # the torso: the handle may be too low or too high for it as it was
     start = _measure(belief, container)
-    start = 0.0 if start is None else start
+    start = belief.container_states.get(container.name, 0.0) if start is None else start  # as last seen
     if container.kind == "door":
         if abs(start - goal) < DOOR_TOLERANCE / 2:
             return start
@@ -594,9 +597,13 @@ def _door_push_contact() -> Any:
 def _push_poses(container: Any, arm: str | None, goal: float, side: str) -> Any:
     """Solutions of ``('to_open', door), ('pushing', side)``: where to stand to push the door's
     `side` face from its believed angle to `goal` [rad]. The grippers are set as the robot
-    pushes with them first (``DOOR_PUSH[side]['gripper']``, a fraction open; default closed):
-    the reasoning checks the robot as it is."""
-    fraction = float(_door_push_contact()[side].get("gripper", 0.0))
+    pushes with them first (``DOOR_PUSH[side]['gripper']``, a fraction open; default closed),
+    the torso to ``DOOR_PUSH[side]['torso']`` (if given): the reasoning checks the robot as it
+    is."""
+    contact = _door_push_contact()[side]
+    fraction = float(contact.get("gripper", 0.0))
+    if contact.get("torso") is not None:  # the reasoning checks the robot at the height it pushes at
+        motion(type="setting_torso", position=contact["torso"])
     for hand in [arm] if arm is not None else arms():
         best_effort(
             "setting a hand to push",

@@ -282,6 +282,8 @@ class BeliefState(Belief):
         self.environment = environment
         self.gate = gate
         self.container_states: dict[str, float] = {}
+        #: When [s, the reports' clock] each container was last measured.
+        self.container_stamps: dict[str, float] = {}
         self._counts: dict[str, int] = {}
         self._update_lock = threading.Lock()
         #: The most recent looks (at most `MAX_LOOKS`), oldest first.
@@ -313,6 +315,7 @@ class BeliefState(Belief):
         """Fold `report` into the belief (see the module's description); returns what changed."""
         with self._update_lock:
             self.container_states.update(report.container_states)
+            self.container_stamps.update(dict.fromkeys(report.container_states, report.stamp))
             known = [o for o in self.objects() if isinstance(o, PerceivedObject)]
             pairs = sorted(
                 (

@@ -86,6 +86,9 @@ def test_the_tiago_pulls_the_fridge_door_by_its_handle_pushes_it_open_from_insid
         pulled = [n for n in attempts if "arm" in n]
         pushed = [n for n in attempts if "pushing" in n]
         assert pulled and pushed and attempts.index(pulled[0]) < attempts.index(pushed[0]), attempts
+        # the torso left down (as a low drawer leaves it): pushing raises it, or the arm's way to
+        # the second push stage crosses the door and knocks it open again
+        perform(MoveTorso("down"))
         measured = perform(Close("fridge"))
         assert opening_of(world, "fridge") < math.radians(4)
         assert abs(measured - opening_of(world, "fridge")) < math.radians(1)
@@ -174,8 +177,8 @@ def apartment(request):
 @pytest.mark.parametrize("name", CONTAINERS)
 def test_each_container_is_opened_and_closed_again(apartment, name):
     robot_name, world, robot = apartment
-    # each from the ready pose: the TIAGo with its torso left down by a low drawer knocks the
-    # fridge door open again while pushing it shut (see docs/actions.md)
+    # each from the ready pose: the TIAGo opening the fridge with its torso down from the start
+    # leaves door and robot where closing finds no path to a push pose (see docs/actions.md)
     perform(ParkArms())
     perform(MoveTorso("up"))
 
