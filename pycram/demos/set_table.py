@@ -80,15 +80,16 @@ START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
 #: Objects that may start inside a closed container, as data: object type -> (probability,
 #: {inside surface: region (x0, y0, x1, y1) [m, map, the container closed]}). Drawn from the
 #: seed after the object's spot in `START_REGIONS` (so every other object starts where it did
-#: without containers). Measured (docs/set-table.md): cups and bowls are picked from the top out
-#: of drawer 2 by both robots, 15-25 cm behind its front, mid-width. Not drawer 3 (the TIAGo
-#: opened it but did not see the object, 0 of 2), not drawer 1 (too low to pick from), not the
-#: plate (it does not fit a drawer: `found_on`), not the milk in the fridge (neither robot
-#: finds a standing pose to grasp it on a shelf: the opened door stands in front of the west
-#: half, the raised arm and the side grasps hit the fridge's side wall and shelf boards).
+#: without containers). Measured (docs/set-table.md): cups are picked from the top out of
+#: drawer 2 by both robots, 15-22 cm behind its front, mid-width (0.24 m off the middle the
+#: TIAGo's look into the opened drawer did not see the cup). Not drawer 3 (the TIAGo opened it
+#: but did not see the object, 0 of 2), not drawer 1 (too low to pick from), not the bowl (the
+#: PR2's rim grasp out of drawer 2 failed or dropped it in 3 of 4 runs), not the plate (it does
+#: not fit a drawer: `found_on`), not the milk in the fridge (neither robot finds a standing
+#: pose to grasp it on a shelf: the opened door stands in front of the west half, the raised
+#: arm and the side grasps hit the fridge's side wall and shelf boards).
 START_CONTAINERS: dict[str, tuple[float, dict[str, tuple[float, float, float, float]]]] = {
-    "bowl": (0.35, {"drawer 2 inside": (0.35, 2.65, 0.45, 3.15)}),
-    "cup": (0.35, {"drawer 2 inside": (0.35, 2.65, 0.45, 3.15)}),
+    "cup": (0.35, {"drawer 2 inside": (0.38, 2.82, 0.45, 2.98)}),
 }
 #: Objects start at least this far [m] apart (between their footprints): an arm reaching for one
 #: object knocks over a neighbour closer than this (measured: tall milk cartons and cups).
