@@ -167,7 +167,9 @@ def lookouts(
         if _free(environment, stand[0], stand[1]):
             cx, cy, h = surface.centroid
             out.append(Lookout(surface.name, surface.name, (cx, cy, h + 0.05), stand, container.name))
-    return sorted(out, key=lambda lk: math.dist(near, lk.stand[:2]))
+    # places seen from the same standing pose (a cabinet's drawers): the highest first -- an
+    # upper drawer is opened and closed more easily than the ones below it
+    return sorted(out, key=lambda lk: (math.dist(near, lk.stand[:2]), -lk.target[2]))
 
 
 def _robot_belief() -> BeliefState:

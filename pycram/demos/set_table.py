@@ -40,6 +40,7 @@ from pycram.demos.set_table_plan import PlaceSetting, PlanRecord, SettingOutcome
 __all__ = [
     "OBJECTS",
     "START_REGIONS",
+    "START_CONTAINERS",
     "START_SPACING",
     "start_scene",
     "SEAT",
@@ -67,18 +68,28 @@ OBJECTS = ("plate", "bowl", "cup", "milk")
 #: Where objects start, as data: object type -> the supports (surface names) it may start on,
 #: each with the region (x0, y0, x1, y1) [m, map] where it may stand: the front strips of the
 #: kitchen counter and of the drawer cabinet's top. Measured: the counter's back half is out of
-#: both robots' reach; side grasps of tall objects need the pre-grasp off the counter; objects
-#: inside the drawers cannot be picked up yet (side grasps hit the drawer's walls, the robot does
-#: not fit in front of a fully opened drawer) and the fridge was left out (doors could not be
-#: opened when these figures were measured) -- so the
-#: drawers are searched (with the ``missed`` fault) but no object starts in them. The milk
+#: both robots' reach; side grasps of tall objects need the pre-grasp off the counter. The milk
 #: carton starts on the counter only: on the cabinet top the PR2's arm knocked it over in 2 of
-#: 12 seeds.
+#: 12 seeds. (Inside containers: `START_CONTAINERS`.)
 START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
     "plate": {"counter": (0.5, 4.54, 2.4, 4.56), "cabinet top": (0.42, 2.6, 0.45, 3.15)},
     "bowl": {"counter": (0.5, 4.5, 2.4, 4.55), "cabinet top": (0.42, 2.6, 0.5, 3.15)},
     "cup": {"counter": (0.5, 4.46, 2.4, 4.52), "cabinet top": (0.45, 2.6, 0.54, 3.15)},
     "milk": {"counter": (0.5, 4.47, 2.4, 4.5)},  # on the cabinet top the arm knocks it over
+}
+#: Objects that may start inside a closed container, as data: object type -> (probability,
+#: {inside surface: region (x0, y0, x1, y1) [m, map, the container closed]}). Drawn from the
+#: seed after the object's spot in `START_REGIONS` (so every other object starts where it did
+#: without containers). Measured (docs/set-table.md): cups are picked from the top out of
+#: drawer 2 by both robots, 15-22 cm behind its front, mid-width (0.24 m off the middle the
+#: TIAGo's look into the opened drawer did not see the cup). Not drawer 3 (the TIAGo opened it
+#: but did not see the object, 0 of 2), not drawer 1 (too low to pick from), not the bowl (the
+#: PR2's rim grasp out of drawer 2 failed or dropped it in 3 of 4 runs), not the plate (it does
+#: not fit a drawer: `found_on`), not the milk in the fridge (neither robot finds a standing
+#: pose to grasp it on a shelf: the opened door stands in front of the west half, the raised
+#: arm and the side grasps hit the fridge's side wall and shelf boards).
+START_CONTAINERS: dict[str, tuple[float, dict[str, tuple[float, float, float, float]]]] = {
+    "cup": (0.35, {"drawer 2 inside": (0.38, 2.82, 0.45, 2.98)}),
 }
 #: Objects start at least this far [m] apart (between their footprints): an arm reaching for one
 #: object knocks over a neighbour closer than this (measured: tall milk cartons and cups).
@@ -540,40 +551,64 @@ def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS)
     """Where `objects` start (`pycram.world.scenes.Placement`s), drawn from `seed`: a support of
     a kind the object is found on among `START_REGIONS`, a spot in its region clear of the
     others, a random yaw (boxes roughly square to the counter's edge: perception does not
-    measure yaw). The same seed gives the same scene."""
+    measure yaw). Then, with the probability of `START_CONTAINERS` (from a second random stream
+    of the seed, so the open-surface spots stay those of a scene without containers), an object
+    is moved inside a closed container instead (`Placement.container` names it). The same seed
+    gives the same scene."""
+    rng = random.Random(seed)
+    inside = random.Random(seed * 7907 + 3)  # the draws of starts in containers
+    drawn: list[Any] = []  # every object's spot on an open surface, as without containers
+    placed: list[Any] = []
+    for name in objects:
+        candidate = _start_spot(environment, name, START_REGIONS[name], drawn, rng)
+        if candidate is None:
+            raise RuntimeError(f"no free start spot for the {name} (seed {seed})")
+        drawn.append(candidate)
+        if name in START_CONTAINERS:
+            probability, containers = START_CONTAINERS[name]
+            if inside.random() < probability:
+                others = [p for p in placed if p.container is not None]
+                candidate = _start_spot(environment, name, containers, others, inside) or candidate
+        placed.append(candidate)
+    return placed
+
+
+def _start_spot(
+    environment: Any,
+    name: str,
+    regions: dict[str, tuple[float, float, float, float]],
+    placed: list[Any],
+    rng: random.Random,
+) -> Any:
+    """A `Placement` of `name` on one of `regions` (support name -> region [m, map]), drawn from
+    `rng`, at least `START_SPACING` from each of `placed`; None after 500 tries."""
     from pycram.world.objects import object_type
     from pycram.world.scenes import GAP, Placement
 
-    rng = random.Random(seed)
-    placed: list[Placement] = []
-    for name in objects:
-        otype = object_type(name)
-        supports = list(START_REGIONS[name])
-        for _ in range(500):
-            support = rng.choice(supports)
-            surface = environment.surface(support)
-            x0, y0, x1, y1 = START_REGIONS[name][support]
-            x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
-            if otype.shape == "box":
-                yaw = rng.choice((0.0, math.pi / 2, math.pi, -math.pi / 2)) + rng.uniform(-0.15, 0.15)
-            else:
-                yaw = rng.uniform(-math.pi, math.pi)
-            container = environment.container_of(support)
-            candidate = Placement(
-                name,
-                name,
-                support,
-                None if container is None else container.name,
-                (x, y, surface.height + otype.half_height + 0.001),
-                yaw,
-                otype.footprint_radius,
-            )
-            if not any(candidate.overlaps(other, GAP + START_SPACING) for other in placed):
-                placed.append(candidate)
-                break
+    otype = object_type(name)
+    supports = list(regions)
+    for _ in range(500):
+        support = rng.choice(supports)
+        surface = environment.surface(support)
+        x0, y0, x1, y1 = regions[support]
+        x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
+        if otype.shape == "box":
+            yaw = rng.choice((0.0, math.pi / 2, math.pi, -math.pi / 2)) + rng.uniform(-0.15, 0.15)
         else:
-            raise RuntimeError(f"no free start spot for the {name} (seed {seed})")
-    return placed
+            yaw = rng.uniform(-math.pi, math.pi)
+        container = environment.container_of(support)
+        candidate = Placement(
+            name,
+            name,
+            support,
+            None if container is None else container.name,
+            (x, y, surface.height + otype.half_height + 0.001),
+            yaw,
+            otype.footprint_radius,
+        )
+        if not any(candidate.overlaps(other, GAP + START_SPACING) for other in placed):
+            return candidate
+    return None
 
 
 def open_world(
