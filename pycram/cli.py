@@ -424,7 +424,8 @@ def demo_command(
     scenario: str = typer.Option(
         "thesis",
         "--scenario",
-        help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the apartment.",
+        help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the "
+        "apartment; set-table-containers: the same, some objects starting inside closed drawers.",
     ),
     faults: str = typer.Option(
         "",
@@ -436,10 +437,10 @@ def demo_command(
     or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
     if output is not None:
         _check_output_folder(output)
-    scenarios = ("thesis", "set-table")
+    scenarios = ("thesis", "set-table", "set-table-containers")
     if scenario not in scenarios:
         _fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
-    if scenario == "set-table":
+    if scenario.startswith("set-table"):
         from pycram.demos.set_table import main as set_table_main
 
         code = _trace_errors(
@@ -452,6 +453,7 @@ def demo_command(
             record=_record_flag(record),
             quiet=quiet,
             animation=animation,
+            in_containers=scenario == "set-table-containers",
         )
         raise typer.Exit(int(code or 0))
     if faults:
@@ -687,7 +689,7 @@ def experiment_command(
     scenario: str | None = typer.Option(
         None,
         "--scenario",
-        help="Scenario: thesis (default), set-table, or an import path package.module:function.",
+        help="Scenario: thesis (default), set-table, set-table-containers, or an import path package.module:function.",
     ),
     robot: str | None = typer.Option(None, "--robot", help="Robots, comma-separated: pr2,tiago [default: pr2]."),
     seeds: str | None = typer.Option(None, "--seeds", help="Seeds: a range 1-200, a list 1,5,9 or both (1,5,10-20)."),

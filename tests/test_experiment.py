@@ -203,7 +203,10 @@ def test_set_table_is_registered_lazily():
     try:
         import pycram.demos.set_table  # noqa: F401
     except ModuleNotFoundError:
-        with pytest.raises(UnknownScenario, match="set-table.*does not exist.*available scenarios: set-table, thesis"):
+        with pytest.raises(
+            UnknownScenario,
+            match="set-table.*does not exist.*available scenarios: set-table, set-table-containers, thesis",
+        ):
             get_scenario("set-table")
     else:
         assert callable(get_scenario("set-table").load())

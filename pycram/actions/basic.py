@@ -30,7 +30,6 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.designators.perform import perform
 from pycram.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
 from pycram.language import State, par
 
@@ -233,6 +232,6 @@ def searching(designator: ActionDesignator) -> Any:
         wanted = ObjectDesignator(type=wanted)
     if not isinstance(wanted, ObjectDesignator):
         raise ActionParameterError("searching", "object", f"needs an object designator or a type name, got {wanted!r}")
-    from .containers import Open
+    from .containers import opening_one_at_a_time
 
-    return search_for(wanted, open_container=lambda name: perform(Open(name)))
+    return search_for(wanted, open_container=opening_one_at_a_time())

@@ -40,11 +40,13 @@ from __future__ import annotations
 import logging
 import math
 import weakref
+from collections.abc import Callable
 from functools import partial
 from typing import Any
 
 from pycram.designators.action import ActionDesignator
 from pycram.designators.location import LocationDesignator
+from pycram.designators.perform import perform
 from pycram.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
 from pycram.locations import doors
 from pycram.locations.reasoning import DRAWER_PUSH_BEYOND
@@ -69,6 +71,7 @@ from .core import (
 __all__ = [
     "Open",
     "Close",
+    "opening_one_at_a_time",
     "DRAWER_OPENING",
     "DOOR_OPENING",
     "CONTAINER_ATTEMPTS",
@@ -91,6 +94,8 @@ HANDLE_OPENING = 0.008
 AT_POSE = 0.03
 #: A push that stopped short goes on from this much [m] nearer to the drawer.
 STEP_IN = 0.15
+#: A stage of closing a drawer (`_close_drawer`) counts as progress when it pushes it in this far [m].
+MIN_PUSH_GAIN = 0.05
 #: Closing pushes the handle this far [m] beyond closed (the slide's stop holds the drawer; the
 #: standing poses are checked for it).
 PUSH_BEYOND = DRAWER_PUSH_BEYOND
@@ -131,6 +136,30 @@ def Open(container: str, arm: str | None = None, opening: float | None = None) -
 def Close(container: str, arm: str | None = None) -> ActionDesignator:
     """Close the drawer or door `container`. Returns the measured opening [m or rad] afterwards."""
     return make_action("closing", container=container, arm=arm)
+
+
+def opening_one_at_a_time() -> Callable[[str], Any]:
+    """An ``open_container`` for `pycram.actions.search.search_for`: opens a container with
+    `Open` after closing the one it opened before, if that is still believed open (a search
+    looking into one drawer after another leaves at most the last one open: an open drawer
+    stands in the way of the robot and of opening the drawers below it). A container that will
+    not close is logged and left."""
+    opened: list[str] = []
+
+    def open_next(name: str) -> Any:
+        belief = getattr(current_robot(), "belief", None)
+        while opened:
+            previous = opened.pop()
+            if previous != name and belief is not None and belief.container_open(previous) is True:
+                try:
+                    perform(Close(previous))
+                except RECOVERABLE as error:
+                    log.warning("could not close %s before opening %s: %s", previous, name, unwrap(error))
+        result = perform(Open(name))
+        opened.append(name)
+        return result
+
+    return open_next
 
 
 def _environment() -> Any:
@@ -444,16 +473,50 @@ def _operate(action: str, designator: ActionDesignator, goal_of: Any) -> float:
     goal = goal_of(container)
     if container.kind == "door":
         return _operate_door(action, designator, belief, container, arm, goal)
-    closing = action == "closing"
+    if action == "closing":
+        return _close_drawer(designator, belief, container, arm)
     # the trajectory the reasoning checks: from where the drawer is believed to be to the goal
-    # (closing: all the way in -- checking only where the handle is now found poses from which
-    # the arm could not push the handle home)
-    travel = 0.0 if closing else max(goal, belief.container_states.get(container.name, 0.0), 0.05)
-    poses = _standing_poses(container, arm, min(travel, container.limits[1]), closing=closing)
+    travel = max(goal, belief.container_states.get(container.name, 0.0), 0.05)
+    poses = _standing_poses(container, arm, min(travel, container.limits[1]))
     measured = _try_poses(
         action, designator, container, poses, partial(_move_handle, belief=belief, container=container, goal=goal)
     )
     return measured
+
+
+def _close_drawer(designator: ActionDesignator, belief: Any, container: Any, arm: str | None) -> float:
+    """Push the drawer `container` home from a standing pose that reaches the whole push (to
+    `DRAWER_PUSH_BEYOND` past closed: checking only where the handle is found poses from which
+    the arm could not push it home). A drawer far out may leave no such pose (the base keeps
+    clear of the drawer as it is): then it is pushed in as far as it goes from a pose reaching
+    its handle where it is, and the whole push is sought again -- stages while each gains at least
+    `MIN_PUSH_GAIN`, at most `CONTAINER_ATTEMPTS`. Raises the last stage's typed failure."""
+    move = partial(_move_handle, belief=belief, container=container, goal=0.0)
+    for _stage in range(CONTAINER_ATTEMPTS):
+        start = belief.container_states.get(container.name, 0.0)
+        try:
+            return _try_poses("closing", designator, container, _standing_poses(container, arm, 0.0, True), move)
+        except (ContainerFailure, ObjectOutOfReach) as whole:
+            if belief.container_states.get(container.name, 0.0) < start - MIN_PUSH_GAIN:
+                continue  # it went part of the way in: seek the whole push again from there
+            log.info("%s: no pose pushes it home from %.2f m: pushing it in part of the way", container.name, start)
+            try:
+                return _try_poses(
+                    "closing",
+                    designator,
+                    container,
+                    _standing_poses(container, arm, min(start, container.limits[1])),
+                    move,
+                )
+            except (ContainerFailure, ObjectOutOfReach):
+                if belief.container_states.get(container.name, 0.0) >= start - MIN_PUSH_GAIN:
+                    raise whole from None  # neither way moved it
+    measured = belief.container_states.get(container.name, 0.0)
+    raise ContainerStuck(
+        f"closing {container.name!r}: still open {measured:.2f} m after {CONTAINER_ATTEMPTS} stages of pushing",
+        container.name,
+        designator,
+    )
 
 
 def _operate_door(

@@ -229,10 +229,10 @@ def believed_object(action: str, wanted: Any) -> PerceivedObject:
 
 
 def _search(description: ObjectDesignator) -> PerceivedObject:
-    """`search_for`, opening closed drawers with the `Open` action."""
-    from .containers import Open
+    """`search_for`, opening closed drawers with the `Open` action, one at a time."""
+    from .containers import opening_one_at_a_time
 
-    found: PerceivedObject = search_for(description, open_container=lambda name: perform(Open(name)))
+    found: PerceivedObject = search_for(description, open_container=opening_one_at_a_time())
     return found
 
 

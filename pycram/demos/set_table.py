@@ -55,13 +55,14 @@ __all__ = [
     "check_faults",
     "judge",
     "run_set_table",
+    "run_set_table_in_containers",
     "run_scenario",
 ]
 
 log = logging.getLogger("pycram.demo")
 
 #: The scenarios of `pycram demo --scenario`.
-SCENARIOS = ("thesis", "set-table")
+SCENARIOS = ("thesis", "set-table", "set-table-containers")
 #: The objects of the breakfast setting, in the order they are brought (types both robots grasp
 #: reliably: spoons are too thin for the fingers, cereal boxes push away; see the docs).
 OBJECTS = ("plate", "bowl", "cup", "milk")
@@ -206,6 +207,8 @@ class SetTableResult:
     #: What the plan's concurrency did (`PlanRecord.as_dict`), and -- measured with the
     #: simulator's truth -- the most objects the robot's grippers held at the same time.
     concurrency: dict[str, Any] = field(default_factory=dict)
+    #: Object -> the closed container it started in (the others started on open surfaces).
+    started_in: dict[str, str] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -247,6 +250,7 @@ class SetTableResult:
             "failure_causes": self.failure_causes,
             "open_containers": dict(self.open_containers),
             "faults_injected": list(self.faults_injected),
+            "started_in": dict(self.started_in),
             "sim_time": self.sim_time,
             "wall_time": self.wall_time,
             "error": self.error,
@@ -547,14 +551,17 @@ class _PlanThread:
         self._thread.join(timeout)
 
 
-def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS) -> list[Any]:
+def start_scene(
+    environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS, in_containers: bool = False
+) -> list[Any]:
     """Where `objects` start (`pycram.world.scenes.Placement`s), drawn from `seed`: a support of
     a kind the object is found on among `START_REGIONS`, a spot in its region clear of the
     others, a random yaw (boxes roughly square to the counter's edge: perception does not
-    measure yaw). Then, with the probability of `START_CONTAINERS` (from a second random stream
-    of the seed, so the open-surface spots stay those of a scene without containers), an object
-    is moved inside a closed container instead (`Placement.container` names it). The same seed
-    gives the same scene."""
+    measure yaw). Then, with `in_containers` (the ``set-table-containers`` scenario) and the
+    probability of `START_CONTAINERS` (from a second random stream of the seed, so the
+    open-surface spots stay those of a scene without containers), an object is moved inside a
+    closed container instead (`Placement.container` names it). The same seed gives the same
+    scene."""
     rng = random.Random(seed)
     inside = random.Random(seed * 7907 + 3)  # the draws of starts in containers
     drawn: list[Any] = []  # every object's spot on an open surface, as without containers
@@ -564,7 +571,7 @@ def start_scene(environment: Any, seed: int, objects: tuple[str, ...] = OBJECTS)
         if candidate is None:
             raise RuntimeError(f"no free start spot for the {name} (seed {seed})")
         drawn.append(candidate)
-        if name in START_CONTAINERS:
+        if in_containers and name in START_CONTAINERS:
             probability, containers = START_CONTAINERS[name]
             if inside.random() < probability:
                 others = [p for p in placed if p.container is not None]
@@ -612,17 +619,22 @@ def _start_spot(
 
 
 def open_world(
-    robot: str, seed: int, faults: frozenset[str] = frozenset(), objects: tuple[str, ...] = OBJECTS
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = False,
 ) -> tuple[Any, list[Any]]:
-    """The apartment with the scenario's objects at random spots from `seed` (`start_scene`)
-    and `robot` at the start pose (perception misses detections with the ``missed`` fault).
-    Returns the world and the placements."""
+    """The apartment with the scenario's objects at random spots from `seed` (`start_scene`,
+    some inside closed containers with `in_containers`) and `robot` at the start pose
+    (perception misses detections with the ``missed`` fault). Returns the world and the
+    placements."""
     from pycram.environments import load as load_environment
     from pycram.sim import ItemSpec, World
     from pycram.sim.perception import PerceptionFaults
     from pycram.world.objects import object_type
 
-    placements = start_scene(load_environment("apartment"), seed, objects)
+    placements = start_scene(load_environment("apartment"), seed, objects, in_containers)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
     world = World(robot, items, environment="apartment", perception_faults=perception)
@@ -649,18 +661,21 @@ def run_scenario(
     animation: bool = False,
     progress: Any = None,
     objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = False,
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
     `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
-    faults)` is called about 4 times a second of wall time while the plan runs. Returns the
+    faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
+    objects may start inside closed containers (`start_scene`). Returns the
     result and the plan's task (the root of its task tree, None if it never started)."""
     from pycram import robots as robot_packages
 
     kinds = _check(robot, seed, faults)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
-    world, placements = open_world(robot, seed, kinds, objects)
+    world, placements = open_world(robot, seed, kinds, objects, in_containers)
+    result.started_in = {p.name: p.container for p in placements if p.container is not None}
     plan: _PlanThread | None = None
     injector: Faults | None = None
     robot_handle = None
@@ -735,15 +750,18 @@ def run_set_table(
     db_url: str | None = None,
     pictures: bool = False,
     objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = False,
 ) -> dict[str, Any]:
     """Run the set-table scenario once, headless and without animation, for `pycram experiment`.
 
     `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
     recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``;
-    `objects`: the object types to bring (a subset of `OBJECTS`, in that order). Returns
+    `objects`: the object types to bring (a subset of `OBJECTS`, in that order);
+    `in_containers`: objects may start inside closed containers (`start_scene`). Returns
     a JSON-serialisable dict: ``success``, ``objects`` (per object: ``placed``, ``failure`` (a
     failure type's name or None), ``reason``), ``failure_causes``, ``sim_time`` [s],
-    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``, and
+    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``,
+    ``started_in`` (object -> the closed container it started in), and
     ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
     driving, searches ended by a sighting, objects carried together) and
     ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
@@ -761,7 +779,9 @@ def run_set_table(
     output = Path("output") / f"set-table-{robot}-{seed}" if pictures else None
     result: SetTableResult | None = None
     try:
-        result, _ = run_scenario(robot, seed, kinds, recorder=recorder, output=output, objects=tuple(objects))
+        result, _ = run_scenario(
+            robot, seed, kinds, recorder=recorder, output=output, objects=tuple(objects), in_containers=in_containers
+        )
     finally:
         run_id = None
         if recorder is not None:
@@ -772,6 +792,18 @@ def run_set_table(
     out = result.as_dict()
     out["run_id"] = run_id
     return out
+
+
+def run_set_table_in_containers(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    db_url: str | None = None,
+    pictures: bool = False,
+) -> dict[str, Any]:
+    """The ``set-table-containers`` scenario of `pycram experiment`: `run_set_table` with
+    objects that may start inside closed containers (`START_CONTAINERS`)."""
+    return run_set_table(robot, seed, faults, db_url, pictures, in_containers=True)
 
 
 # -- `pycram demo --scenario set-table` -------------------------------------------------------------
@@ -791,6 +823,7 @@ def main(
     record: bool = True,
     quiet: bool = False,
     animation: bool = True,
+    in_containers: bool = False,
 ) -> int:
     """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
     tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
@@ -839,7 +872,14 @@ def main(
         if live is not None:
             live.start()
         result, task = run_scenario(
-            robot, seed, kinds, recorder=recorder, output=folder, animation=animation, progress=progress
+            robot,
+            seed,
+            kinds,
+            recorder=recorder,
+            output=folder,
+            animation=animation,
+            progress=progress,
+            in_containers=in_containers,
         )
     finally:
         if live is not None:

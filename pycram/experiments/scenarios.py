@@ -289,3 +289,8 @@ register_scenario(
     "pycram.demos.set_table:run_set_table",
     description="set the table for breakfast in the apartment (issue 17)",
 )
+register_scenario(
+    "set-table-containers",
+    "pycram.demos.set_table:run_set_table_in_containers",
+    description="set the table, some objects starting inside closed containers (START_CONTAINERS)",
+)

@@ -4,6 +4,7 @@ moved, the object really was inside."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 
@@ -12,9 +13,10 @@ from action_helpers import TABLE, apartment_with, holding, run_as_task, tasks_na
 from sim_helpers import ok
 
 from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, Search
-from pycram.designator import ObjectDesignator, perform
+from pycram.designator import MotionDesignator, ObjectDesignator, perform
 from pycram.failures import ContainerStuck
 from pycram.fluent import Fluent
+from pycram.process_module import ProcessModuleFailure
 
 ROBOTS = ("pr2", "tiago")
 
@@ -192,3 +194,22 @@ def test_each_container_is_opened_and_closed_again(apartment, name):
     measured = perform(Close(name))
     assert opening_of(world, name) < closed, f"{robot_name}: {name} still open {opening_of(world, name):.3f}"
     assert measured < closed
+
+
+@pytest.mark.parametrize("robot_name", ["tiago"])
+def test_a_drawer_far_out_is_pushed_home_in_stages(robot_name):
+    # far out, no standing pose both keeps clear of the drawer and reaches its handle all the way
+    # home (the set-table search opened drawer 2 this far to see a cup under the furniture)
+    with apartment_with(robot_name, {"cup": TABLE}) as (world, robot):
+        perform(Open("drawer 2"))
+        ok(world.push_container("drawer 2", (30.0, 0.0, 0.0), 0.5))  # a person pulls it further out
+        far = opening_of(world, "drawer 2")
+        assert far >= 0.33
+        drawer = world.environment.container("drawer 2")
+        with contextlib.suppress(ProcessModuleFailure):  # standing close: it points as near as it can
+            perform(MotionDesignator(type="pointing_head", coordinates=list(drawer.handle_position(far))))
+        perform(MotionDesignator(type="detecting"))
+        assert abs(robot.belief.container_states["drawer 2"] - far) < 0.01  # seen
+        measured, task = run_as_task(lambda: perform(Close("drawer 2")))
+        assert opening_of(world, "drawer 2") < 0.03 and measured < 0.03
+        assert len(tasks_named(task, "closing drawer 2")) >= 2, "closed in one push: not the case this test is for"

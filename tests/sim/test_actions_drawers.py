@@ -92,7 +92,9 @@ def test_transport_from_a_closed_drawer_to_the_table(robot_name, close):
             assert closings and closings[-1].status.get_value().value == "succeeded"
             assert opening_of(world, "drawer 2") < 0.03  # closed again
         else:
-            assert not closings and opening_of(world, "drawer 2") > 0.15
+            # closed only by the search: a drawer it looked into first and found empty
+            assert all("/search_for/" in repr(t) for t in closings), closings
+            assert opening_of(world, "drawer 2") > 0.15
 
 
 def test_an_object_without_a_grasp_over_the_walls_is_out_of_reach_and_says_why():
