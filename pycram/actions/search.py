@@ -3,11 +3,15 @@
 `search_for(ObjectDesignator(type="cup"))` finds an object matching the description:
 
 1. if the robot's belief already holds one, that is the answer;
-2. it looks around from where it stands: at each likely place within `look_range` [m], nearest
-   first, it points the head there and detects;
-3. it visits the likely places it has not looked at closely, nearest first -- places inside
-   containers not known to be open last: it drives to a standing pose in front of each,
-   points the head at it and detects;
+2. it parks the arms that hold nothing (out of the head camera's view) and looks around from
+   where it stands: at each likely place within `look_range` [m], nearest first, it points the
+   head there and detects -- twice while nothing matching is seen (`LOOKS_PER_PLACE`: one look
+   is no proof that nothing is there; a detector misses objects now and then);
+3. it visits the likely places it has not looked at closely, nearest first -- the surfaces
+   where a matching object was last seen before it was believed gone first (moved by a person
+   or missed by a look, it is likely still near), places inside containers not known to be
+   open last: it drives to a standing pose in front of each, points the head at it and detects
+   (as in 2.);
 4. it fails with `pycram.failures.ObjectNotFound`, which names every place it looked at and
    the places it could not look into (closed containers, places it could not reach).
 
@@ -20,7 +24,8 @@ and reported: this package has no opening action yet, so objects in closed conta
 only when the scene leaves them open.
 
 The plan uses motion designators only (`subscribing_pose`, `moving`, `pointing_head`,
-`detecting`, and `setting_arm_configuration` to park the empty arms out of the camera's view) and the active robot's belief (`robot.belief`, a
+`detecting`; `setting_arm_configuration` parks the empty arms out of the camera's view) and
+the active robot's belief (`robot.belief`, a
 `pycram.world.belief.BeliefState`): it runs unchanged on every robot that offers them.
 A failed motion (a pose it cannot drive to, a point its head cannot turn to) skips that place;
 evaporation is never caught.
