@@ -3,8 +3,7 @@
 `search_for(ObjectDesignator(type="cup"))` finds an object matching the description:
 
 1. if the robot's belief already holds one, that is the answer;
-2. it parks the arms that hold nothing (out of the head camera's view) and looks around from
-   where it stands: at each likely place within `look_range` [m], nearest first, it points the
+2. it looks around from where it stands: at each likely place within `look_range` [m], nearest first, it points the
    head there and detects -- twice while nothing matching is seen (`LOOKS_PER_PLACE`: one look
    is no proof that nothing is there; a detector misses objects now and then);
 3. it visits the likely places it has not looked at closely, nearest first -- the surfaces
@@ -24,8 +23,7 @@ and reported: this package has no opening action yet, so objects in closed conta
 only when the scene leaves them open.
 
 The plan uses motion designators only (`subscribing_pose`, `moving`, `pointing_head`,
-`detecting`; `setting_arm_configuration` parks the empty arms out of the camera's view) and
-the active robot's belief (`robot.belief`, a
+`detecting`) and the active robot's belief (`robot.belief`, a
 `pycram.world.belief.BeliefState`): it runs unchanged on every robot that offers them.
 A failed motion (a pose it cannot drive to, a point its head cannot turn to) skips that place;
 evaporation is never caught.
@@ -274,26 +272,6 @@ def _look_around(
     return seen
 
 
-def _clear_the_view() -> None:
-    """Park the arms that hold nothing: an arm left raised (in its carry pose, after a failed
-    grasp or an object lost from the gripper) stands in front of the head camera and hides what
-    is on the counter in front of the robot (measured: the PR2's, a cup 0.8 m ahead unseen in
-    six looks). Best effort: a robot without arm motions searches as it stands."""
-    from .core import arms
-    from .manipulation import held_objects
-
-    try:
-        holding = held_objects()
-        empty = [arm for arm in arms() if arm not in holding]
-    except PlanFailure:  # no robot description: nothing known about arms
-        return
-    for arm in empty:
-        try:
-            motion(type="setting_arm_configuration", arm=arm, configuration="park")
-        except _FAILURES as failure:
-            logger.info("searching: could not park the %s arm: %s", arm, failure)
-
-
 def _last_seen_first(places: list[Lookout], description: ObjectDesignator, belief: BeliefState) -> list[Lookout]:
     """`places` with those on the surfaces where a matching object was last seen before it was
     believed gone first (a person who moved it likely put it down nearby; a missed look is
@@ -351,7 +329,6 @@ def search_for(
     known = _believed(description, belief)
     if known is not None:
         return known
-    _clear_the_view()
     here = _base_pose().get_value()
     places = _last_seen_first(
         lookouts(environment, description.prop_value("type"), (here.x, here.y), standoff), description, belief
