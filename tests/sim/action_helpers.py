@@ -184,6 +184,8 @@ class MissingDetections:
     def __init__(self, world: World, misses: int, when: Any = lambda: True) -> None:
         self.world, self.misses, self.when = world, misses, when
         self.missed: list[Any] = []
+        #: Every look's report (missed or not), in order.
+        self.reports: list[Any] = []
         self.looks = 0
 
     def __enter__(self) -> MissingDetections:
@@ -194,7 +196,9 @@ class MissingDetections:
         def detect(*args: Any, **kwargs: Any) -> Any:
             self.looks += 1
             if len(self.missed) >= self.misses or not self.when():
-                return original(*args, **kwargs)
+                handle = original(*args, **kwargs)
+                self.reports.append(ok(handle))
+                return handle
             saved, self.world.perception_faults = self.world.perception_faults, PerceptionFaults(miss_probability=1.0)
             try:
                 handle = original(*args, **kwargs)
@@ -202,6 +206,7 @@ class MissingDetections:
             finally:
                 self.world.perception_faults = saved
             self.missed.append(report)
+            self.reports.append(report)
             return handle
 
         self.world.detect = detect  # type: ignore[method-assign]
