@@ -381,7 +381,7 @@ class Faults:
         """A spot [m] for `name` standing upright in its counter start region, clear of every
         object standing around (objects in a gripper do not count) by 0.4 m if possible, else
         the clearest spot tried (and at least 0.15 m from `near`, within 0.6 m of it, when
-        given)."""
+        given and such spots exist)."""
         from pycram.world.objects import object_type
 
         surface = self.world.environment.surface("counter")
@@ -401,6 +401,12 @@ class Faults:
                 best = (clearance, x, y)
         if best is not None:  # no spot 0.4 m clear: the clearest one (never one next to an object)
             return (best[1], best[2], z)
+        if near is not None:
+            # `near` is not on the counter (an object that started on the cabinet top): no spot
+            # is within 0.6 m of it; the clearest spot on the counter (this fell back to the
+            # region's middle, whatever stood there: a plate put 0.12 m from the milk carton,
+            # into it, seeds 6, 15, 24)
+            return self._free_counter_spot(name)
         return ((x0 + x1) / 2, (y0 + y1) / 2, z)
 
     def _move_object(self) -> None:

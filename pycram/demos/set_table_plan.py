@@ -514,7 +514,10 @@ def _bring(
         def transport(round_number: int = round_number) -> Any:
             held = _held(setting.type)
             if held is not None:  # still in a gripper after an interrupted round: put it down
-                return perform(Place(held, setting.point, arm=held.arm))
+                try:
+                    return perform(Place(held, setting.point, arm=held.arm))
+                except GripperEmpty as empty:  # lost meanwhile (taken, dropped): fetch it again
+                    log.info("set table: the %s is no longer held (%s); fetching it again", setting.type, empty)
             found = find(setting.type, record)
             if round_number == 1 and partner is not None and not partner.placed and _arms_to_spare() >= 2:
                 return _carry_two(found, outcome, partner, record, still_wanted)

@@ -19,8 +19,10 @@ objects *should* have been seen) and the measured joint positions of the contain
   simulation], and its `pose_fluent` set (so it pulses);
 - adds a new `PerceivedObject` for each detection left over, named "<type>-<n>" in order of
   first sight (belief names: nothing is taken from the simulator);
-- marks *gone* each believed object that was not seen although the view says it should have
-  been (in the image, within range, nothing measured in front of it); gone objects are not
+- counts a *miss* for each believed object that was not seen although the view says it should
+  have been (in the image, within range, nothing measured in front of it), and marks it *gone*
+  after `misses_to_gone` (`MISSES_TO_GONE`) such looks in a row: one look is no proof of absence
+  (a detector misses objects now and then); a sighting resets the count. Gone objects are not
   resolved by designators until seen again.
 
 Thread-safe: updates and reads may come from any thread.
@@ -44,6 +46,7 @@ from .objects import OBJECT_TYPES
 
 __all__ = [
     "COLOR_NAMES",
+    "MISSES_TO_GONE",
     "BeliefState",
     "BeliefUpdate",
     "CameraView",
@@ -57,6 +60,11 @@ __all__ = [
 Vec3 = tuple[float, float, float]
 #: How many looks a `BeliefState` remembers.
 MAX_LOOKS = 100
+#: Looks in a row that should have seen an object and did not, before it is believed gone. One
+#: look is no proof of absence: a detector misses a visible object now and then (the simulated
+#: camera with the ``missed`` fault: 3 looks in 10); two misses in a row are (for independent
+#: misses) 1 in 11, and an action that needs to know looks again (`PickUp`, `Place`).
+MISSES_TO_GONE = 2
 
 #: Colour names a recogniser reports (see `color_name`).
 COLOR_NAMES = ("red", "orange", "yellow", "green", "blue", "purple", "white", "grey", "black")
@@ -204,11 +212,13 @@ class PerceivedObject(BelievedObject):
     "size", "on" (the surface's name), "in" (the container's name or None), "first_seen",
     "last_seen" [s] and "pixels". `pose_fluent` holds the pose and pulses on every refresh;
     `gone` is True while it should have been seen but was not.
+    `misses` counts the looks in a row that should have seen it and did not.
     """
 
     pose_fluent: Fluent = field(default_factory=lambda: Fluent(None))
     gone: bool = False
     times_seen: int = 0
+    misses: int = 0
 
     @property
     def yaw(self) -> float:
@@ -257,11 +267,13 @@ class PerceivedObject(BelievedObject):
 
 @dataclass(frozen=True)
 class BeliefUpdate:
-    """What one report changed: objects `added`, `refreshed` (seen again) and newly `gone`."""
+    """What one report changed: objects `added`, `refreshed` (seen again), newly `gone`, and
+    `missed` (should have been seen, were not, but are not believed gone yet)."""
 
     added: tuple[PerceivedObject, ...] = ()
     refreshed: tuple[PerceivedObject, ...] = ()
     gone: tuple[PerceivedObject, ...] = ()
+    missed: tuple[PerceivedObject, ...] = ()
 
     @property
     def seen(self) -> tuple[PerceivedObject, ...]:
@@ -273,14 +285,20 @@ class BeliefState(Belief):
     """A robot's belief: the `PerceivedObject`s it saw, filled by `update`.
 
     `environment` (a description) gives perception its surfaces and containers; `gate` [m] is
-    how far an object may have moved between two looks and still be taken for the same one.
-    `container_states` holds the containers' joint positions last measured.
+    how far an object may have moved between two looks and still be taken for the same one;
+    `misses_to_gone` how many looks in a row must miss an object in view before it is believed
+    gone. `container_states` holds the containers' joint positions last measured.
     """
 
-    def __init__(self, environment: Environment | None = None, gate: float = 0.3) -> None:
+    def __init__(
+        self, environment: Environment | None = None, gate: float = 0.3, misses_to_gone: int = MISSES_TO_GONE
+    ) -> None:
         super().__init__()
+        if misses_to_gone < 1:
+            raise ValueError(f"misses_to_gone must be at least 1, got {misses_to_gone}")
         self.environment = environment
         self.gate = gate
+        self.misses_to_gone = misses_to_gone
         self.container_states: dict[str, float] = {}
         #: When [s, the reports' clock] each container was last measured.
         self.container_stamps: dict[str, float] = {}
@@ -342,7 +360,7 @@ class BeliefState(Belief):
                     obj = self._new_object(detection.type, report.stamp)
                     added.append(obj)
                 self._refresh(obj, detection, report.stamp)
-            gone = []
+            gone, missed = [], []
             if report.view is not None:
                 view = report.view
                 forward = -np.asarray(view.rotation, float).reshape(3, 3)[:, 2]
@@ -363,10 +381,14 @@ class BeliefState(Belief):
                         and obj.pose is not None
                         and report.view.expects_visible(obj.pose)
                     ):
-                        obj.gone = True
-                        gone.append(obj)
+                        obj.misses += 1
+                        if obj.misses >= self.misses_to_gone:
+                            obj.gone = True
+                            gone.append(obj)
+                        else:
+                            missed.append(obj)
         self.updated.set_value(report.stamp)
-        return BeliefUpdate(tuple(added), tuple(refreshed), tuple(gone))
+        return BeliefUpdate(tuple(added), tuple(refreshed), tuple(gone), tuple(missed))
 
     def put_down(self, obj: PerceivedObject, position: Iterable[float]) -> None:
         """The robot itself put `obj` down at `position` (x, y, z) [m, map]: believe it there
@@ -374,6 +396,7 @@ class BeliefState(Belief):
         with self._update_lock:
             obj.pose = tuple(float(v) for v in position)
             obj.gone = False
+            obj.misses = 0
             obj.pose_fluent.set_value(obj.pose)
 
     def lost(self, obj: PerceivedObject) -> None:
@@ -401,6 +424,7 @@ class BeliefState(Belief):
             axis=detection.axis,
         )
         obj.gone = False
+        obj.misses = 0
         obj.times_seen += 1
         obj.pose = detection.position
         obj.pose_fluent.set_value(detection.position)

@@ -174,3 +174,43 @@ class KnockOverOnceLetGo:
     def join(self, timeout: float = 60.0) -> bool:
         assert self.done.wait(timeout), "the person never acted"
         return self.acted
+
+
+class MissingDetections:
+    """Makes the world's perception miss every object (a detector that misses, as the
+    ``missed`` fault does at random) in the next `misses` looks for which `when()` is True;
+    looks are counted in `missed` (their reports). Install with ``with MissingDetections(...)``."""
+
+    def __init__(self, world: World, misses: int, when: Any = lambda: True) -> None:
+        self.world, self.misses, self.when = world, misses, when
+        self.missed: list[Any] = []
+        #: Every look's report (missed or not), in order.
+        self.reports: list[Any] = []
+        self.looks = 0
+
+    def __enter__(self) -> MissingDetections:
+        from pycram.sim.perception import PerceptionFaults
+
+        original = self._original = self.world.detect
+
+        def detect(*args: Any, **kwargs: Any) -> Any:
+            self.looks += 1
+            if len(self.missed) >= self.misses or not self.when():
+                handle = original(*args, **kwargs)
+                self.reports.append(ok(handle))
+                return handle
+            saved, self.world.perception_faults = self.world.perception_faults, PerceptionFaults(miss_probability=1.0)
+            try:
+                handle = original(*args, **kwargs)
+                report = ok(handle)
+            finally:
+                self.world.perception_faults = saved
+            self.missed.append(report)
+            self.reports.append(report)
+            return handle
+
+        self.world.detect = detect  # type: ignore[method-assign]
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.world.detect = self._original  # type: ignore[method-assign]

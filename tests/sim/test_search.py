@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from belief_helpers import apartment, open_container, put
 
@@ -128,3 +129,55 @@ def test_search_needs_a_belief():
         search_for(ObjectDesignator(type="cup"))
     with pytest.raises(TypeError, match="ObjectDesignator"):
         search_for("cup")
+
+
+def test_a_look_that_misses_the_object_is_taken_again_before_the_search_moves_on():
+    # the first look at the table misses the cup in plain view (a missed detection): the search
+    # looks at the same place again and finds it there -- it moved on after one look, and the
+    # table, looked at from close by, was not visited again
+    from action_helpers import MissingDetections
+
+    world = apartment((4.3, 0.9, math.pi / 2))  # south of the table, facing it
+    put(world, "cup", "table", (4.3, 1.7))
+    robot = robot_in(world)
+    try:
+        with robot, MissingDetections(world, 1) as camera:
+            found = search_for(ObjectDesignator(type="cup"))
+            assert len(camera.missed) == 1 and found.properties["on"] == "table" and within(found, world, "cup")
+            first, second = camera.reports[:2]
+            assert not any(d.type == "cup" for d in first.detections)  # the miss
+            assert any(d.type == "cup" for d in second.detections)
+            # the second look was taken at the same place, from where it stood
+            assert np.allclose(first.view.rotation, second.view.rotation, atol=1e-3)
+            assert math.dist(first.view.position, second.view.position) < 0.01
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_the_search_looks_first_where_a_lost_object_was_last_seen():
+    # the belief lost the cup on the cabinet top (believed gone there); a cup of that type is
+    # looked for on the cabinet top first, though the counter is nearer
+    from pycram.actions.search import Lookout, _last_seen_first
+
+    world = apartment(START)
+    robot = robot_in(world)
+    try:
+        with robot:
+            cup = PerceivedObject("cup-1", "cup", (0.3, 3.0, 0.95), {"on": "cabinet top"})
+            robot.belief.add(cup)
+            places = [
+                Lookout("counter (1/2)", "counter", (1.0, 4.4, 0.95), (1.0, 3.5, 1.57)),
+                Lookout("cabinet top", "cabinet top", (0.4, 3.0, 0.95), (1.3, 3.0, 3.14)),
+            ]
+            description = ObjectDesignator(type="cup")
+            assert _last_seen_first(places, description, robot.belief) == places  # not lost: as it was
+            robot.belief.lost(cup)
+            assert [p.name for p in _last_seen_first(places, description, robot.belief)] == [
+                "cabinet top",
+                "counter (1/2)",
+            ]
+            assert _last_seen_first(places, ObjectDesignator(type="milk"), robot.belief) == places
+    finally:
+        robot.shutdown()
+        world.close()

@@ -68,6 +68,32 @@ def test_the_start_scene_comes_from_the_seed_and_stays_in_the_start_regions():
     assert inside == {("cup", "drawer 2")}
 
 
+def test_a_person_moving_an_object_from_the_cabinet_top_puts_it_clear_of_the_others_on_the_counter():
+    # the `moved` fault's spot near an object on the cabinet top: no counter spot is within
+    # 0.6 m of it; the person put it in the counter region's middle whatever stood there (a
+    # plate 0.12 m from the milk carton, into it: seeds 6, 15, 24), now at the clearest spot
+    import random
+    from types import SimpleNamespace
+
+    from pycram.demos.set_table import START_REGIONS, Faults
+    from pycram.fluent import Fluent
+
+    environment = load_environment("apartment")
+    x0, y0, x1, y1 = START_REGIONS["bowl"]["counter"]
+    middle = ((x0 + x1) / 2, (y0 + y1) / 2)
+    pose = lambda x, y: SimpleNamespace(position=(x, y, 0.95))  # noqa: E731
+    world = SimpleNamespace(
+        environment=environment,
+        gripper_states={},
+        item_poses=Fluent({"milk": pose(middle[0] + 0.1, middle[1]), "bowl": pose(0.44, 2.79)}),
+    )
+    faults = object.__new__(Faults)  # only the spot drawing: no threads, no scene
+    faults.world, faults.rng = world, random.Random(15)
+    x, y, _ = faults._free_counter_spot("bowl", (0.44, 2.79))
+    assert x0 <= x <= x1 and y0 <= y <= y1
+    assert math.hypot(x - middle[0] - 0.1, y - middle[1]) > 0.3  # clear of the milk carton
+
+
 def test_unknown_fault_and_robot_names_are_refused_naming_the_valid_choices():
     with pytest.raises(ValueError, match=r"unknown fault\(s\) 'flood'; valid faults: moved, taken, stuck"):
         run_set_table("pr2", 1, frozenset({"flood"}))

@@ -11,7 +11,15 @@ import pytest
 from pycram.designator import NoSolutionError, ObjectDesignator
 from pycram.environments import load
 from pycram.robot import ResolverSet
-from pycram.world.belief import BeliefState, CameraView, Detection, PerceptionReport, color_name, support_of
+from pycram.world.belief import (
+    MISSES_TO_GONE,
+    BeliefState,
+    CameraView,
+    Detection,
+    PerceptionReport,
+    color_name,
+    support_of,
+)
 
 APARTMENT = load("apartment")
 
@@ -51,7 +59,7 @@ def test_the_best_match_is_the_most_recently_seen_then_the_most_visible():
         assert [o.name for o in ObjectDesignator(type="cup").solutions()] == ["cup-1", "cup-2"]
 
 
-def test_an_object_expected_in_view_but_not_seen_is_gone_one_hidden_behind_something_is_not():
+def test_an_object_expected_in_view_but_not_seen_twice_is_gone_one_hidden_behind_something_is_not():
     belief = BeliefState(APARTMENT)
     resolvers = ResolverSet("belief")
     resolvers.object_resolvers.append(belief.resolver)
@@ -62,7 +70,11 @@ def test_an_object_expected_in_view_but_not_seen_is_gone_one_hidden_behind_somet
     view = view_from_south()
     assert view.expects_visible((4.3, 2.0, 0.8)) and not view.expects_visible((4.3, 0.2, 0.8))  # behind
     assert not view.expects_visible((8.3, 2.0, 0.8))  # outside the image
-    (gone,) = belief.update(PerceptionReport(3.0, (), view)).gone
+    first = belief.update(PerceptionReport(3.0, (), view))  # one miss: no proof of absence
+    assert first.gone == () and [o.name for o in first.missed] == ["cup-1"]
+    with resolvers:
+        assert ObjectDesignator(type="cup").reference().name == "cup-1"
+    (gone,) = belief.update(PerceptionReport(3.5, (), view)).gone  # missed twice in a row: gone
     with resolvers, pytest.raises(NoSolutionError):
         ObjectDesignator(type="cup").reference()
     back = belief.update(PerceptionReport(4.0, (cup(4.35, 2.1),)))
@@ -107,3 +119,23 @@ def test_moved_is_a_fluent_on_the_believed_pose():
     assert moved.get_value() is None
     belief.update(PerceptionReport(3.0, (cup(4.1, 2.0),)))
     assert moved.get_value() is True and math.isclose(obj.pose[0], 4.1)
+
+
+def test_a_sighting_between_two_misses_starts_the_count_again():
+    """A missed detection now and then (a flaky detector) never makes an object gone: only
+    `misses_to_gone` looks in a row that should have seen it and did not."""
+    belief = BeliefState(APARTMENT)
+    assert belief.misses_to_gone == MISSES_TO_GONE == 2
+    belief.update(PerceptionReport(1.0, (cup(4.3, 2.0),)))
+    (obj,) = belief.present()
+    view = view_from_south()
+    for stamp in (2.0, 4.0, 6.0):
+        update = belief.update(PerceptionReport(stamp, (), view))
+        assert update.missed == (obj,) and not obj.gone and obj.misses == 1
+        belief.update(PerceptionReport(stamp + 1.0, (cup(4.31, 2.0),), view))
+        assert obj.misses == 0
+    strict = BeliefState(APARTMENT, misses_to_gone=1)  # the old rule: one look is enough
+    strict.update(PerceptionReport(1.0, (cup(4.3, 2.0),)))
+    assert len(strict.update(PerceptionReport(2.0, (), view)).gone) == 1
+    with pytest.raises(ValueError):
+        BeliefState(APARTMENT, misses_to_gone=0)
