@@ -134,6 +134,12 @@ HELD_FRACTION = 0.5
 #: Looks at an object that should be in view before the action believes what they tell: it is
 #: looked at again while it is missed but not believed gone yet (`BeliefState.misses_to_gone`).
 LOOKS_TO_CONFIRM = 3
+#: After picking up or putting down at a surface, the base backs straight away from it by this
+#: much [m] before it drives on: the arm in its carry pose still reaches ~0.65 m ahead, over the
+#: surface, and the path planner keeps only the base off a counter the arms reach over -- driving
+#: along the counter from there, the carried plate swept a milk carton over (measured: PR2,
+#: set-table seed 31 with faults; the carton was then picked up lying and could not be placed).
+BACK_AWAY = 0.3
 
 
 @dataclass
@@ -275,6 +281,17 @@ def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None, locat
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
         retreat,
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
+        lambda: motion(type="moving", pose=(-BACK_AWAY, 0.0, 0.0), frame="base_footprint"),
+    )
+
+
+def back_away(why: str, distance: float = BACK_AWAY) -> None:
+    """Best effort: drive the base `distance` [m] straight back (a planned drive, so it stops
+    short of anything behind it rather than touching it); a failure is logged, not raised (the
+    object is held or down already)."""
+    best_effort(
+        f"backing away after {why}",
+        lambda: motion(type="moving", pose=(-distance, 0.0, 0.0), frame="base_footprint"),
     )
 
 
@@ -367,9 +384,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     torso_after = getattr(location, "torso_after", None)
     if torso is not None and torso_after is not None:
         motion(type="setting_torso", position=torso_after)
+    back_away(f"picking up {obj.name}")
     opening = gripper_opening(gripper)
     if opening < held.held_opening:
-        raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting", obj)
+        raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting it away", obj)
     return held
 
 
@@ -637,6 +655,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
         motion(type="setting_arm_configuration", arm=arm, configuration="park")
         _look_again(obj, spot)
         problem = None if obj.gone else resting_problem(obj)
+    back_away(f"putting down {obj.name}")
     if problem is not None:
         reason, why = problem
         raise PlacingFailed(f"{obj.name} does not rest upright at {_xyz(spot)}: {why}", obj, reason)

@@ -12,6 +12,7 @@ from typing import Any
 from sim_helpers import ok, tilt
 
 from pycram import robots
+from pycram.actions.manipulation import BACK_AWAY
 from pycram.sim import World
 from pycram.world.objects import object_type
 
@@ -99,10 +100,11 @@ def held_fluent(world: World, item: str) -> Any:
 
 class OnceHolding:
     """Runs `action(world)` in a thread of its own once the robot holds `item` and its base has
-    moved `distance` [m] from where it grasped it (a person acting while the robot carries).
-    Waits on fluents only; `join()` returns what the action returned."""
+    moved `distance` [m] from where it grasped it (a person acting while the robot carries: the
+    default is farther than the base backs away from the surface as part of picking up,
+    `BACK_AWAY`). Waits on fluents only; `join()` returns what the action returned."""
 
-    def __init__(self, world: World, item: str, action: Any, distance: float = 0.3) -> None:
+    def __init__(self, world: World, item: str, action: Any, distance: float = BACK_AWAY + 0.3) -> None:
         self.world, self.item, self.action, self.distance = world, item, action, distance
         self.done = threading.Event()
         self.result: Any = None
