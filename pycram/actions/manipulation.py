@@ -502,6 +502,9 @@ def _pick_up(designator: ActionDesignator) -> Held:
                         break
                     continue
                 held_objects()[held.arm] = held
+                belief = getattr(current_robot(), "belief", None)
+                if belief is not None:
+                    belief.picked_up(obj, held.gripper)
                 log.info("picked up %s with the %s arm", obj.name, held.arm)
                 return held
         except NoSolutionError as error:

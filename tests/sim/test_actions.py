@@ -326,7 +326,12 @@ def test_looks_after_placing_that_miss_the_object_twice_are_taken_again():
     with apartment_with("pr2", {"cup": COUNTER}) as (world, robot):
         ready()
         held = perform(PickUp(ObjectDesignator(type="cup")))
-        with MissingDetections(world, 2, lambda: "cup" not in holding(world)) as camera:
+
+        def put_down() -> bool:  # let go and low on the table (contacts with a carried cup flicker:
+            # "not held" alone was true for a look while driving, measured)
+            return "cup" not in holding(world) and world.item_poses.get_value()["cup"].position[2] < 0.85
+
+        with MissingDetections(world, 2, put_down) as camera:
             obj = perform(Place(held, "table"))
         assert len(camera.missed) == 2 and not any(d.type == "cup" for r in camera.missed for d in r.detections)
         assert rests_upright_at(world, "cup", "table", obj.pose[:2]) and not obj.gone and obj.misses == 0

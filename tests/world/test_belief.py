@@ -139,3 +139,26 @@ def test_a_sighting_between_two_misses_starts_the_count_again():
     assert len(strict.update(PerceptionReport(2.0, (), view)).gone) == 1
     with pytest.raises(ValueError):
         BeliefState(APARTMENT, misses_to_gone=0)
+
+
+def test_an_object_in_hand_is_not_missed_and_its_sighting_in_the_air_is_not_a_new_object():
+    belief = BeliefState(APARTMENT)
+    (milk,) = belief.update(PerceptionReport(1.0, (cup(4.3, 2.0),))).added
+    belief.picked_up(milk, "right")
+    view = view_from_south()
+    assert view.expects_visible(milk.pose)
+    carried = Detection("cup", (4.4, 1.4, 1.1), (0.07, 0.07, 0.09), "red", support=None, pixels=200)
+    for stamp in (2.0, 3.0, 4.0):  # the place it was taken from looked at, the hand in view
+        update = belief.update(PerceptionReport(stamp, (carried,), view))
+        assert update.added == () and update.missed == () and update.gone == ()
+    assert [o.name for o in belief.present()] == ["cup-1"] and milk.times_seen == 1
+    # on a surface, a cup of the held type is another cup
+    other = belief.update(PerceptionReport(5.0, (cup(3.6, 2.0),))).added
+    assert [o.name for o in other] == ["cup-2"]
+    belief.put_down(milk, (4.5, 2.0, 0.795))
+    assert belief.in_hand == {}
+    assert belief.update(PerceptionReport(6.0, (cup(4.52, 2.01),))).refreshed == (milk,)
+    # lost from the gripper: no longer in hand, gone until seen again
+    belief.picked_up(milk, "left")
+    belief.lost(milk)
+    assert belief.in_hand == {} and milk.gone
