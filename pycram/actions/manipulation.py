@@ -336,7 +336,17 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         # only once there: a torso lowered where the robot stood would sweep its raised arm over
         # the table or counter beside it
         motion(type="setting_torso", position=torso)
-    _look_again(obj)
+    seen = _look_again(obj)
+    if not seen and not obj.gone and not deep:
+        # hidden from this view -- by the robot's own arm, raised to carry, whose gripper stands
+        # just in front of the object here. The pose believed may then come from a partial view
+        # from elsewhere (measured: the TIAGo's, a milk carton believed from a 1.5-cm sliver of
+        # it, 3.5 cm off: the fingers knocked it over), so the arm is parked for a look
+        log.info("grasping %s: hidden from the standing pose; parking the %s arm to look", obj.name, arm)
+        motion(type="setting_arm_configuration", arm=arm, configuration="park")
+        _look_again(obj)
+        if not obj.gone:
+            motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, grasp))
     if obj.gone:
         raise ObjectNotVisible(f"{obj.name} is no longer where it was believed ({_xyz(planned)})", obj, "lost")
     moved = max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius)

@@ -216,3 +216,44 @@ class MissingDetections:
 
     def __exit__(self, *exc: Any) -> None:
         self.world.detect = self._original  # type: ignore[method-assign]
+
+
+class HiddenBehindRaisedArm:
+    """Test double of a camera whose view of `item` the robot's own raised arm blocks: while a
+    tool of the robot is higher than `height` [m] (an arm raised to carry), looks report no `item`
+    and something `near` [m] in front of the camera everywhere -- so the belief holds `item`
+    hidden, not missed. Looks so rewritten are counted in `hidden`. Install with ``with``."""
+
+    def __init__(self, world: World, item: str, height: float = 1.0, near: float = 0.3) -> None:
+        self.world, self.item, self.height, self.near = world, item, height, near
+        self.hidden = 0
+
+    def __enter__(self) -> HiddenBehindRaisedArm:
+        import dataclasses
+
+        import numpy as np
+
+        from pycram.sim.handle import CommandHandle
+
+        original = self._original = self.world.detect
+
+        def detect(*args: Any, **kwargs: Any) -> Any:
+            handle = original(*args, **kwargs)
+            if max(p.position[2] for p in self.world.tool_poses.get_value().values()) <= self.height:
+                return handle
+            outcome = handle.wait(T)
+            report = outcome.value
+            view = dataclasses.replace(report.view, depth=np.full_like(report.view.depth, self.near))
+            report = dataclasses.replace(
+                report, detections=tuple(d for d in report.detections if d.type != self.item), view=view
+            )
+            self.hidden += 1
+            rewritten = CommandHandle("detect (behind the raised arm)", lambda h: None)
+            rewritten.result.set_value(dataclasses.replace(outcome, value=report))
+            return rewritten
+
+        self.world.detect = detect  # type: ignore[method-assign]
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.world.detect = self._original  # type: ignore[method-assign]
