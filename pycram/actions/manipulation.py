@@ -69,6 +69,7 @@ from .core import (
     _description,
     action_plan,
     arm_name,
+    arms,
     attempt,
     base_pose_fluent,
     best_effort,
@@ -330,6 +331,14 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     # bumped it while the base drove up (measured: the TIAGo's, 1 in 4 runs), so the arm is parked
     deep = grasp.approach != "top" and grasp.radius > 0.0
     motion(type="setting_arm_configuration", arm=arm, configuration="park" if deep else carry_configuration(arm, grasp))
+    # another arm that holds nothing is parked: raised to carry, it stands over the counter beside
+    # the object and swept a milk carton over as the base drove up (measured: the PR2's)
+    for other in arms():
+        if other != arm and other not in held_objects():
+            best_effort(
+                f"parking the empty {other} arm",
+                partial(motion, type="setting_arm_configuration", arm=other, configuration="park"),
+            )
     motion(type="moving", pose=location)
     torso = getattr(location, "torso", None)
     if torso is not None:  # e.g. in a low drawer: the sequence was validated at another torso height
@@ -389,15 +398,25 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         raise GraspFailed(
             f"the {gripper} gripper closed on nothing at {_xyz(point)} (opening {opening * 1000:.1f} mm)", obj
         )
-    _reach(arm, location, 2, "lift", point)
-    motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, grasp))
-    torso_after = getattr(location, "torso_after", None)
-    if torso is not None and torso_after is not None:
-        motion(type="setting_torso", position=torso_after)
-    back_away(f"picking up {obj.name}")
-    opening = gripper_opening(gripper)
-    if opening < held.held_opening:
-        raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting it away", obj)
+    # in hand from now on: a look while it is lifted (e.g. a plan's look for the next object)
+    # must not take it for another object standing in the air
+    belief = getattr(current_robot(), "belief", None)
+    if belief is not None:
+        belief.picked_up(obj, gripper)
+    try:
+        _reach(arm, location, 2, "lift", point)
+        motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, grasp))
+        torso_after = getattr(location, "torso_after", None)
+        if torso is not None and torso_after is not None:
+            motion(type="setting_torso", position=torso_after)
+        back_away(f"picking up {obj.name}")
+        opening = gripper_opening(gripper)
+        if opening < held.held_opening:
+            raise ObjectSlipped(f"{obj.name} slipped out of the {gripper} gripper while lifting it away", obj)
+    except BaseException:
+        if belief is not None:
+            belief.released(obj)
+        raise
     return held
 
 
@@ -512,9 +531,6 @@ def _pick_up(designator: ActionDesignator) -> Held:
                         break
                     continue
                 held_objects()[held.arm] = held
-                belief = getattr(current_robot(), "belief", None)
-                if belief is not None:
-                    belief.picked_up(obj, held.gripper)
                 log.info("picked up %s with the %s arm", obj.name, held.arm)
                 return held
         except NoSolutionError as error:

@@ -417,6 +417,12 @@ class BeliefState(Belief):
         with self._update_lock:
             self.in_hand[gripper] = obj
 
+    def released(self, obj: PerceivedObject) -> None:
+        """No gripper holds `obj` any more (e.g. a pick-up attempt failed after the grasp); the
+        belief of where it is stays as it was until a look refreshes it."""
+        with self._update_lock:
+            self._out_of_hand(obj)
+
     def _out_of_hand(self, obj: PerceivedObject) -> None:
         for gripper in [g for g, o in self.in_hand.items() if o is obj]:
             del self.in_hand[gripper]

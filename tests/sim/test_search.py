@@ -148,7 +148,9 @@ def test_a_look_that_misses_the_object_is_taken_again_before_the_search_moves_on
             assert not any(d.type == "cup" for d in first.detections)  # the miss
             assert any(d.type == "cup" for d in second.detections)
             # the second look was taken at the same place, from where it stood
-            assert np.allclose(first.view.rotation, second.view.rotation, atol=1e-3)
+            # (each pointing ends within its 0.02 rad of the point: two of them differ by up to
+            # twice that -- atol 1e-3 failed 1 run in 3 under load)
+            assert np.allclose(first.view.rotation, second.view.rotation, atol=0.04)
             assert math.dist(first.view.position, second.view.position) < 0.01
     finally:
         robot.shutdown()

@@ -158,6 +158,10 @@ def test_an_object_in_hand_is_not_missed_and_its_sighting_in_the_air_is_not_a_ne
     belief.put_down(milk, (4.5, 2.0, 0.795))
     assert belief.in_hand == {}
     assert belief.update(PerceptionReport(6.0, (cup(4.52, 2.01),))).refreshed == (milk,)
+    # released (an attempt failed after the grasp): in no hand, believed where it was
+    belief.picked_up(milk, "left")
+    belief.released(milk)
+    assert belief.in_hand == {} and not milk.gone and milk.pose[:2] == (4.52, 2.01)
     # lost from the gripper: no longer in hand, gone until seen again
     belief.picked_up(milk, "left")
     belief.lost(milk)
