@@ -485,6 +485,12 @@ def _pick_up(designator: ActionDesignator) -> Held:
     requested_grasp = designator.prop_value("grasp")
     obj = believed_object("picking_up", wanted)
     grasps = executable_grasps(obj.type, requested_grasp)
+    if not obj.properties.get("in"):
+        # on an open surface: from the torso height it carries at (``'up'``), not one left low by
+        # a drawer opened before -- the arm going to its carry pose with the torso low swept the
+        # milk carton it held into the counter's edge and off (measured: the PR2, set-table with
+        # the cup in drawer 2, seed 6); location reasoning may still choose another height
+        motion(type="setting_torso", position="up")
     if not grasps:
         available = [g.approach for g in object_type(obj.type).grasps]
         raise GraspFailed(
