@@ -282,8 +282,8 @@ def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None, locat
         lambda: motion(type="setting_gripper", gripper=gripper, position=1),
         retreat,
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
-        lambda: motion(type="moving", pose=(-BACK_AWAY, 0.0, 0.0), frame="base_footprint"),
     )
+    back_away("a failed grasp")
 
 
 def back_away(why: str, distance: float = BACK_AWAY) -> None:

@@ -3,9 +3,10 @@
 `search_for(ObjectDesignator(type="cup"))` finds an object matching the description:
 
 1. if the robot's belief already holds one, that is the answer;
-2. it looks around from where it stands: at each likely place within `look_range` [m], nearest first, it points the
-   head there and detects -- twice while nothing matching is seen (`LOOKS_PER_PLACE`: one look
-   is no proof that nothing is there; a detector misses objects now and then);
+2. it looks around from where it stands: at each likely place within `look_range` [m], nearest
+   first, it points the head there and detects -- twice while nothing matching is seen
+   (`LOOKS_PER_PLACE`: one look is no proof that nothing is there; a detector misses objects
+   now and then);
 3. it visits the likely places it has not looked at closely, nearest first -- the surfaces
    where a matching object was last seen before it was believed gone first (moved by a person
    or missed by a look, it is likely still near), places inside containers not known to be

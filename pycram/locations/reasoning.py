@@ -256,13 +256,8 @@ class LocationReasoner:
         elif desig.prop_value("grasp") is None:  # out in the open, a cup is taken by its side
             grasps = [g for g in grasps if not _body_from_the_top(g)] or grasps
         grid = FloorGrid.of(env)
-        occupancy = occupancy_layer(env, grid, self._base_radius)
-        open_drawers = self._open_drawers(env)
-        if open_drawers:  # the base may come closer to an open drawer than to the furniture
-            occupancy = occupancy.copy()
-            near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
-            for rect in open_drawers:
-                occupancy[rect_distance(grid, rect) < near] = np.inf
+        # the base may come closer to an open drawer than to the furniture
+        occupancy = self._occupancy_with_drawers(env, grid, self._open_drawers(env))
         facing = self._facing_yaws(env, target)
         streams = []
         maps = {}
@@ -600,13 +595,8 @@ class LocationReasoner:
         # the drawer out as far as it is or will be: the base may come as close to it as to an
         # open drawer in ``to_reach`` (each candidate is checked against the drawer pulled out)
         furthest = max(opening, start)
-        occupancy = occupancy_layer(env, grid, self._base_radius)
         swept = self._swept_rects(container, furthest)
-        if swept:
-            occupancy = occupancy.copy()
-            near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
-            for rect in swept:
-                occupancy[rect_distance(grid, rect) < near] = np.inf
+        occupancy = self._occupancy_with_drawers(env, grid, swept)
         pulled_out = {container.joint_name: furthest} if swept else {}
         if container.kind == "door":
             occupancy = occupancy.copy()
@@ -813,6 +803,20 @@ class LocationReasoner:
             a = container.hinge_sign * q
             dx, dy = math.cos(a) * dx - math.sin(a) * dy, math.sin(a) * dx + math.cos(a) * dy
         return math.atan2(-dy, -dx)
+
+    def _occupancy_with_drawers(
+        self, env: Environment, grid: FloorGrid, drawers: list[tuple[float, float, float, float]]
+    ) -> np.ndarray:
+        """The base's occupancy layer of `env` on `grid`, with the base kept `DRAWER_CLEARANCE`
+        [m] clear of each pulled-out drawer's rectangle in `drawers` (nearer than to furniture).
+        The layer is copied before it is marked (`occupancy_layer` may share it)."""
+        occupancy = occupancy_layer(env, grid, self._base_radius)
+        if drawers:
+            occupancy = occupancy.copy()
+            near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
+            for rect in drawers:
+                occupancy[rect_distance(grid, rect) < near] = np.inf
+        return occupancy
 
     def _open_drawers(self, env: Environment) -> list[tuple[float, float, float, float]]:
         """Floor rectangles of the drawers believed open (where they stick out now, handle
