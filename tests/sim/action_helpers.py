@@ -7,6 +7,7 @@ import math
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from functools import partial
 from typing import Any
 
 from sim_helpers import ok, tilt
@@ -178,7 +179,25 @@ class KnockOverOnceLetGo:
         return self.acted
 
 
-class MissingDetections:
+class _CameraDouble:
+    """Base of the test doubles of the world's perception: while installed (``with``), every
+    look goes through `look(original, *args, **kwargs)`, which returns the command handle."""
+
+    world: World
+
+    def look(self, original: Any, *args: Any, **kwargs: Any) -> Any:
+        raise NotImplementedError
+
+    def __enter__(self) -> Any:
+        original = self._original = self.world.detect
+        self.world.detect = partial(self.look, original)  # type: ignore[method-assign]
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.world.detect = self._original  # type: ignore[method-assign]
+
+
+class MissingDetections(_CameraDouble):
     """Makes the world's perception miss every object (a detector that misses, as the
     ``missed`` fault does at random) in the next `misses` looks for which `when()` is True;
     looks are counted in `missed` (their reports). Install with ``with MissingDetections(...)``."""
@@ -190,35 +209,26 @@ class MissingDetections:
         self.reports: list[Any] = []
         self.looks = 0
 
-    def __enter__(self) -> MissingDetections:
+    def look(self, original: Any, *args: Any, **kwargs: Any) -> Any:
         from pycram.sim.perception import PerceptionFaults
 
-        original = self._original = self.world.detect
-
-        def detect(*args: Any, **kwargs: Any) -> Any:
-            self.looks += 1
-            if len(self.missed) >= self.misses or not self.when():
-                handle = original(*args, **kwargs)
-                self.reports.append(ok(handle))
-                return handle
-            saved, self.world.perception_faults = self.world.perception_faults, PerceptionFaults(miss_probability=1.0)
-            try:
-                handle = original(*args, **kwargs)
-                report = ok(handle)
-            finally:
-                self.world.perception_faults = saved
-            self.missed.append(report)
-            self.reports.append(report)
+        self.looks += 1
+        if len(self.missed) >= self.misses or not self.when():
+            handle = original(*args, **kwargs)
+            self.reports.append(ok(handle))
             return handle
+        saved, self.world.perception_faults = self.world.perception_faults, PerceptionFaults(miss_probability=1.0)
+        try:
+            handle = original(*args, **kwargs)
+            report = ok(handle)
+        finally:
+            self.world.perception_faults = saved
+        self.missed.append(report)
+        self.reports.append(report)
+        return handle
 
-        self.world.detect = detect  # type: ignore[method-assign]
-        return self
 
-    def __exit__(self, *exc: Any) -> None:
-        self.world.detect = self._original  # type: ignore[method-assign]
-
-
-class HiddenBehindRaisedArm:
+class HiddenBehindRaisedArm(_CameraDouble):
     """Test double of a camera whose view of `item` the robot's own raised arm blocks: while a
     tool of the robot is higher than `height` [m] (an arm raised to carry), looks report no `item`
     and something `near` [m] in front of the camera everywhere -- so the belief holds `item`
@@ -228,32 +238,23 @@ class HiddenBehindRaisedArm:
         self.world, self.item, self.height, self.near = world, item, height, near
         self.hidden = 0
 
-    def __enter__(self) -> HiddenBehindRaisedArm:
+    def look(self, original: Any, *args: Any, **kwargs: Any) -> Any:
         import dataclasses
 
         import numpy as np
 
         from pycram.sim.handle import CommandHandle
 
-        original = self._original = self.world.detect
-
-        def detect(*args: Any, **kwargs: Any) -> Any:
-            handle = original(*args, **kwargs)
-            if max(p.position[2] for p in self.world.tool_poses.get_value().values()) <= self.height:
-                return handle
-            outcome = handle.wait(T)
-            report = outcome.value
-            view = dataclasses.replace(report.view, depth=np.full_like(report.view.depth, self.near))
-            report = dataclasses.replace(
-                report, detections=tuple(d for d in report.detections if d.type != self.item), view=view
-            )
-            self.hidden += 1
-            rewritten = CommandHandle("detect (behind the raised arm)", lambda h: None)
-            rewritten.result.set_value(dataclasses.replace(outcome, value=report))
-            return rewritten
-
-        self.world.detect = detect  # type: ignore[method-assign]
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.world.detect = self._original  # type: ignore[method-assign]
+        handle = original(*args, **kwargs)
+        if max(p.position[2] for p in self.world.tool_poses.get_value().values()) <= self.height:
+            return handle
+        outcome = handle.wait(T)
+        report = outcome.value
+        view = dataclasses.replace(report.view, depth=np.full_like(report.view.depth, self.near))
+        report = dataclasses.replace(
+            report, detections=tuple(d for d in report.detections if d.type != self.item), view=view
+        )
+        self.hidden += 1
+        rewritten = CommandHandle("detect (behind the raised arm)", lambda h: None)
+        rewritten.result.set_value(dataclasses.replace(outcome, value=report))
+        return rewritten
