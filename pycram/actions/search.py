@@ -10,8 +10,9 @@
 3. it visits the likely places it has not looked at closely, nearest first -- the surfaces
    where a matching object was last seen before it was believed gone first (moved by a person
    or missed by a look, it is likely still near), places inside containers not known to be
-   open last: it drives to a standing pose in front of each, points the head at it and detects
-   (as in 2.);
+   open last, the kinds of place the object type is most likely found on first
+   (`ObjectType.found_on`: a cup in the drawers before the fridge): it drives to a standing
+   pose in front of each, points the head at it and detects (as in 2.);
 4. it fails with `pycram.failures.ObjectNotFound`, which names every place it looked at and
    the places it could not look into (closed containers, places it could not reach).
 
@@ -36,6 +37,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from pycram.designators.core import DesignatorError
@@ -345,17 +347,28 @@ def search_for(
         return around[0]
 
     # 2. visit the likely places, nearest first -- those behind a closed door or drawer last
-    #    (opening is slow, and an opened drawer stands in the way)
-    def closed_last(lookout: Lookout) -> bool:
-        return lookout.container is not None and belief.container_open(lookout.container) is not True
-
-    for lookout in sorted(places, key=closed_last):
+    #    (opening is slow, and an opened drawer stands in the way), the likeliest kind first
+    for lookout in sorted(places, key=partial(_closed_last, environment, belief, description.prop_value("type"))):
         if lookout.name in close:
             continue
         found = _visit(description, lookout, environment, belief, open_container, looked, skipped)
         if found is not None:
             return found
     raise ObjectNotFound(description, looked, sorted(skipped.items()))
+
+
+def _closed_last(
+    environment: Environment, belief: BeliefState, type_name: str | None, lookout: Lookout
+) -> tuple[bool, int]:
+    """Sort key of the places to visit: open places first (kept nearest first); places in
+    containers not known to be open last, those whose inside is of a kind the object type is
+    more likely found on (`ObjectType.found_on`, most likely first) before the others -- a
+    person looks for a cup in the drawers before the fridge."""
+    if lookout.container is None or belief.container_open(lookout.container) is True:
+        return (False, 0)
+    kinds = OBJECT_TYPES[type_name].found_on if type_name in OBJECT_TYPES else ()
+    kind = environment.surface(lookout.surface).kind
+    return (True, kinds.index(kind) if kind in kinds else len(kinds))
 
 
 def _visit(

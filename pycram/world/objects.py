@@ -77,7 +77,9 @@ class ObjectType:
 
     `shape` is "box" (size: half sizes x, y, z), "cylinder" (radius, half height), "bowl" or
     "plate" (radius, half height, wall thickness: a base with a wall around it). `found_on` are
-    the surface kinds such objects are put on or in ("counter", "table", "shelf", "drawer").
+    the surface kinds such objects are put on or in ("counter", "table", "shelf", "drawer"),
+    most likely first: a search opens the containers whose insides are of an earlier kind first
+    (cups are kept in drawers before they are in the fridge).
     """
 
     name: str
@@ -148,7 +150,7 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
     raise ValueError(f"shape {shape!r} is not one of: box, cylinder, bowl, plate")
 
 
-_ANY_SURFACE = ("counter", "table", "shelf", "drawer")
+_ANY_SURFACE = ("counter", "table", "drawer", "shelf")
 
 #: Every object type by name.
 OBJECT_TYPES: dict[str, ObjectType] = {

@@ -19,7 +19,11 @@ SURFACES = {
     "shelf": ("fridge middle shelf", (3.05, 4.62), (3.05, 3.2, math.pi / 2), "fridge"),
     "drawer": ("drawer 2 inside", (0.3, 2.9), (1.45, 2.9, math.pi), "drawer 2"),
 }
-OPENING_PUSH = {"fridge": ((0.0, -40.0, 0.0), 0.8), "drawer 2": ((40.0, 0.0, 0.0), 0.4)}
+OPENING_PUSH = {
+    "fridge": ((0.0, -40.0, 0.0), 0.8),
+    "drawer 2": ((40.0, 0.0, 0.0), 0.4),
+    "drawer 3": ((40.0, 0.0, 0.0), 0.4),
+}
 
 
 def apartment(base_pose, **kwargs) -> World:

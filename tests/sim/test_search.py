@@ -89,6 +89,29 @@ def _tiago_apartment():
     return world
 
 
+def test_the_search_opens_the_containers_an_object_is_likelier_in_first():
+    """Standing right in front of the closed fridge, the search for a cup opens the drawers on
+    the other side of the room first (cups: `found_on` drawers before shelves), not the fridge."""
+    world = apartment((3.3, 3.3, math.pi / 2))
+    put(world, "cup", "drawer 3 inside", (0.3, 2.9))
+    opened: list[str] = []
+
+    def open_by_hand(name: str) -> None:  # a person opens it: only the order is under test
+        opened.append(name)
+        open_container(world, name)
+
+    robot = robot_in(world)
+    try:
+        with robot:
+            found = search_for(ObjectDesignator(type="cup"), open_container=open_by_hand)
+            assert found.properties["in"] == "drawer 3" and within(found, world, "cup")
+            assert opened == ["drawer 3"], opened
+            assert world.container_states.get_value()["fridge"] == pytest.approx(0.0, abs=0.01)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
 def test_object_not_found_names_the_places_looked_at_and_the_closed_ones():
     world = apartment(START)
     put(world, "cereal", "fridge middle shelf", (3.05, 4.62))  # in the closed fridge

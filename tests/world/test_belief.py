@@ -94,6 +94,25 @@ def test_container_states_and_supports():
     assert support_of(APARTMENT, 4.3, 2.0, 0.75).name == "table"
 
 
+def test_objects_believed_in_a_drawer_move_with_it():
+    belief = BeliefState(APARTMENT)
+    in_drawer = Detection(
+        "cup", (0.7, 2.9, 0.41), (0.07, 0.07, 0.09), "red", support="drawer 2 inside", container="drawer 2"
+    )
+    belief.update(PerceptionReport(1.0, (in_drawer, cup(4.3, 2.0)), None, {"drawer 2": 0.4}))
+    drawer_cup, table_cup = sorted(belief.present(), key=lambda o: o.pose[0])
+    # the drawer pushed in (out of view: no detection), later measured pulled out to 0.25 m
+    belief.update(PerceptionReport(2.0, (), None, {"drawer 2": 0.25}))
+    assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # the drawer opens along +x
+    assert drawer_cup.pose_fluent.get_value() == pytest.approx((0.55, 2.9, 0.41))
+    assert table_cup.pose == pytest.approx((4.3, 2.0, 0.795))  # on the table: stays
+    belief.update(PerceptionReport(3.0, (), None, {"drawer 2": 0.25, "fridge": 1.2}))
+    assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # unchanged drawer, other container
+    belief.picked_up(drawer_cup, "right")
+    belief.update(PerceptionReport(4.0, (), None, {"drawer 2": 0.0}))
+    assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # in hand: not carried by the drawer
+
+
 @pytest.mark.parametrize(
     "rgb, name",
     [
