@@ -425,7 +425,8 @@ def demo_command(
         "thesis",
         "--scenario",
         help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the "
-        "apartment; set-table-containers: the same, some objects starting inside closed drawers.",
+        "apartment (objects on counters and in a closed drawer); set-table-open: the same, every object "
+        "starting on an open surface.",
     ),
     faults: str = typer.Option(
         "",
@@ -437,7 +438,7 @@ def demo_command(
     or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
     if output is not None:
         _check_output_folder(output)
-    scenarios = ("thesis", "set-table", "set-table-containers")
+    scenarios = ("thesis", "set-table", "set-table-open")  # pycram.demos.set_table.SCENARIOS (imported lazily)
     if scenario not in scenarios:
         _fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
     if scenario.startswith("set-table"):
@@ -453,7 +454,7 @@ def demo_command(
             record=_record_flag(record),
             quiet=quiet,
             animation=animation,
-            in_containers=scenario == "set-table-containers",
+            in_containers=scenario != "set-table-open",
         )
         raise typer.Exit(int(code or 0))
     if faults:
@@ -689,7 +690,7 @@ def experiment_command(
     scenario: str | None = typer.Option(
         None,
         "--scenario",
-        help="Scenario: thesis (default), set-table, set-table-containers, or an import path package.module:function.",
+        help="Scenario: thesis (default), set-table, set-table-open, or an import path package.module:function.",
     ),
     robot: str | None = typer.Option(None, "--robot", help="Robots, comma-separated: pr2,tiago [default: pr2]."),
     seeds: str | None = typer.Option(None, "--seeds", help="Seeds: a range 1-200, a list 1,5,9 or both (1,5,10-20)."),

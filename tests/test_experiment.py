@@ -205,7 +205,7 @@ def test_set_table_is_registered_lazily():
     except ModuleNotFoundError:
         with pytest.raises(
             UnknownScenario,
-            match="set-table.*does not exist.*available scenarios: set-table, set-table-containers, thesis",
+            match="set-table.*does not exist.*available scenarios: set-table, set-table-open, thesis",
         ):
             get_scenario("set-table")
     else:

@@ -412,7 +412,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         # carried with the torso up (`CARRY_TORSO`), once backed away from the furniture: from a
         # drawer, picked with the torso low, the PR2's carried cup hung 4 cm above the table top
         # and the hand swept the plate set there 13 cm aside as the base drove up (measured:
-        # set-table-containers seeds 8, 12)
+        # set-table seeds 8, 12, the cup in drawer 2)
         best_effort(
             f"raising the torso to carry {obj.name}", partial(motion, type="setting_torso", position=CARRY_TORSO)
         )

@@ -357,6 +357,44 @@ def search_for(
     raise ObjectNotFound(description, looked, sorted(skipped.items()))
 
 
+#: Other standing poses tried for a place when its own cannot be driven to (e.g. a box on the
+#: floor there): this far [m] to either side of the line of sight, then this far back.
+STAND_ASIDE = (0.35, 0.7)
+STAND_BACK = 0.35
+
+
+def _stands(lookout: Lookout, environment: Environment) -> list[tuple[float, float, float]]:
+    """Where to stand to look at `lookout`: its own standing pose, then poses beside and behind
+    it (`STAND_ASIDE`, `STAND_BACK`) on free floor, each facing the place's target."""
+    x, y, _ = lookout.stand
+    tx, ty, _ = lookout.target
+    distance = math.hypot(tx - x, ty - y) or 1.0
+    fx, fy = (tx - x) / distance, (ty - y) / distance  # towards the target
+    offsets = [(0.0, side * aside) for aside in STAND_ASIDE for side in (1.0, -1.0)] + [(-STAND_BACK, 0.0)]
+    out = [lookout.stand]
+    for ahead, aside in offsets:
+        px, py = x + ahead * fx - aside * fy, y + ahead * fy + aside * fx
+        if _free(environment, px, py):
+            out.append((px, py, math.atan2(ty - py, tx - px)))
+    return out
+
+
+def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str, str]) -> bool:
+    """Drive to a standing pose to look at `lookout` from (`_stands`, the first that can be
+    driven to); False, with the reason in `skipped`, when none can. Each drive runs with the
+    plan's `while_driving` job, if any."""
+    first: BaseException | None = None
+    for stand in _stands(lookout, environment):
+        try:
+            motion(type="moving", pose=stand)
+            return True
+        except _FAILURES as failure:
+            first = first or failure
+            logger.info("cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure)
+    skipped[lookout.name] = f"could not get there: {first}"
+    return False
+
+
 def _closed_last(
     environment: Environment, belief: BeliefState, type_name: str | None, lookout: Lookout
 ) -> tuple[bool, int]:
@@ -384,10 +422,7 @@ def _visit(
     if container is not None and belief.container_open(container) is False and open_container is None:
         skipped[lookout.name] = f"{container} is closed"
         return None
-    try:
-        motion(type="moving", pose=lookout.stand)  # a drive: with the plan's `while_driving` job, if any
-    except _FAILURES as failure:
-        skipped[lookout.name] = f"could not get there: {failure}"
+    if not _drive_to_look(lookout, environment, skipped):
         return None
     for _ in range(2):  # a look that finds the container closed opens it and looks again
         if container is not None and belief.container_open(container) is False:

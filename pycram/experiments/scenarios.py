@@ -287,10 +287,10 @@ register_scenario(
 register_scenario(
     "set-table",
     "pycram.demos.set_table:run_set_table",
-    description="set the table for breakfast in the apartment (issue 17)",
+    description="set the table for breakfast in the apartment, objects on counters and in a drawer (issue 17)",
 )
 register_scenario(
-    "set-table-containers",
-    "pycram.demos.set_table:run_set_table_in_containers",
-    description="set the table, some objects starting inside closed containers (START_CONTAINERS)",
+    "set-table-open",
+    "pycram.demos.set_table:run_set_table_on_open_surfaces",
+    description="set the table, every object starting on an open surface (none in a closed drawer)",
 )

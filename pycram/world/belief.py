@@ -415,7 +415,7 @@ class BeliefState(Belief):
         in) by dq [m] since it was last measured carries them dq along its opening direction.
         A cup seen in a drawer pulled out 0.36 m was believed there after the drawer had been
         closed and pulled out again only 0.27 m; the grasp planned for it missed (measured:
-        TIAGo, set-table-containers seeds 12, 27). Their pose fluents pulse."""
+        TIAGo, set-table seeds 12, 27, the cup in drawer 2). Their pose fluents pulse."""
         if self.environment is None:
             return
         for container in self.environment.containers:

@@ -8,6 +8,7 @@ judge the result with the simulator's truth.
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 import pytest
@@ -107,6 +108,27 @@ def test_the_search_opens_the_containers_an_object_is_likelier_in_first():
             assert found.properties["in"] == "drawer 3" and within(found, world, "cup")
             assert opened == ["drawer 3"], opened
             assert world.container_states.get_value()["fridge"] == pytest.approx(0.0, abs=0.01)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_a_place_whose_standing_pose_is_blocked_is_looked_at_from_beside_it():
+    """A box on the floor where the robot would stand to look into the drawers (the ``obstacle``
+    fault put one there): the search looks from beside it instead of giving the place up."""
+    from sim_helpers import ok
+
+    world = apartment((4.3, 0.9, math.pi / 2))  # 4 m from the drawers: beyond a look from here
+    put(world, "cup", "drawer 3 inside", (0.3, 2.9))  # in the closed drawer
+    (drawers,) = [lk for lk in lookouts(world.environment, "cup") if lk.surface == "drawer 3 inside"]
+    ok(world.place_obstacle(drawers.stand[0] + 0.25, drawers.stand[1]))
+    robot = robot_in(world)
+    try:
+        with robot:
+            found = search_for(ObjectDesignator(type="cup"), open_container=partial(open_container, world))
+            assert found.properties["in"] == "drawer 3" and within(found, world, "cup")
+            base = world.base_pose.get_value()
+            assert math.dist((base.x, base.y), drawers.stand[:2]) > 0.3  # not where the box stands
     finally:
         robot.shutdown()
         world.close()
