@@ -96,6 +96,9 @@ START_CONTAINERS: dict[str, tuple[float, dict[str, tuple[float, float, float, fl
 #: Objects start at least this far [m] apart (between their footprints): an arm reaching for one
 #: object knocks over a neighbour closer than this (measured: tall milk cartons and cups).
 START_SPACING = 0.25
+#: Draws of a start scene per seed before giving up (a draw fails when the objects drawn first
+#: leave no room for the next one on its surfaces: the milk in 1 of ~250 seeds).
+SCENE_DRAWS = 20
 #: The seat the table is set for: a named place of the environment (the base pose of a person
 #: sitting there, facing the table).
 SEAT = "table south"
@@ -568,15 +571,28 @@ def start_scene(
     probability of `START_CONTAINERS` (from a second random stream of the seed, so the
     open-surface spots stay those of a scene without containers), an object is moved inside a
     closed container instead (`Placement.container` names it). The same seed gives the same
-    scene."""
+    scene. When the spots drawn first leave no room for an object, the scene is drawn again
+    from another stream of the seed (at most `SCENE_DRAWS` times)."""
     rng = random.Random(seed)
+    for attempt in range(1, SCENE_DRAWS + 1):
+        placed = _draw_scene(environment, seed, objects, in_containers, rng)
+        if placed is not None:
+            return placed
+        rng = random.Random(seed * 7907 + 3 + attempt)  # the spots drawn first left no room: again
+    raise RuntimeError(f"no free start spots for {', '.join(objects)} in {SCENE_DRAWS} draws (seed {seed})")
+
+
+def _draw_scene(
+    environment: Any, seed: int, objects: tuple[str, ...], in_containers: bool, rng: random.Random
+) -> list[Any] | None:
+    """One draw of `start_scene`'s placements from `rng`; None when an object found no spot."""
     inside = random.Random(seed * 7907 + 3)  # the draws of starts in containers
     drawn: list[Any] = []  # every object's spot on an open surface, as without containers
     placed: list[Any] = []
     for name in objects:
         candidate = _start_spot(environment, name, START_REGIONS[name], drawn, rng)
         if candidate is None:
-            raise RuntimeError(f"no free start spot for the {name} (seed {seed})")
+            return None
         drawn.append(candidate)
         if in_containers and name in START_CONTAINERS:
             probability, containers = START_CONTAINERS[name]
