@@ -612,9 +612,14 @@ class World:
             self._fault_rng,
             min_pixels,
         )
-        # the joint positions of the containers whose handle is in the image
+        # the joint positions of the containers whose handle is in the image, and of those an
+        # object was seen inside (their inside is in view): the belief moves objects in a drawer
+        # with its measured opening, so an object's pose and its drawer's opening come together
         in_view = {
-            name: q for name, q in states.items() if view.in_image(self.environment.container(name).handle_position(q))
+            name: q
+            for name, q in states.items()
+            if view.in_image(self.environment.container(name).handle_position(q))
+            or any(d.container == name for d in detections)
         }
         return PerceptionReport(eng.time, tuple(detections), view, in_view)
 

@@ -202,7 +202,8 @@ class PerceptionReport:
     stamp: float
     detections: tuple[Detection, ...]
     view: CameraView | None = None
-    #: Measured joint position of each container in view [m or rad], 0 when closed.
+    #: Measured joint position of each container in view [m or rad], 0 when closed: at least of
+    #: every container a detection lies inside (its pose was measured with the container so).
     container_states: dict[str, float] = field(default_factory=dict)
 
 

@@ -83,6 +83,8 @@ def test_objects_in_a_closed_container_are_invisible_until_it_opens(container, s
         report = look(world, (look_at[0] + dx, look_at[1], look_at[2]))
         assert [d.type for d in report.detections] == ["cup"]
         assert report.detections[0].container == container
+        # with an object seen inside, the report measures the container's opening too
+        assert report.container_states[container] == pytest.approx(q, abs=0.02)
 
 
 def _table_world(**faults):
