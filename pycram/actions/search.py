@@ -277,16 +277,22 @@ def _look_around(
     return seen
 
 
-def _last_seen_first(places: list[Lookout], description: ObjectDesignator, belief: BeliefState) -> list[Lookout]:
-    """`places` with those on the surfaces where a matching object was last seen before it was
-    believed gone first (a person who moved it likely put it down nearby; a missed look is
-    made good there), the order kept otherwise."""
+def _last_seen_on(description: ObjectDesignator, belief: BeliefState) -> set[str]:
+    """The surfaces where an object matching `description` was last seen before it was believed
+    gone."""
     gone = [
         o
         for o in belief.objects()
         if isinstance(o, PerceivedObject) and o.gone and o.pose is not None and description.matches(o)
     ]
-    surfaces = {str(o.properties.get("on")) for o in gone if o.properties.get("on")}
+    return {str(o.properties.get("on")) for o in gone if o.properties.get("on")}
+
+
+def _last_seen_first(places: list[Lookout], description: ObjectDesignator, belief: BeliefState) -> list[Lookout]:
+    """`places` with those on the surfaces where a matching object was last seen before it was
+    believed gone first (a person who moved it likely put it down nearby; a missed look is
+    made good there), the order kept otherwise."""
+    surfaces = _last_seen_on(description, belief)
     if not surfaces:
         return places
     return sorted(places, key=lambda lookout: lookout.surface not in surfaces)
@@ -348,7 +354,10 @@ def search_for(
 
     # 2. visit the likely places, nearest first -- those behind a closed door or drawer last
     #    (opening is slow, and an opened drawer stands in the way), the likeliest kind first
-    for lookout in sorted(places, key=partial(_closed_last, environment, belief, description.prop_value("type"))):
+    order = partial(
+        _closed_last, environment, belief, description.prop_value("type"), _last_seen_on(description, belief)
+    )
+    for lookout in sorted(places, key=order):
         if lookout.name in close:
             continue
         found = _visit(description, lookout, environment, belief, open_container, looked, skipped)
@@ -396,17 +405,18 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
 
 
 def _closed_last(
-    environment: Environment, belief: BeliefState, type_name: str | None, lookout: Lookout
-) -> tuple[bool, int]:
+    environment: Environment, belief: BeliefState, type_name: str | None, last_seen: set[str], lookout: Lookout
+) -> tuple[bool, bool, int]:
     """Sort key of the places to visit: open places first (kept nearest first); places in
-    containers not known to be open last, those whose inside is of a kind the object type is
-    more likely found on (`ObjectType.found_on`, most likely first) before the others -- a
-    person looks for a cup in the drawers before the fridge."""
+    containers not known to be open last -- where a matching object was last seen (`last_seen`)
+    first among them, then those whose inside is of a kind the object type is more likely found
+    on (`ObjectType.found_on`, most likely first): a person looks for a cup in the drawers
+    before the fridge."""
     if lookout.container is None or belief.container_open(lookout.container) is True:
-        return (False, 0)
+        return (False, False, 0)
     kinds = OBJECT_TYPES[type_name].found_on if type_name in OBJECT_TYPES else ()
     kind = environment.surface(lookout.surface).kind
-    return (True, kinds.index(kind) if kind in kinds else len(kinds))
+    return (True, lookout.surface not in last_seen, kinds.index(kind) if kind in kinds else len(kinds))
 
 
 def _visit(

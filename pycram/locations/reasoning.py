@@ -335,7 +335,6 @@ class LocationReasoner:
                         return found, (None if found is not None else failure)
             # the target lies low or high for the torso as it is: another torso height
             joint = self.geometry.torso_joint
-            back = self._nearest_torso_height()
             for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
                 if prosp.in_collision((x, y, natural), {**tucked, joint: height}) or prosp.in_collision(
@@ -344,7 +343,7 @@ class LocationReasoner:
                     continue
                 other, why = sequences({**raised, joint: height})
                 if other is not None:
-                    return replace(other, torso=torso, torso_after=back), None
+                    return replace(other, torso=torso), None
                 failure = why
             return None, failure
 
@@ -764,15 +763,6 @@ class LocationReasoner:
                 return solutions, f"{pose.phase}: {answer.reason}"
             solutions.append(tuple(answer.solutions[0]))
         return solutions, None
-
-    def _nearest_torso_height(self) -> str | None:
-        """The robot's named torso height nearest to its torso now (None: no torso, or unknown)."""
-        joint, named = self.geometry.torso_joint, self.geometry.torso_positions or {}
-        prosp = self.prospection()
-        if joint is None or not named or not hasattr(prosp, "joint_position"):
-            return None
-        now = prosp.joint_position(joint)
-        return min(named, key=lambda name: abs(named[name] - now))
 
     def _higher_torso_heights(self) -> list[tuple[str, float]]:
         """The robot's named torso heights above its torso now, nearest first (none when the

@@ -18,10 +18,10 @@ class BaseLocation:
     solutions of the validated sequence; `cost` its rank in the costmap (lower is better);
     `visible` the fraction of the target the head camera sees (``to_see``); `tool_poses` the
     validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order;
-    `torso` the named torso position the solution needs (None: the torso as it is), and
-    `torso_after` the named position to return to once the sequence is done (the one nearest the
-    robot's torso when the solution was found; None: stay); `push` the face of a door the hand
-    pushes from there (``'inside'``/``'outside'``; None: not a push).
+    `torso` the named torso position the solution needs (None: the torso as it is; the actions
+    carry objects with the torso up afterwards, `pycram.actions.manipulation.CARRY_TORSO`);
+    `push` the face of a door the hand pushes from there (``'inside'``/``'outside'``; None: not
+    a push).
     """
 
     x: float
@@ -35,7 +35,6 @@ class BaseLocation:
     tool_poses: tuple = field(default=(), repr=False, compare=False)
     torso: str | None = None
     push: str | None = None
-    torso_after: str | None = None
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))

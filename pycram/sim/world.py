@@ -581,7 +581,8 @@ class World:
         """One look of the head camera's object perception: value a
         `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
         colour images of `width` x `height` [px], most visible first; the camera view with its
-        depth image; the joint positions of the containers whose handle is in the image),
+        depth image; the joint positions of the containers whose handle is in the image or that
+        an object was seen inside),
         stamped with the simulated time.
 
         Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are

@@ -416,7 +416,9 @@ class BeliefState(Belief):
         in) by dq [m] since it was last measured carries them dq along its opening direction.
         A cup seen in a drawer pulled out 0.36 m was believed there after the drawer had been
         closed and pulled out again only 0.27 m; the grasp planned for it missed (measured:
-        TIAGo, set-table seeds 12, 27, the cup in drawer 2). Their pose fluents pulse."""
+        TIAGo, set-table seeds 12, 27, the cup in drawer 2). Only objects believed on the
+        drawer's inside at its opening before move (not one put down elsewhere since it was last
+        seen there). Their pose fluents pulse."""
         if self.environment is None:
             return
         for container in self.environment.containers:
@@ -424,12 +426,14 @@ class BeliefState(Belief):
             if container.kind != "drawer" or before is None or now is None or now == before:
                 continue
             dx, dy = ((now - before) * d for d in container.opening_direction)
+            inside = set(container.interior)
             for obj in self.objects():
                 if (
                     isinstance(obj, PerceivedObject)
                     and id(obj) not in held
                     and obj.pose is not None
                     and obj.properties.get("in") == container.name
+                    and _rests_in(self.environment, obj, {container.name: before}, inside)
                 ):
                     x, y, z = obj.pose
                     obj.pose = (x + dx, y + dy, z)
@@ -497,6 +501,15 @@ class BeliefState(Belief):
         obj.times_seen += 1
         obj.pose = detection.position
         obj.pose_fluent.set_value(detection.position)
+
+
+def _rests_in(environment: Environment, obj: PerceivedObject, states: dict[str, float], inside: set[Surface]) -> bool:
+    """Whether believed `obj` stands on one of the `inside` surfaces with the containers opened
+    as in `states` (its bottom from its measured size, when known)."""
+    x, y, z = obj.pose  # type: ignore[misc]
+    size = obj.properties.get("size")
+    bottom = z - size[2] / 2 if size else z
+    return support_of(environment, x, y, bottom, states) in inside
 
 
 def support_of(

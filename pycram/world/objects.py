@@ -88,7 +88,7 @@ class ObjectType:
     mass: float
     rgba: RGBA
     grasps: tuple[Grasp, ...]
-    found_on: tuple[str, ...] = ("counter", "table", "shelf", "drawer")
+    found_on: tuple[str, ...] = ("counter", "table", "drawer", "shelf")
     description: str = ""
 
     @property

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import random
 
 import pytest
 
@@ -43,6 +44,7 @@ def test_the_start_scene_comes_from_the_seed_and_stays_in_the_start_regions():
     first, again, other = start_scene(env, 5), start_scene(env, 5), start_scene(env, 6)
     assert first == again and first != other
     # seed 221's first draw leaves no room for the milk on the counter: drawn again, not refused
+    assert set_table._draw_scene(env, 221, OBJECTS, True, random.Random(221)) is None
     assert [p.type for p in start_scene(env, 221)] == list(OBJECTS) and start_scene(env, 221) == start_scene(env, 221)
     inside: set[tuple[str, str]] = set()
     for seed in range(30):
@@ -158,11 +160,9 @@ IN_A_DRAWER = {"tiago": (1006, ("cup",), "cup"), "pr2": (1006, ("cup",), "cup")}
 @pytest.mark.parametrize("robot", sorted(IN_A_DRAWER))
 def test_an_object_starting_in_a_closed_drawer_is_brought_and_the_drawers_are_closed_again(robot):
     seed, objects, inside = IN_A_DRAWER[robot]
-    (start,) = [
-        p for p in start_scene(load_environment("apartment"), seed, objects, in_containers=True) if p.type == inside
-    ]
+    (start,) = [p for p in start_scene(load_environment("apartment"), seed, objects) if p.type == inside]
     assert start.container == "drawer 2"
-    out = run_set_table(robot, seed, objects=objects, in_containers=True)
+    out = run_set_table(robot, seed, objects=objects)
     assert out["started_in"] == {inside: "drawer 2"}
     _assert_set(out, objects)  # every object at its setting, every drawer and the fridge closed
 

@@ -106,11 +106,26 @@ def test_objects_believed_in_a_drawer_move_with_it():
     assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # the drawer opens along +x
     assert drawer_cup.pose_fluent.get_value() == pytest.approx((0.55, 2.9, 0.41))
     assert table_cup.pose == pytest.approx((4.3, 2.0, 0.795))  # on the table: stays
-    belief.update(PerceptionReport(3.0, (), None, {"drawer 2": 0.25, "fridge": 1.2}))
-    assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # unchanged drawer, other container
+    belief.update(PerceptionReport(3.0, (), None, {"drawer 2": 0.25}))
+    assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # the drawer did not move
     belief.picked_up(drawer_cup, "right")
     belief.update(PerceptionReport(4.0, (), None, {"drawer 2": 0.0}))
     assert drawer_cup.pose == pytest.approx((0.55, 2.9, 0.41))  # in hand: not carried by the drawer
+    # put down on the table (still believed "in" drawer 2 until seen again): stays on the table
+    belief.put_down(drawer_cup, (4.0, 1.8, 0.795))
+    belief.update(PerceptionReport(5.0, (), None, {"drawer 2": 0.3}))
+    assert drawer_cup.pose == pytest.approx((4.0, 1.8, 0.795))
+
+
+def test_objects_on_a_fridge_shelf_stay_when_its_door_swings():
+    belief = BeliefState(APARTMENT)
+    on_shelf = Detection(
+        "cup", (3.05, 4.62, 0.67), (0.07, 0.07, 0.09), "red", support="fridge middle shelf", container="fridge"
+    )
+    belief.update(PerceptionReport(1.0, (on_shelf,), None, {"fridge": 1.2}))
+    belief.update(PerceptionReport(2.0, (), None, {"fridge": 0.0}))
+    (cup_in_fridge,) = belief.present()
+    assert cup_in_fridge.pose == pytest.approx((3.05, 4.62, 0.67))
 
 
 @pytest.mark.parametrize(
