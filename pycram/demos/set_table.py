@@ -3,11 +3,11 @@
 From a seed, the objects of `OBJECTS` start at random spots on the kitchen counter and the
 drawer cabinet's top (`START_REGIONS`), the cup in about a third of the seeds inside the closed
 drawer 2 instead (`START_CONTAINERS`; not in the ``set-table-open`` scenario; nothing starts in
-the fridge yet, see `docs/set-table.md`). The robot starts at the apartment's start pose, knowing nothing about the
-objects, and runs `set_table_plan.set_table` for the place settings of `SETTINGS` (stated
-relative to the table's edge at the seat). The simulator's ground truth is used for judging only
-(`judge`): every object upright at its place setting within `TOLERANCE` and `MAX_TILT`, no
-gripper holding it, every drawer closed.
+the fridge yet, see `docs/set-table.md`). The robot starts at the apartment's start pose,
+knowing nothing about the objects, and runs `set_table_plan.set_table` for the place settings
+of `SETTINGS` (stated relative to the table's edge at the seat). The simulator's ground truth
+is used for judging only (`judge`): every object upright at its place setting within
+`TOLERANCE` and `MAX_TILT`, no gripper holding it, every drawer closed.
 
 Faults (`FAULTS`, off by default), drawn from the seed -- a simulated person and a flaky camera,
 acting on the simulator (this module is the plan's environment, not the plan):
