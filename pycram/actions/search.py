@@ -268,6 +268,8 @@ def _look_around(
         except _FAILURES as failure:
             logger.info("cannot look at %s from here: %s", lookout.name, failure)
             continue
+        if lookout.container is not None and not belief.container_open(lookout.container):
+            continue  # a door or drawer never measured before: the look showed it closed, or not
         looked.append(f"{lookout.name} (from where it stood)")
         if distance < CLOSE_LOOK:
             close.add(lookout.name)

@@ -2,13 +2,15 @@
 
 Plan (x east, y north, [m]): the room is 6.5 x 5 m with walls along its north (y = 5) and west
 (x = 0) sides. Along the north wall stand the kitchen counter (with a sink and a two-burner
-cooker) and a fridge whose hinged door opens towards the room. Against the west wall stands a
-drawer cabinet with three drawers sliding out east; its top is a second counter. The dining
-table stands in the middle of the room with at least 1.5 m of free floor on every side.
+cooker), a fridge whose hinged door opens towards the room, and a cupboard: a closed base with
+one compartment from 0.8 to 1.4 m above it, behind a door hinged on its west edge. Against the
+west wall stands a drawer cabinet with three drawers sliding out east; its top is a second
+counter. The dining table stands in the middle of the room with at least 1.5 m of free floor on
+every side.
 
     y=5 +--wall-----------------------------------+
-        | counter [sink] [cooker]  |fridge|       |
-        |                           door          |
+        | counter [sink] [cooker]  |fridge||cupb.| |
+        |                           door   door    |
         |drawer                                    |
         |cabinet          +-------table-------+    |
         |                 +-------------------+    |
@@ -112,6 +114,28 @@ _FRIDGE_DOOR_CONTAINER = Container(
     ),
 )
 
+# --- a cupboard against the north wall east of the fridge: a closed base, one compartment above it
+# from the counter-like height 0.8 m up, its door hinged on the west edge ------------------------
+_CUPBOARD_BOXES = (
+    Box("cupboard base", (4.1, 4.775, 0.4), (0.3, 0.225, 0.4), _WOOD),
+    Box("cupboard side west", (3.815, 4.775, 1.1), (0.015, 0.225, 0.3), _WOOD),
+    Box("cupboard side east", (4.385, 4.775, 1.1), (0.015, 0.225, 0.3), _WOOD),
+    Box("cupboard back", (4.1, 4.985, 1.1), (0.27, 0.015, 0.3), _WOOD),
+    Box("cupboard top", (4.1, 4.775, 1.415), (0.3, 0.225, 0.015), _WOOD),
+)
+_CUPBOARD_CONTAINER = Container(
+    name="cupboard",
+    kind="door",
+    body=Box("cupboard door", (4.1, 4.54, 1.1), (0.3, 0.015, 0.3), _DRAWER),
+    handle=(4.35, 4.485, 1.1),
+    opening_direction=(0.0, -1.0),
+    limits=(0.0, 1.9),
+    hinge=(3.80, 4.525),
+    damping=4.0,
+    friction=1.0,
+    interior=(Surface.rectangle("cupboard shelf", (3.83, 4.57, 4.37, 4.97), 0.8, "cupboard", clearance=0.58),),
+)
+
 # --- the dining table in the middle of the room -------------------------------------------------
 _TABLE_CENTER, _TABLE_HALF = (4.3, 2.0), (0.7, 0.45)
 _TABLE_BOXES = (Box("table", (*_TABLE_CENTER, TABLE_HEIGHT - 0.02), (*_TABLE_HALF, 0.02), _TABLE),) + tuple(
@@ -136,7 +160,7 @@ _WALLS = (
 ENVIRONMENT = Environment(
     name="apartment",
     title="An apartment: kitchen counter with cooker and sink, fridge, drawer cabinet, dining table",
-    static=_WALLS + _KITCHEN + _CABINET + _FRIDGE_BOXES + _TABLE_BOXES,
+    static=_WALLS + _KITCHEN + _CABINET + _FRIDGE_BOXES + _CUPBOARD_BOXES + _TABLE_BOXES,
     surfaces=(
         Surface.rectangle("counter", _COUNTER_RECT, COUNTER_HEIGHT, "counter"),
         Surface.rectangle("cabinet top", (0.0, _CABINET_Y[0], 0.6, _CABINET_Y[1]), COUNTER_HEIGHT, "counter"),
@@ -145,13 +169,14 @@ ENVIRONMENT = Environment(
     + tuple(
         Surface.rectangle(name, rect_around(xy, (0.1, 0.1)), COUNTER_HEIGHT, "cooker") for name, xy in _COOKERS.items()
     ),
-    containers=_DRAWERS + (_FRIDGE_DOOR_CONTAINER,),
+    containers=_DRAWERS + (_FRIDGE_DOOR_CONTAINER, _CUPBOARD_CONTAINER),
     floor=((0.0, 0.0, 6.5, 5.0),),
     places=(
         Place("start", (2.0, 1.5, 1.5708)),
         Place("kitchen", (1.3, 3.6, 1.5708)),
         Place("fridge", (3.3, 3.2, 1.5708)),
         Place("drawers", (1.6, 2.9, 3.1416)),
+        Place("cupboard", (4.1, 3.6, 1.5708)),
         Place("table south", (4.3, 0.9, 1.5708)),
         Place("table north", (4.3, 3.1, -1.5708)),
     ),

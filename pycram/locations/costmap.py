@@ -23,7 +23,16 @@ import numpy as np
 
 from pycram.world.environment import Environment, Rect
 
-__all__ = ["RESOLUTION", "FloorGrid", "Costmap", "occupancy_layer", "ring_layer", "rect_distance", "floor_obstacles"]
+__all__ = [
+    "RESOLUTION",
+    "FloorGrid",
+    "Costmap",
+    "occupancy_layer",
+    "ring_layer",
+    "rect_distance",
+    "segment_distance",
+    "floor_obstacles",
+]
 
 #: Cell size [m] of the floor grids.
 RESOLUTION = 0.05
@@ -92,6 +101,19 @@ def rect_distance(grid: FloorGrid, rect: Rect) -> np.ndarray:
     dx = np.maximum(np.maximum(x0 - grid.x, grid.x - x1), 0.0)
     dy = np.maximum(np.maximum(y0 - grid.y, grid.y - y1), 0.0)
     return np.hypot(dx, dy)
+
+
+def segment_distance(grid: FloorGrid, a: tuple[float, float], b: tuple[float, float]) -> np.ndarray:
+    """Distance [m] of every cell centre from the floor segment from `a` to `b` [m]."""
+    (ax, ay), (bx, by) = a, b
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    t = (
+        np.zeros(grid.shape)
+        if length2 == 0.0
+        else np.clip(((grid.x - ax) * dx + (grid.y - ay) * dy) / length2, 0.0, 1.0)
+    )
+    return np.hypot(grid.x - (ax + t * dx), grid.y - (ay + t * dy))
 
 
 def occupancy_layer(environment: Environment, grid: FloorGrid, radius: float, extra: Sequence[Rect] = ()) -> np.ndarray:

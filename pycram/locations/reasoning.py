@@ -56,7 +56,7 @@ from pycram.world.environment import FURNITURE_TOPS, Container, Environment, Sur
 from pycram.world.objects import Grasp, ObjectType, object_type
 
 from . import doors
-from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, rect_distance, ring_layer
+from .costmap import Costmap, FloorGrid, angle_difference, occupancy_layer, rect_distance, ring_layer, segment_distance
 from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation, Spot
 from .targets import KnownObject, Target, as_target
@@ -99,6 +99,11 @@ RIM_CLEARANCE = 0.04
 #: Free space [m] kept between the base's inscribed circle and an open drawer (the base stands
 #: close to reach over it; its footprint is checked with prospection).
 DRAWER_CLEARANCE = 0.08
+#: Free space [m] kept between the base's inscribed circle and an open door's panel (more than
+#: for a drawer: a corner of the base turned towards the panel comes closer than the circle).
+DOOR_CLEARANCE = 0.12
+#: A door counts as standing out into the room from this opening [rad] on.
+DOOR_OPEN_FROM = 0.05
 #: How far [m] a drawer's handle bar reaches beyond its grasp point (the bar's half thickness).
 HANDLE_DEPTH = 0.015
 #: Closing a drawer, the hand pushes its handle this far [m] beyond closed (against the slide's
@@ -257,7 +262,7 @@ class LocationReasoner:
             grasps = [g for g in grasps if not _body_from_the_top(g)] or grasps
         grid = FloorGrid.of(env)
         # the base may come closer to an open drawer than to the furniture
-        occupancy = self._occupancy_with_drawers(env, grid, self._open_drawers(env))
+        occupancy = self._occupancy_with_drawers(env, grid, self._open_drawers(env), self._open_doors(env))
         facing = self._facing_yaws(env, target)
         streams = []
         maps = {}
@@ -595,7 +600,7 @@ class LocationReasoner:
         # open drawer in ``to_reach`` (each candidate is checked against the drawer pulled out)
         furthest = max(opening, start)
         swept = self._swept_rects(container, furthest)
-        occupancy = self._occupancy_with_drawers(env, grid, swept)
+        occupancy = self._occupancy_with_drawers(env, grid, swept, self._open_doors(env, skip=container.name))
         pulled_out = {container.joint_name: furthest} if swept else {}
         if container.kind == "door":
             occupancy = occupancy.copy()
@@ -795,18 +800,46 @@ class LocationReasoner:
         return math.atan2(-dy, -dx)
 
     def _occupancy_with_drawers(
-        self, env: Environment, grid: FloorGrid, drawers: list[tuple[float, float, float, float]]
+        self,
+        env: Environment,
+        grid: FloorGrid,
+        drawers: list[tuple[float, float, float, float]],
+        doors: list[tuple[tuple[float, float], tuple[float, float]]] = (),  # type: ignore[assignment]
     ) -> np.ndarray:
         """The base's occupancy layer of `env` on `grid`, with the base kept `DRAWER_CLEARANCE`
-        [m] clear of each pulled-out drawer's rectangle in `drawers` (nearer than to furniture).
-        The layer is copied before it is marked (`occupancy_layer` may share it)."""
+        [m] clear of each pulled-out drawer's rectangle in `drawers` (nearer than to furniture)
+        and `DOOR_CLEARANCE` [m] clear of each open door's panel in `doors` (floor segments from
+        the hinge to the free edge). The layer is copied before it is marked (`occupancy_layer`
+        may share it)."""
         occupancy = occupancy_layer(env, grid, self._base_radius)
-        if drawers:
+        if drawers or doors:
             occupancy = occupancy.copy()
             near = self.geometry.inscribed_radius + DRAWER_CLEARANCE
             for rect in drawers:
                 occupancy[rect_distance(grid, rect) < near] = np.inf
+            near = self.geometry.inscribed_radius + DOOR_CLEARANCE
+            for a, b in doors:
+                occupancy[segment_distance(grid, a, b) < near] = np.inf
         return occupancy
+
+    def _open_doors(
+        self, env: Environment, skip: str | None = None
+    ) -> list[tuple[tuple[float, float], tuple[float, float]]]:
+        """Floor segments (hinge, free edge) [m] of the door panels believed open (but `skip`'s),
+        where they stand now."""
+        segments = []
+        for name, q in self.container_states().items():
+            if name == skip or abs(q) < DOOR_OPEN_FROM:
+                continue
+            try:
+                container = env.container(name)
+            except KeyError:
+                continue
+            if container.kind == "door" and container.hinge is not None:
+                width = container.door_width
+                ends = [container.door_face(float(q), d, "outside")[0] for d in (0.0, width)]
+                segments.append((ends[0], ends[1]))
+        return segments
 
     def _open_drawers(self, env: Environment) -> list[tuple[float, float, float, float]]:
         """Floor rectangles of the drawers believed open (where they stick out now, handle

@@ -77,9 +77,9 @@ class ObjectType:
 
     `shape` is "box" (size: half sizes x, y, z), "cylinder" (radius, half height), "bowl" or
     "plate" (radius, half height, wall thickness: a base with a wall around it). `found_on` are
-    the surface kinds such objects are put on or in ("counter", "table", "shelf", "drawer"),
-    most likely first: a search opens the containers whose insides are of an earlier kind first
-    (cups are kept in drawers before they are in the fridge).
+    the surface kinds such objects are put on or in ("counter", "table", "cupboard", "drawer",
+    "shelf" -- a fridge's), most likely first: a search opens the containers whose insides are
+    of an earlier kind first (cups are kept in a cupboard, then in drawers, before the fridge).
     """
 
     name: str
@@ -88,7 +88,7 @@ class ObjectType:
     mass: float
     rgba: RGBA
     grasps: tuple[Grasp, ...]
-    found_on: tuple[str, ...] = ("counter", "table", "drawer", "shelf")
+    found_on: tuple[str, ...] = ("counter", "table", "cupboard", "drawer", "shelf")
     description: str = ""
 
     @property
@@ -150,7 +150,7 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
     raise ValueError(f"shape {shape!r} is not one of: box, cylinder, bowl, plate")
 
 
-_ANY_SURFACE = ("counter", "table", "drawer", "shelf")
+_ANY_SURFACE = ("counter", "table", "cupboard", "drawer", "shelf")
 
 #: Every object type by name.
 OBJECT_TYPES: dict[str, ObjectType] = {
@@ -173,7 +173,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             0.25,
             (1.0, 0.82, 0.05, 1.0),
             (Grasp("side", 0.06, 0.05), Grasp("top", 0.06, 0.07, across="radial")),
-            ("counter", "table", "shelf"),
+            ("counter", "table", "cupboard", "shelf"),
             "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)",
         ),
         ObjectType(
@@ -193,7 +193,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             0.35,
             (0.96, 0.96, 0.93, 1.0),
             (Grasp("top", 0.008, 0.02, radius=0.106, across="radial"),),
-            ("counter", "table", "shelf"),
+            ("counter", "table", "cupboard", "shelf"),
             "a dinner plate, 22 cm wide, with a 1 cm rim; grasped at its rim",
         ),
         ObjectType(
@@ -217,7 +217,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
                 Grasp("-y", 0.07, 0.16, radius=0.07),
                 Grasp("top", 0.07, 0.26, across="x"),
             ),
-            ("counter", "table", "shelf"),
+            ("counter", "table", "cupboard", "shelf"),
             "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side, 2.5 cm in from its end",
         ),
         ObjectType(

@@ -18,11 +18,13 @@ SURFACES = {
     "table": ("table", (4.3, 2.0), (4.3, 0.9, math.pi / 2), None),
     "shelf": ("fridge middle shelf", (3.05, 4.62), (3.05, 3.2, math.pi / 2), "fridge"),
     "drawer": ("drawer 2 inside", (0.3, 2.9), (1.45, 2.9, math.pi), "drawer 2"),
+    "cupboard": ("cupboard shelf", (4.2, 4.65), (4.3, 3.5, math.pi / 2), "cupboard"),
 }
 OPENING_PUSH = {
     "fridge": ((0.0, -40.0, 0.0), 0.8),
     "drawer 2": ((40.0, 0.0, 0.0), 0.4),
     "drawer 3": ((40.0, 0.0, 0.0), 0.4),
+    "cupboard": ((0.0, -20.0, 0.0), 0.6),
 }
 
 

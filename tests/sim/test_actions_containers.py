@@ -165,7 +165,7 @@ def test_search_opens_the_closed_fridge_and_finds_the_milk_inside(robot_name):
 
 
 #: Every container of the apartment, in the order one robot opens and closes them in one world.
-CONTAINERS = ("drawer 1", "drawer 2", "drawer 3", "fridge")
+CONTAINERS = ("drawer 1", "drawer 2", "drawer 3", "fridge", "cupboard")
 
 
 @pytest.fixture(scope="module", params=ROBOTS)

@@ -26,7 +26,7 @@ def test_every_object_type_is_detected_on_every_surface_kind(kind):
     surface, spot, base, container = SURFACES[kind]
     with apartment(base) as world:
         dx = open_container(world, container) if container == "drawer 2" else 0.0
-        if container == "fridge":
+        if container in ("fridge", "cupboard"):
             open_container(world, container)
         s = world.environment.surface(surface)
         types = [
@@ -71,6 +71,7 @@ def test_an_object_behind_another_is_not_seen():
     [
         ("drawer 2", "drawer 2 inside", (0.3, 2.9), (1.45, 2.9, math.pi), (0.6, 2.9, 0.4)),
         ("fridge", "fridge middle shelf", (3.05, 4.62), (3.05, 3.2, math.pi / 2), (3.05, 4.6, 0.7)),
+        ("cupboard", "cupboard shelf", (4.2, 4.65), (4.3, 3.5, math.pi / 2), (4.2, 4.65, 0.85)),
     ],
 )
 def test_objects_in_a_closed_container_are_invisible_until_it_opens(container, surface, spot, base, look_at):
