@@ -79,7 +79,7 @@ class ObjectType:
     "plate" (radius, half height, wall thickness: a base with a wall around it). `found_on` are
     the surface kinds such objects are put on or in ("counter", "table", "cupboard", "drawer",
     "shelf" -- a fridge's), most likely first: a search opens the containers whose insides are
-    of an earlier kind first (cups are kept in a cupboard, then in drawers, before the fridge).
+    of an earlier kind first (cups are kept in drawers, then in a cupboard, before the fridge).
     """
 
     name: str
@@ -88,7 +88,7 @@ class ObjectType:
     mass: float
     rgba: RGBA
     grasps: tuple[Grasp, ...]
-    found_on: tuple[str, ...] = ("counter", "table", "cupboard", "drawer", "shelf")
+    found_on: tuple[str, ...] = ("counter", "table", "drawer", "cupboard", "shelf")
     description: str = ""
 
     @property
@@ -150,7 +150,7 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
     raise ValueError(f"shape {shape!r} is not one of: box, cylinder, bowl, plate")
 
 
-_ANY_SURFACE = ("counter", "table", "cupboard", "drawer", "shelf")
+_ANY_SURFACE = ("counter", "table", "drawer", "cupboard", "shelf")
 
 #: Every object type by name.
 OBJECT_TYPES: dict[str, ObjectType] = {

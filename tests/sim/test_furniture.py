@@ -28,7 +28,7 @@ def _wait(world, seconds):
 
 def test_containers_are_closed_and_stay_closed_by_themselves(world):
     names = {c.name for c in world.environment.containers}
-    assert names == {"drawer 1", "drawer 2", "drawer 3", "fridge"}
+    assert names == {"drawer 1", "drawer 2", "drawer 3", "fridge", "cupboard"}
     _wait(world, 1.5)  # gravity, the robot standing by: nothing opens
     assert all(abs(q) < 1e-3 for q in world.container_states.get_value().values())
     assert not any(j.startswith("drawer") for j in world.joint_states.get_value().position)
@@ -81,7 +81,9 @@ def test_a_stuck_drawer_does_not_open_until_freed(world):
 
 
 def test_unknown_containers_are_named_with_the_valid_choices(world):
-    with pytest.raises(UnknownNameError, match="container 'oven' does not exist. Available: drawer 1, drawer 2"):
+    with pytest.raises(
+        UnknownNameError, match="container 'oven' does not exist. Available: cupboard, drawer 1, drawer 2"
+    ):
         world.push_container("oven", (1.0, 0.0, 0.0), 0.1)
     with pytest.raises(KeyError, match="fridge"):
         world.set_container_stuck("freezer")

@@ -72,11 +72,11 @@ def test_no_two_objects_overlap_and_all_rest_plausibly_over_200_seeds():
             assert surface.kind in otype.found_on
             assert surface.contains(p.position[0], p.position[1], p.radius), (seed, p)  # fully on it
             assert p.z_range[0] == pytest.approx(surface.height, abs=0.002)  # standing on it
-            assert otype.height < surface.clearance, (seed, p)  # fits inside a drawer or the fridge
-            assert (p.container is None) == (surface.kind not in ("drawer", "shelf"))
+            assert otype.height < surface.clearance, (seed, p)  # fits inside a drawer, the cupboard or the fridge
+            assert (p.container is None) == (surface.kind not in ("drawer", "cupboard", "shelf"))
             for q in scene[i + 1 :]:
                 assert not p.overlaps(q, GAP), (seed, p, q)
-    assert supports_used == {"counter", "table", "shelf", "drawer"}  # every kind of spot occurs
+    assert supports_used == {"counter", "table", "shelf", "drawer", "cupboard"}  # every kind of spot occurs
 
 
 def test_impossible_requests_fail_with_a_named_reason():
