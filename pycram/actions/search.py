@@ -269,7 +269,7 @@ def _look_around(
             logger.info("cannot look at %s from here: %s", lookout.name, failure)
             continue
         if lookout.container is not None and not belief.container_open(lookout.container):
-            continue  # a door or drawer never measured before: the look showed it closed, or not
+            continue  # it showed the door or drawer shut (or not at all): no look inside
         looked.append(f"{lookout.name} (from where it stood)")
         if distance < CLOSE_LOOK:
             close.add(lookout.name)

@@ -3,9 +3,9 @@
 From a seed, the objects of `OBJECTS` start at random spots on the kitchen counter and the
 drawer cabinet's top (`START_REGIONS`), the cup in about a third of the seeds inside the closed
 drawer 2 or the closed cupboard instead (`START_CONTAINERS`; not in the ``set-table-open``
-scenario; nothing starts in the fridge yet, see `docs/set-table.md`). The robot starts at the apartment's start pose,
-knowing nothing about the objects, and runs `set_table_plan.set_table` for the place settings
-of `SETTINGS` (stated relative to the table's edge at the seat). The simulator's ground truth
+scenario; nothing starts in the fridge yet, see `docs/set-table.md`). The robot starts at the
+apartment's start pose, knowing nothing about the objects, and runs `set_table_plan.set_table`
+for the place settings of `SETTINGS` (stated relative to the table's edge at the seat). The simulator's ground truth
 is used for judging only (`judge`): every object upright at its place setting within
 `TOLERANCE` and `MAX_TILT`, no gripper holding it, every drawer and door closed.
 
@@ -86,12 +86,13 @@ START_REGIONS: dict[str, dict[str, tuple[float, float, float, float]]] = {
 #: cups are picked from the top out of drawer 2 by both robots, 15-22 cm behind its front,
 #: mid-width (0.24 m off the middle the TIAGo's look into the opened drawer did not see the
 #: cup), and by their side from the cupboard's east half, 6-13 cm behind its door (its west
-#: half is behind the door opened 69 deg; 4 cm from the east wall the fingers hit it). Not drawer 3 (the TIAGo opened it
-#: but did not see the object, 0 of 2), not drawer 1 (too low to pick from), not the bowl (the
-#: PR2's rim grasp out of drawer 2 failed or dropped it in 3 of 4 runs), not the plate (it does
-#: not fit a drawer: `found_on`), not the milk in the fridge (neither robot finds a standing
-#: pose to grasp it on a shelf: the opened door stands in front of the west half, the raised
-#: arm and the side grasps hit the fridge's side wall and shelf boards).
+#: half is behind the door opened 69 deg; 4 cm from the east wall the fingers hit it). Not
+#: drawer 3 (the TIAGo opened it but did not see the object, 0 of 2), not drawer 1 (too low to
+#: pick from), not the bowl (the PR2's rim grasp out of drawer 2 failed or dropped it in 3 of 4
+#: runs), not the plate (it does not fit a drawer: `found_on`), not the milk in the fridge
+#: (neither robot finds a standing pose to grasp it on a shelf: the opened door stands in front
+#: of the west half, the raised arm and the side grasps hit the fridge's side wall and shelf
+#: boards).
 START_CONTAINERS: dict[str, tuple[float, dict[str, tuple[float, float, float, float]]]] = {
     "cup": (0.35, {"drawer 2 inside": (0.38, 2.82, 0.45, 2.98), "cupboard shelf": (4.14, 4.59, 4.24, 4.66)}),
 }

@@ -159,7 +159,7 @@ _WALLS = (
 
 ENVIRONMENT = Environment(
     name="apartment",
-    title="An apartment: kitchen counter with cooker and sink, fridge, drawer cabinet, dining table",
+    title="An apartment: kitchen counter with cooker and sink, fridge, cupboard, drawer cabinet, dining table",
     static=_WALLS + _KITCHEN + _CABINET + _FRIDGE_BOXES + _CUPBOARD_BOXES + _TABLE_BOXES,
     surfaces=(
         Surface.rectangle("counter", _COUNTER_RECT, COUNTER_HEIGHT, "counter"),

@@ -803,8 +803,8 @@ class LocationReasoner:
         self,
         env: Environment,
         grid: FloorGrid,
-        drawers: list[tuple[float, float, float, float]],
-        doors: list[tuple[tuple[float, float], tuple[float, float]]] = (),  # type: ignore[assignment]
+        drawers: Sequence[tuple[float, float, float, float]],
+        doors: Sequence[tuple[tuple[float, float], tuple[float, float]]] = (),
     ) -> np.ndarray:
         """The base's occupancy layer of `env` on `grid`, with the base kept `DRAWER_CLEARANCE`
         [m] clear of each pulled-out drawer's rectangle in `drawers` (nearer than to furniture)
@@ -825,8 +825,8 @@ class LocationReasoner:
     def _open_doors(
         self, env: Environment, skip: str | None = None
     ) -> list[tuple[tuple[float, float], tuple[float, float]]]:
-        """Floor segments (hinge, free edge) [m] of the door panels believed open (but `skip`'s),
-        where they stand now."""
+        """Floor segments [m] of the door panels believed open (but `skip`'s), where they stand
+        now: their outside faces from the hinge to the free edge."""
         segments = []
         for name, q in self.container_states().items():
             if name == skip or abs(q) < DOOR_OPEN_FROM:
