@@ -12,7 +12,7 @@ from test_location_reasoning import APARTMENT, CUP_ON_TABLE, ScriptedProspection
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.locations import KnownObject, LocationReasoner, RobotGeometry
-from pycram.locations.reasoning import DRAWER_CLEARANCE, RIM_CLEARANCE
+from pycram.locations.reasoning import DOOR_CLEARANCE, DRAWER_CLEARANCE, RIM_CLEARANCE
 from pycram.robot import ResolverSet
 from pycram.robots.pr2 import description as pr2
 
@@ -124,3 +124,21 @@ def test_a_drawer_knows_where_its_contents_are():
     assert DRAWER_2.surface_holding(CUP_IN_DRAWER.position, 0.0) is None  # closed, it is not there
     assert APARTMENT.container("drawer 3").surface_holding(CUP_IN_DRAWER.position, OPENING) is None
     assert APARTMENT.container("fridge").surface_holding((3.0, 4.6, 0.67), 0.0) is None  # a door's shelves
+
+
+def test_the_base_stands_clear_of_an_open_door_not_only_of_the_furniture():
+    """The cupboard opened 69 deg: its door stands out into the room in front of the compartment's
+    west half. With every pose reachable (a scripted prospection that sees no door), the
+    standing poses chosen to reach a cup inside keep the base `DOOR_CLEARANCE` off the panel."""
+    cupboard = APARTMENT.container("cupboard")
+    opening = 1.2
+    cup = KnownObject("cup", "cup", (4.2, 4.63, 0.8 + 0.045))
+    with resolver_set(TorsoProspection(), {"cupboard": opening}):
+        found = first(LocationDesignator([("to_reach", cup)]), 5)
+    assert found
+    (ax, ay), _, _ = cupboard.door_face(opening, 0.0, "outside")
+    (bx, by), _, _ = cupboard.door_face(opening, cupboard.door_width, "outside")
+    for s in found:
+        t = max(0.0, min(1.0, ((s.x - ax) * (bx - ax) + (s.y - ay) * (by - ay)) / ((bx - ax) ** 2 + (by - ay) ** 2)))
+        distance = math.dist((s.x, s.y), (ax + t * (bx - ax), ay + t * (by - ay)))
+        assert distance >= pr2.BASE["inscribed_radius"] + DOOR_CLEARANCE - 0.05, (s, distance)

@@ -91,8 +91,9 @@ def _tiago_apartment():
 
 
 def _search_opening_by_hand(world, wanted: str = "cup") -> tuple[PerceivedObject, list[str]]:
-    """Search for an object of type `wanted` in `world`, a person opening each container the search asks for (only
-    the search's choices are under test); returns what was found and the containers opened."""
+    """Search for an object of type `wanted` in `world`, a person opening each container the
+    search asks for (only the search's choices are under test); returns what was found and the
+    containers opened."""
     opened: list[str] = []
 
     def open_by_hand(name: str) -> None:
