@@ -781,14 +781,14 @@ def run_set_table(
     """Run the set-table scenario once, headless and without animation, for `pycram experiment`.
 
     `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
-    recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``;
-    `objects`: the object types to bring (a subset of `OBJECTS`, in that order);
-    `in_containers`: objects may start inside closed containers (`start_scene`). Returns
-    a JSON-serialisable dict: ``success``, ``objects`` (per object: ``placed``, ``failure`` (a
-    failure type's name or None), ``reason``), ``failure_causes``, ``sim_time`` [s],
-    ``wall_time`` [s], ``robot``, ``seed``, ``faults``, ``faults_injected``, ``run_id``,
-    ``started_in`` (object -> the closed container it started in), and
-    ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
+    recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``
+    (``output/set-table-open-ROBOT-SEED`` without `in_containers`); `objects`: the object types
+    to bring (a subset of `OBJECTS`, in that order); `in_containers`: objects may start inside
+    closed containers (`start_scene`). Returns a JSON-serialisable dict: ``success``,
+    ``objects`` (per object: ``placed``, ``failure`` (a failure type's name or None),
+    ``reason``), ``failure_causes``, ``sim_time`` [s], ``wall_time`` [s], ``robot``, ``seed``,
+    ``faults``, ``faults_injected``, ``run_id``, ``started_in`` (object -> the closed container
+    it started in), and ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
     driving, searches ended by a sighting, objects carried together) and
     ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
     Raises `ValueError` for an unknown robot or fault name.
@@ -802,7 +802,8 @@ def run_set_table(
         from pycram.trace import start_recording
 
         recorder = start_recording(url=db_url, plan=f"set table ({robot}, seed {seed})")
-    output = Path("output") / f"set-table-{robot}-{seed}" if pictures else None
+    scenario = "set-table" if in_containers else "set-table-open"
+    output = Path("output") / f"{scenario}-{robot}-{seed}" if pictures else None
     result: SetTableResult | None = None
     try:
         result, _ = run_scenario(

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import random
+from pathlib import Path
 
 import pytest
 
@@ -316,3 +317,22 @@ def test_the_pr2_carries_two_objects_at_once_and_looks_for_the_next_while_drivin
     drives = tasks_named(task, "drive, looking around")
     assert drives
     assert all(_statuses(drive)["look_while_driving"] == "EVAPORATED" for drive in drives)
+
+
+def test_the_two_scenarios_write_the_pictures_of_a_seed_to_folders_of_their_own(monkeypatch):
+    """`set-table` and `set-table-open` runs of the same seed and robot do not overwrite each
+    other's pictures (the run itself is replaced: only the folder it is given is under test)."""
+    folders = []
+
+    class Stopped(Exception):
+        pass
+
+    def run_scenario(robot, seed, kinds, recorder=None, output=None, **options):
+        folders.append(output)
+        raise Stopped
+
+    monkeypatch.setattr(set_table, "run_scenario", run_scenario)
+    for run in (set_table.run_set_table, set_table.run_set_table_on_open_surfaces):
+        with pytest.raises(Stopped):
+            run("pr2", 7, pictures=True)
+    assert folders == [Path("output") / "set-table-pr2-7", Path("output") / "set-table-open-pr2-7"]
