@@ -331,8 +331,8 @@ class Faults:
         self._lock = threading.Lock()
         self.moved_object = rng.choice([p.name for p in placements if p.container is None] or [None])
         self.taken_object = rng.choice([s.type for s in settings])
-        in_drawers = sorted({p.container for p in placements if p.container is not None})
         drawers = [c.name for c in world.environment.containers if c.kind == "drawer"]
+        in_drawers = sorted({p.container for p in placements if p.container in drawers})
         self.stuck_drawer = rng.choice(in_drawers or drawers) if drawers else None
         self.stuck_for = rng.uniform(4.0, 10.0)
         self.obstacle_fraction = rng.uniform(0.35, 0.6)

@@ -336,3 +336,23 @@ def test_the_two_scenarios_write_the_pictures_of_a_seed_to_folders_of_their_own(
         with pytest.raises(Stopped):
             run("pr2", 7, pictures=True)
     assert folders == [Path("output") / "set-table-pr2-7", Path("output") / "set-table-open-pr2-7"]
+
+
+def test_the_stuck_fault_sticks_a_drawer_the_one_holding_the_cup_if_any():
+    """`stuck` is a stuck drawer (the issue's fault): drawer 2 when the cup starts in it, some
+    drawer when it starts in the cupboard -- never the cupboard's door."""
+    from types import SimpleNamespace
+
+    env = load_environment("apartment")
+    world = SimpleNamespace(environment=env)  # the fault's choices need the environment only
+    drawers = {c.name for c in env.containers if c.kind == "drawer"}
+    seen = set()
+    for seed in range(1, 41):
+        placements = start_scene(env, seed)
+        (inside,) = {p.container for p in placements if p.container} or {None}
+        faults = set_table.Faults(world, frozenset({"stuck"}), random.Random(seed), place_settings(env), placements)
+        assert faults.stuck_drawer in drawers, (seed, faults.stuck_drawer)
+        if inside == "drawer 2":
+            assert faults.stuck_drawer == "drawer 2"
+        seen.add(inside)
+    assert seen == {None, "drawer 2", "cupboard"}
