@@ -443,7 +443,7 @@ def picking_up(designator: ActionDesignator) -> Held:
         obj = believed_object("picking_up", wanted)
         needed = _wider_opening(obj, as_far_as_needed=True)
         if needed is not None:
-            log.info("%s is still under the furniture in %s: opening it further", obj.name, obj.properties["in"])
+            log.info("%s is behind the door or under the furniture of %s: opening it", obj.name, obj.properties["in"])
             perform(Open(obj.properties["in"], opening=needed))
             _look_again(obj)
     try:
@@ -463,14 +463,20 @@ def picking_up(designator: ActionDesignator) -> Held:
 def _wider_opening(obj: PerceivedObject, as_far_as_needed: bool = False) -> float | None:
     """How far [m] to pull out the drawer `obj` lies in: near the slide's end, or -- with
     `as_far_as_needed` -- just so far that the object is `OUT_FROM_UNDER` out from under the
-    furniture (its footprint past the closed drawer's front). None when it is in no drawer or the
-    drawer is (about) that far out already."""
+    furniture (its footprint past the closed drawer's front). Behind a door (a cupboard's, the
+    fridge's) believed open less than `DOOR_USEFUL`: `DOOR_OPENING` [rad] (the object was seen
+    inside, and the door was closed since or stuck part way). None when it is in no container or
+    the container is (about) that far open already."""
+    from .containers import DOOR_OPENING, DOOR_USEFUL
+
     name = obj.properties.get("in")
     belief = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
     if not name or belief is None or environment is None or obj.pose is None:
         return None
     container = environment.container(name)
+    if container.kind == "door":
+        return DOOR_OPENING if abs(float(belief.container_states.get(name, 0.0))) < DOOR_USEFUL else None
     if container.kind != "drawer":
         return None
     wide = container.limits[1] - WIDE_MARGIN

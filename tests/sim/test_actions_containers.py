@@ -12,7 +12,7 @@ import pytest
 from action_helpers import TABLE, apartment_with, holding, run_as_task, tasks_named
 from sim_helpers import ok
 
-from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, Search
+from pycram.actions import ActionParameterError, Close, MoveTorso, Open, ParkArms, PickUp, Search
 from pycram.designator import MotionDesignator, ObjectDesignator, perform
 from pycram.failures import ContainerStuck
 from pycram.fluent import Fluent
@@ -213,3 +213,22 @@ def test_a_drawer_far_out_is_pushed_home_in_stages(robot_name):
         measured, task = run_as_task(lambda: perform(Close("drawer 2")))
         assert opening_of(world, "drawer 2") < 0.03 and measured < 0.03
         assert len(tasks_named(task, "closing drawer 2")) >= 2, "closed in one push: not the case this test is for"
+
+
+def test_an_object_seen_in_the_cupboard_that_was_closed_since_is_picked_up_after_opening_it_again():
+    """The cup was seen on the cupboard's shelf, then the cupboard was closed (a search closes
+    each container before the next): picking it up opens the door again first."""
+    with apartment_with("pr2", {"cup": ("cupboard shelf", (4.2, 4.62))}, base_pose=(4.1, 3.4, math.pi / 2)) as (
+        world,
+        robot,
+    ):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        found = perform(Search(ObjectDesignator(type="cup")))
+        assert found.properties["in"] == "cupboard"
+        perform(Close("cupboard"))
+        assert opening_of(world, "cupboard") < math.radians(4)
+        held, task = run_as_task(lambda: perform(PickUp(found)))
+        assert holding(world) == {"cup"} and held.object is found
+        assert opening_of(world, "cupboard") >= math.radians(60)
+        assert tasks_named(task, "perform opening")
