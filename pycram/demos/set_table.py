@@ -5,9 +5,9 @@ drawer cabinet's top (`START_REGIONS`), the cup in about a third of the seeds in
 drawer 2 or the closed cupboard instead (`START_CONTAINERS`; not in the ``set-table-open``
 scenario; nothing starts in the fridge yet, see `docs/set-table.md`). The robot starts at the
 apartment's start pose, knowing nothing about the objects, and runs `set_table_plan.set_table`
-for the place settings of `SETTINGS` (stated relative to the table's edge at the seat). The simulator's ground truth
-is used for judging only (`judge`): every object upright at its place setting within
-`TOLERANCE` and `MAX_TILT`, no gripper holding it, every drawer and door closed.
+for the place settings of `SETTINGS` (stated relative to the table's edge at the seat). The
+simulator's ground truth is used for judging only (`judge`): every object upright at its place
+setting within `TOLERANCE` and `MAX_TILT`, no gripper holding it, every drawer and door closed.
 
 Faults (`FAULTS`, off by default), drawn from the seed -- a simulated person and a flaky camera,
 acting on the simulator (this module is the plan's environment, not the plan):
