@@ -20,7 +20,7 @@ from pycram.designators.action import ActionDesignator
 from pycram.failures import ObjectNotFound
 
 from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
-from .containers import Close, Open
+from .containers import Close, Open, believed_open
 from .core import ACTION_PLANS, ActionParameterError, resolve_action
 from .manipulation import Held, PickUp, Place, held_objects
 from .search import Lookout, look_around, lookouts, search_for
@@ -42,6 +42,7 @@ __all__ = [
     "Transport",
     "Open",
     "Close",
+    "believed_open",
     "Held",
     "held_objects",
     "ACTION_PLANS",

@@ -61,6 +61,7 @@ from pycram.actions import (
     PickUp,
     Place,
     Transport,
+    believed_open,
     held_objects,
     lookouts,
     search_for,
@@ -119,6 +120,10 @@ ROUNDS = 2
 #: Looking while driving: once every place in view range has been looked at, the next look
 #: waits until the base has moved this far [m] (places may have come into range).
 RESCAN_DISTANCE = 1.0
+
+#: `close_opened_containers` goes over the containers at most this often (closing one may show
+#: another one open).
+CLOSING_PASSES = 3
 
 #: Carrying one object to fetch a second: the second may be at most this tall [m] (the held
 #: object sticks out ahead over the furniture's front and knocked a 0.2 m milk carton over as
@@ -213,22 +218,32 @@ def believed(type_name: str) -> PerceivedObject | None:
 
 
 def close_opened_containers() -> list[str]:
-    """Close every drawer and door the robot believes open (from its last look); returns their
-    names. A container that will not close is logged and left (its failure is not raised).
+    """Close every drawer and door the robot believes open (`believed_open`: from its last
+    look); returns their names. A container that will not close is logged and left (its failure
+    is not raised). Closing one may show another open (the looks at its neighbours after each
+    push): the containers are gone over again, at most `CLOSING_PASSES` times.
     (Doors: the search opens the fridge to look inside, on a robot that opens doors.)"""
     belief = _belief()
     environment = getattr(belief, "environment", None)
     if belief is None or environment is None:
         return []
-    closed = []
-    for container in environment.containers:
-        if container.kind not in ("drawer", "door") or belief.container_open(container.name) is not True:
-            continue
-        try:
-            perform(Close(container.name))
-            closed.append(container.name)
-        except WORLD_FAILURES as failure:
-            log.warning("could not close %s: %s", container.name, failure)
+    closed: list[str] = []
+    failed: set[str] = set()
+    for _ in range(CLOSING_PASSES):
+        todo = [
+            c.name
+            for c in environment.containers
+            if c.kind in ("drawer", "door") and c.name not in failed and believed_open(c.name)
+        ]
+        if not todo:
+            break
+        for name in todo:
+            try:
+                perform(Close(name))
+                closed.append(name)
+            except WORLD_FAILURES as failure:
+                log.warning("could not close %s: %s", name, failure)
+                failed.add(name)
     return closed
 
 

@@ -232,3 +232,23 @@ def test_an_object_seen_in_the_cupboard_that_was_closed_since_is_picked_up_after
         assert holding(world) == {"cup"} and held.object is found
         assert opening_of(world, "cupboard") >= math.radians(60)
         assert tasks_named(task, "perform opening")
+
+
+def test_a_drawer_pulled_out_beside_the_one_closed_is_seen_and_closed_too():
+    """Closing a drawer looks at its neighbours' handles: one pulled out meanwhile (by a person
+    here; by the TIAGo's arm going up from drawer 1 in the faulted set-table runs) is believed
+    open and `close_opened_containers` closes it as well."""
+    from pycram.demos.set_table_plan import close_opened_containers
+
+    with apartment_with("tiago", {"cup": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        perform(Open("drawer 1"))
+        assert robot.belief.container_states.get("drawer 3", 0.0) < 0.03  # closed, as far as it knows
+        ok(world.push_container("drawer 3", (25.0, 0.0, 0.0), 0.3))  # a person pulls it out a little
+        pulled = opening_of(world, "drawer 3")
+        assert 0.04 < pulled < 0.25, pulled
+        assert robot.belief.container_states.get("drawer 3", 0.0) < 0.03  # not seen
+        closed = close_opened_containers()
+        assert closed == ["drawer 1", "drawer 3"]
+        assert opening_of(world, "drawer 1") < 0.03 and opening_of(world, "drawer 3") < 0.03
