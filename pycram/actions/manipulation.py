@@ -298,6 +298,21 @@ def back_away(why: str, distance: float = BACK_AWAY) -> None:
     )
 
 
+def _arm_to_drive(arm: str, configuration: str) -> None:
+    """Move `arm` to `configuration` before driving; blocked where the robot stands (beside the
+    furniture it just worked at: the TIAGo's arm against the cupboard's side after pushing its
+    door shut, 5 of 200 faulted set-table seeds), the base backs away `BACK_AWAY` and it tries
+    once more (raising that failure)."""
+    try:
+        motion(type="setting_arm_configuration", arm=arm, configuration=configuration)
+    except RECOVERABLE as error:
+        if getattr(unwrap(error), "reason", None) != "blocked":
+            raise
+        log.info("the %s arm is blocked on its way to %s: backing away first (%s)", arm, configuration, unwrap(error))
+        back_away(f"the {arm} arm was blocked")
+        motion(type="setting_arm_configuration", arm=arm, configuration=configuration)
+
+
 def _look_again(obj: PerceivedObject, point: Any = None) -> bool:
     """Point the head at the believed object (or at `point` [m, map]) and look; True when it was
     seen. The belief is refreshed, or counts a miss when the object should have been seen (not
@@ -332,7 +347,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     # a deep object (the cereal box) reaches out towards the robot: the raised arm, 0.6 m ahead,
     # bumped it while the base drove up (measured: the TIAGo's, 1 in 4 runs), so the arm is parked
     deep = grasp.approach != "top" and grasp.radius > 0.0
-    motion(type="setting_arm_configuration", arm=arm, configuration="park" if deep else carry_configuration(arm, grasp))
+    _arm_to_drive(arm, "park" if deep else carry_configuration(arm, grasp))
     # another arm that holds nothing is parked: raised to carry, it stands over the counter beside
     # the object and swept a milk carton over as the base drove up (measured: the PR2's)
     for other in arms():

@@ -42,7 +42,7 @@ from pycram.actions import (
     held_objects,
 )
 from pycram.actions.manipulation import resting_problem
-from pycram.designator import LocationDesignator, ObjectDesignator, perform
+from pycram.designator import LocationDesignator, MotionDesignator, ObjectDesignator, perform
 from pycram.failures import (
     GoalUnreachable,
     GraspFailed,
@@ -54,6 +54,7 @@ from pycram.failures import (
     PlacingFailed,
     PlanFailure,
 )
+from pycram.process_module import ProcessModuleFailure
 from pycram.world.objects import object_type
 
 ROBOTS = ("pr2", "tiago")
@@ -289,6 +290,28 @@ def test_a_standing_pose_that_cannot_be_reached_gives_way_to_the_next():
         assert math.hypot(reached.x - free[0], reached.y - free[1]) < 0.05
         drives = tasks_named(task, "drive to solution")
         assert [d.status.get_value().value for d in drives] == ["failed", "succeeded"]
+
+
+def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
+    """Where the TIAGo stands to push the cupboard shut, the arm's way up to ``carry_top`` meets
+    the cupboard: the arm going up before a pick-up's drive backs the base away first (the
+    faulted set-table run of seed 14 failed to pick up the bowl after closing the cupboard)."""
+    from pycram.actions.manipulation import _arm_to_drive
+
+    near_cupboard = (4.625, 4.025, 2.949)
+    with apartment_with("tiago", {"bowl": COUNTER}, base_pose=near_cupboard) as (world, robot):
+        ready()
+        with pytest.raises(ProcessModuleFailure, match="blocked"):  # the case this test is for
+            perform(MotionDesignator(type="setting_arm_configuration", arm="right", configuration="carry_top"))
+        perform(ParkArms())
+        run_as_task(lambda: _arm_to_drive("right", "carry_top"))
+        base = world.base_pose.get_value()
+        assert math.hypot(base.x - near_cupboard[0], base.y - near_cupboard[1]) > 0.2  # backed away
+        from pycram.robots.tiago.description import ARM_CONFIGURATIONS
+
+        joints = world.joint_states.get_value().position
+        up = [joints[f"arm_{i}_joint"] for i in range(1, 8)]
+        assert max(abs(a - b) for a, b in zip(up, ARM_CONFIGURATIONS["right"]["carry_top"], strict=True)) < 0.05
 
 
 # -- typed failures when recovery is impossible ------------------------------------------------------
