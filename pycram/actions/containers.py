@@ -236,7 +236,7 @@ def believed_open(name: str) -> bool | None:
     """Whether the current robot believes the container `name` open: a drawer measured out
     `CLOSED` [m] or more, a door `DOOR_CLOSED` [rad] or more -- the thresholds `Close` pushes
     below. None when it was never measured (or the robot has no belief of the environment)."""
-    belief = getattr(current_robot(), "belief", None)
+    belief: Any = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
     if environment is None or name not in belief.container_states:
         return None
