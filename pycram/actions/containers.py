@@ -5,8 +5,9 @@ or the door's arc.
 handle too low or too high for the torso as it is -- the torso height.
 One attempt drives there, looks at the handle (perception measures how far the drawer is open),
 grasps the handle (fingers closing vertically on its horizontal bar), pulls it along the opening
-trajectory in steps, lets go, backs off and looks again: the drawer must be measured open (within
-6 cm of the goal, or at least 15 cm out: enough to look and reach in).
+trajectory in steps, lets go, backs off and looks again (at the handles of the containers next
+to it too, `NEIGHBOUR_RADIUS`): the drawer must be measured open (within 6 cm of the goal, or at
+least 15 cm out: enough to look and reach in).
 `Close("drawer 2")` is the same, pushing back to closed.
 
 `Open("fridge")` (a door, `DOOR_OPENING` = 69 deg unless told): the arms parked, the robot
