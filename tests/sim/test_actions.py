@@ -297,6 +297,7 @@ def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
     the cupboard: the arm going up before a pick-up's drive backs the base away first (the
     faulted set-table run of seed 14 failed to pick up the bowl after closing the cupboard)."""
     from pycram.actions.manipulation import _arm_to_drive
+    from pycram.robots.tiago.description import ARM_CONFIGURATIONS
 
     near_cupboard = (4.625, 4.025, 2.949)
     with apartment_with("tiago", {"bowl": COUNTER}, base_pose=near_cupboard) as (world, robot):
@@ -307,8 +308,6 @@ def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
         run_as_task(lambda: _arm_to_drive("right", "carry_top"))
         base = world.base_pose.get_value()
         assert math.hypot(base.x - near_cupboard[0], base.y - near_cupboard[1]) > 0.2  # backed away
-        from pycram.robots.tiago.description import ARM_CONFIGURATIONS
-
         joints = world.joint_states.get_value().position
         up = [joints[f"arm_{i}_joint"] for i in range(1, 8)]
         assert max(abs(a - b) for a, b in zip(up, ARM_CONFIGURATIONS["right"]["carry_top"], strict=True)) < 0.05
