@@ -788,8 +788,8 @@ def run_set_table(
     ``objects`` (per object: ``placed``, ``failure`` (a failure type's name or None),
     ``reason``), ``failure_causes``, ``sim_time`` [s], ``wall_time`` [s], ``robot``, ``seed``,
     ``faults``, ``faults_injected``, ``run_id``, ``started_in`` (object -> the closed container
-    it started in), and ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`: objects found while
-    driving, searches ended by a sighting, objects carried together) and
+    it started in), and ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`:
+    objects found while driving, searches ended by a sighting, objects carried together) and
     ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
     Raises `ValueError` for an unknown robot or fault name.
     """
