@@ -52,7 +52,7 @@ def open_world(robot: str, env: str):
 
 def floor_planner(world):
     """The world's current `PathPlanner` (built in the simulation thread; pure afterwards)."""
-    from pycram.sim.path_drive import navigation_of
+    from pycram.backends.sim.path_drive import navigation_of
 
     out = world._call("planner", lambda eng: navigation_of(eng).planner(eng)[0]).wait(60)
     assert out is not None and out.succeeded, out

@@ -21,7 +21,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from pycram.demos.kitchen import DemoOptions, run_demo  # noqa: E402
+from pycram.apps.demos.kitchen import DemoOptions, run_demo  # noqa: E402
 
 SCENARIOS = {
     "pr2": dict(robot="pr2"),

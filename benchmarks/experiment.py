@@ -25,9 +25,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from pycram.experiments import store  # noqa: E402
-from pycram.experiments.report import percentile  # noqa: E402
-from pycram.experiments.runner import prepare_experiment, run_experiment  # noqa: E402
+from pycram.apps.experiments import store  # noqa: E402
+from pycram.apps.experiments.report import percentile  # noqa: E402
+from pycram.apps.experiments.runner import prepare_experiment, run_experiment  # noqa: E402
 
 
 def _experiment(db: str, name: str, args: argparse.Namespace, workers: int, ray: str | None) -> tuple[float, list]:

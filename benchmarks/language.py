@@ -61,10 +61,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from rich.console import Console  # noqa: E402
 from rich.table import Table  # noqa: E402
 
+from pycram.core.runtime.workers import shutdown_idle_workers  # noqa: E402
 from pycram.fluent import Fluent, whenever  # noqa: E402
 from pycram.language import par, pursue, seq  # noqa: E402
 from pycram.runtime import TaskStatus, current_task  # noqa: E402
-from pycram.runtime.workers import shutdown_idle_workers  # noqa: E402
 
 perf = time.perf_counter
 

@@ -31,7 +31,7 @@ from pycram.designator import LocationDesignator  # noqa: E402
 from pycram.designators.core import DesignatorError  # noqa: E402
 from pycram.environments import load  # noqa: E402
 from pycram.locations import KnownObject, RobotGeometry, grasp_sequence  # noqa: E402
-from pycram.robots.sim_resolvers import make_to_reach_generator  # noqa: E402
+from pycram.robots.common.sim_resolvers import make_to_reach_generator  # noqa: E402
 from pycram.sim import World  # noqa: E402
 from pycram.world.scenes import random_scene  # noqa: E402
 

@@ -53,7 +53,7 @@ def main(argv: list[str]) -> int:
     rng = random.Random(11)
     all_times: list[float] = []
     settings = []
-    from pycram.sim.prospection import SimProspection
+    from pycram.backends.sim.prospection import SimProspection
 
     with open_world(args.robot, args.env) as world:
         for setting in ("no obstacles", "3 obstacles"):
@@ -84,7 +84,7 @@ def main(argv: list[str]) -> int:
                 f"{'':>13}  detours alone: p50 {percentile(detour_times, 50):6.1f} ms, "
                 f"p95 {percentile(detour_times, 95):6.1f} ms"
             )
-        from pycram.sim.path_drive import memoized_free
+        from pycram.backends.sim.path_drive import memoized_free
 
         with_exact = []
         for pair in pairs:  # a fresh memo per plan, as drives have

@@ -35,8 +35,8 @@ def main() -> None:
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
 
+    from pycram.backends.sim.perception import MAX_RANGE, MIN_PIXELS
     from pycram.sim import World
-    from pycram.sim.perception import MAX_RANGE, MIN_PIXELS
     from pycram.world.belief import BeliefState
     from pycram.world.objects import OBJECT_TYPES, object_type
 

@@ -32,9 +32,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from pycram.core.runtime.workers import shutdown_idle_workers  # noqa: E402
 from pycram.fluent import Fluent  # noqa: E402
 from pycram.language import par, pursue, seq  # noqa: E402
-from pycram.runtime.workers import shutdown_idle_workers  # noqa: E402
 
 
 def _noop() -> None:

@@ -35,8 +35,8 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 def demo_figures(robot: str, backend: str, runs: int, master_uri: str = "") -> dict[str, float]:
-    from pycram.demos.kitchen import DemoOptions, run_demo
-    from pycram.ros.launch import BridgeProcess
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
+    from pycram.backends.ros.launch import BridgeProcess
 
     plan, run, sim, startup = [], [], [], []
     for _ in range(runs):
@@ -73,8 +73,8 @@ def round_trip(samples: int) -> list[float]:
     import rospy
     from std_msgs.msg import Float64
 
+    from pycram.backends.ros.ros1 import ros1_transport
     from pycram.fluent import Fluent
-    from pycram.ros.ros1 import ros1_transport
 
     transport = ros1_transport()
     value = Fluent(None, name="benchmark value")
@@ -128,7 +128,7 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=500, help="fluent round trips")
     args = parser.parse_args()
 
-    from pycram.ros.launch import RosMaster
+    from pycram.backends.ros.launch import RosMaster
 
     print(f"thesis demo, {args.robot}, median of {args.runs} run(s) [s of wall time]:")
     sim = demo_figures(args.robot, "sim", args.runs)

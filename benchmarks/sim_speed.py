@@ -48,8 +48,8 @@ def busy_run(world, seconds: float) -> tuple[float, float, str]:
 
 
 def record_run(robot: str, seconds: float, fps: float, size: tuple[int, int]) -> None:
+    from pycram.backends.sim.render import write_animation
     from pycram.sim import World
-    from pycram.sim.render import write_animation
 
     world = World(robot)
     try:
@@ -86,7 +86,7 @@ def record_run(robot: str, seconds: float, fps: float, size: tuple[int, int]) ->
 
 
 def demo_runs() -> None:
-    from pycram.demos.kitchen import DemoOptions, run_demo
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
 
     with tempfile.TemporaryDirectory() as tmp:
         for animation in (True, False):

@@ -12,12 +12,12 @@ from typing import Any
 from pycram._version import __version__ as __version__
 
 _LAZY = {
-    "perform": "pycram.designator",
-    "sleep": "pycram.runtime",
-    "current_task": "pycram.runtime",
-    "Evaporated": "pycram.runtime",
-    "Fluent": "pycram.fluent",
-    "State": "pycram.language",
+    "perform": "pycram.execution.perform",
+    "sleep": "pycram.core.runtime",
+    "current_task": "pycram.core.runtime",
+    "Evaporated": "pycram.core.runtime",
+    "Fluent": "pycram.core.fluent",
+    "State": "pycram.core.expressions",
 }
 
 

@@ -1,7 +1,7 @@
 """`python -m pycram FILE.py [ARGS...]` runs a plan script with the block syntax switched on.
 
 Any other arguments (`python -m pycram run FILE.py`, `python -m pycram demo`, none) go to the
-`pycram` command line (`pycram.cli.main`).
+`pycram` command line (`pycram.apps.cli.main`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run `argv[0]` as a plan script if it names a Python file, else the pycram CLI."""
     args = sys.argv[1:] if argv is None else argv
     if args and (args[0].endswith(".py") or os.path.isfile(args[0])):
-        from pycram.macros import format_script_error, run_script
+        from pycram.core.macros import format_script_error, run_script
 
         try:
             run_script(args[0], args[1:])
@@ -22,7 +22,7 @@ def main(argv: list[str] | None = None) -> int:
             sys.stderr.write(format_script_error(e, args[0]))
             return 1
         return 0
-    from pycram.cli import main as cli_main
+    from pycram.apps.cli import main as cli_main
 
     result = cli_main()
     return result if isinstance(result, int) else 0

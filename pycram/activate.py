@@ -13,6 +13,6 @@ Undo with `pycram.macros.uninstall_import_hook()`.
 
 from __future__ import annotations
 
-from pycram.macros import install_import_hook
+from pycram.core.macros import install_import_hook
 
 install_import_hook()

@@ -20,9 +20,9 @@ from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
-from pycram.process_module import ProcessModule
-from pycram.runtime import wait_until
-from pycram.runtime.evaporation import runtime_code
+from pycram.core.runtime import wait_until
+from pycram.core.runtime.evaporation import runtime_code
+from pycram.execution.process_module import ProcessModule
 
 __all__ = ["ScriptedProcessModule", "CountingGenerator", "scenario_double", "SCENARIO_DOUBLE_FAULTS"]
 

@@ -40,7 +40,7 @@ PY="$VENV/bin/python"
 SITE=$("$PY" -c "import sysconfig; print(sysconfig.get_paths()['purelib'])")
 MSGS=$(cd "$VENV" && pwd)/ros-msgs
 printf '%s\n%s\n' "$MSGS" /usr/lib/python3/dist-packages > "$SITE/pycram-ros.pth"
-PYTHONPATH="$HERE" "$PY" -m pycram.ros.interfaces.generate "$MSGS"
+PYTHONPATH="$HERE" "$PY" -m pycram.backends.ros.interfaces.generate "$MSGS"
 # Check: ROS imports, and the venv's own numpy (not Debian's) comes first.
 PYTHONPATH="$HERE" "$PY" - <<'PYEOF'
 import importlib, sys

@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from pycram.block_forms import BlockSyntaxNotEnabled
+from pycram.core.block_forms import BlockSyntaxNotEnabled
 from pycram.fluent import Fluent, whenever
 from pycram.language import State, par, plan, seq
 from pycram.macros import (

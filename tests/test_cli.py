@@ -15,7 +15,7 @@ import pytest
 pytest.importorskip("sqlalchemy")
 from typer.testing import CliRunner  # noqa: E402
 
-from pycram.cli import app  # noqa: E402
+from pycram.apps.cli import app  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 runner = CliRunner()
@@ -87,9 +87,9 @@ def _invoke(*args: str):
 
 
 def test_run_records_by_default_and_inspection_commands(db, plan_file, tmp_path, monkeypatch):
-    import pycram.cli
+    import pycram.apps.cli
 
-    monkeypatch.setattr(pycram.cli.console, "width", 200)  # one line per tree line and per run
+    monkeypatch.setattr(pycram.apps.cli.console, "width", 200)  # one line per tree line and per run
     result = _invoke("run", str(plan_file), "x", "--y")
     assert result.exit_code == 0, result.output
     assert "script args ['x', '--y']" in result.output
@@ -156,9 +156,9 @@ def test_demo_passes_options_through(monkeypatch, db):
         calls.update(kwargs)
         return 0
 
-    fake = types.ModuleType("pycram.demos.kitchen")
+    fake = types.ModuleType("pycram.apps.demos.kitchen")
     fake.main = fake_main
-    monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
+    monkeypatch.setitem(sys.modules, "pycram.apps.demos.kitchen", fake)
     result = _invoke(
         "demo",
         "--robot",
@@ -207,9 +207,9 @@ def test_demo_passes_options_through(monkeypatch, db):
 def fake_demo(monkeypatch):
     """A stand-in for the demo that records whether it was started."""
     started = []
-    fake = types.ModuleType("pycram.demos.kitchen")
+    fake = types.ModuleType("pycram.apps.demos.kitchen")
     fake.main = lambda **kwargs: started.append(kwargs) or 0
-    monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", fake)
+    monkeypatch.setitem(sys.modules, "pycram.apps.demos.kitchen", fake)
     return started
 
 
@@ -239,7 +239,7 @@ def test_demo_options_out_of_range_are_refused_with_exit_2(fake_demo, option, va
 
 
 def test_demo_missing_is_a_clear_error(monkeypatch):
-    monkeypatch.setitem(sys.modules, "pycram.demos.kitchen", None)
+    monkeypatch.setitem(sys.modules, "pycram.apps.demos.kitchen", None)
     result = _invoke("demo")
     assert result.exit_code == 1
     assert "kitchen demo" in result.output
@@ -262,9 +262,9 @@ def test_console_script_subprocess(tmp_path, plan_file):
 def test_repeated_siblings_are_collapsed_in_displays_not_in_the_data(db, tmp_path, monkeypatch):
     """250 identical successful head motions are one line / box / row "×250"; the failure
     between them stays visible; the database keeps every task; --expand shows them all."""
-    import pycram.cli
+    import pycram.apps.cli
 
-    monkeypatch.setattr(pycram.cli.console, "width", 200)  # one tree line per task line
+    monkeypatch.setattr(pycram.apps.cli.console, "width", 200)  # one tree line per task line
     plan = tmp_path / "head_loop.py"
     plan.write_text(REPEATING_PLAN)
     assert _invoke("run", str(plan)).exit_code == 0

@@ -37,7 +37,7 @@ fetch()
 
 def _commands(tmp_path: Path) -> dict[str, list[str]]:
     exe = Path(sys.executable).with_name("pycram")
-    cli = [str(exe)] if exe.exists() else [sys.executable, "-m", "pycram.cli"]
+    cli = [str(exe)] if exe.exists() else [sys.executable, "-m", "pycram.apps.cli"]
     return {"pycram run": [*cli, "run", "--no-record"], "python -m pycram": [sys.executable, "-m", "pycram"]}
 
 

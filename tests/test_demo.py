@@ -1,6 +1,6 @@
 """End-to-end runs of the thesis demo in the simulated kitchen (headless).
 
-Each test runs the real plan (`pycram.demos.kitchen_plan`) on a simulated robot and checks what
+Each test runs the real plan (`pycram.apps.demos.kitchen_plan`) on a simulated robot and checks what
 the issue asks of the demo. Wall-clock speed is not asserted here: `benchmarks/demo_speed.py`
 prints it.
 """
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from pycram.demos.kitchen import DemoOptions, run_demo
+from pycram.apps.demos.kitchen import DemoOptions, run_demo
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -65,7 +65,7 @@ def test_item_at_position_3_fails_two_grasps_then_succeeds(tmp_path):
 
 
 def test_two_thefts_are_recovered(tmp_path):
-    from pycram.demos import kitchen_plan
+    from pycram.apps.demos import kitchen_plan
 
     result = demo(tmp_path, steal=2, seed=3)
     assert result.exit_code == 0, result.message
@@ -91,14 +91,14 @@ def test_no_item_ends_with_a_clear_failure(tmp_path):
     ],
 )
 def test_bad_options_get_a_clear_message_and_exit_code_2(tmp_path, capsys, option, value, expected):
-    from pycram.demos.kitchen import main
+    from pycram.apps.demos.kitchen import main
 
     assert main(output=str(tmp_path), record=False, quiet=True, **{option: value}) == 2
     assert expected in capsys.readouterr().out
 
 
 def test_the_command_prints_the_collapsed_task_tree_and_a_verdict(tmp_path, capsys):
-    from pycram.demos.kitchen import main
+    from pycram.apps.demos.kitchen import main
 
     code = main(output=str(tmp_path / "out"), db=f"sqlite:///{tmp_path / 'runs.sqlite3'}", quiet=True)
     out = capsys.readouterr().out
@@ -168,7 +168,7 @@ def test_the_pictures_show_the_item_and_each_frame_says_what_happens(tmp_path):
 def test_each_run_writes_to_its_own_folder(tmp_path, monkeypatch):
     """Without --output: output/demo-ROBOT-RUNID for recorded runs (a timestamped folder that
     never reuses an existing one otherwise); `animation=False` writes no GIF."""
-    from pycram.demos.kitchen import default_output
+    from pycram.apps.demos.kitchen import default_output
 
     monkeypatch.chdir(tmp_path)
     db = f"sqlite:///{tmp_path / 'runs.sqlite3'}"

@@ -416,7 +416,7 @@ def test_non_iterable_from_resolver_of_every_kind_names_designator_and_resolver(
 
 
 def test_performed_actions_are_published_as_events():
-    from pycram import events
+    from pycram.core import events
 
     def wave(designator):
         return "waved"

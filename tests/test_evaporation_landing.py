@@ -25,6 +25,7 @@ from typing import Any
 import pytest
 
 import pycram
+from pycram.core.runtime.evaporation import _USER, Evaporated, current_runner, shielded
 from pycram.designator import MotionDesignator, perform
 from pycram.language import (
     State,
@@ -47,7 +48,6 @@ from pycram.language import (
 )
 from pycram.process_module import ProcessModule, ProcessModuleStatus
 from pycram.runtime import Task, as_task, current_task
-from pycram.runtime.evaporation import _USER, Evaporated, current_runner, shielded
 from pycram.testing import ScriptedProcessModule
 
 MAX_POINTS = 400  # more than any scenario below executes

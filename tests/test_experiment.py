@@ -19,7 +19,7 @@ import pytest
 sa = pytest.importorskip("sqlalchemy")
 from typer.testing import CliRunner  # noqa: E402
 
-from pycram.cli import app  # noqa: E402
+from pycram.apps.cli import app  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 runner = CliRunner()
@@ -90,7 +90,7 @@ def local_ray():
         import ray
     except ImportError:
         pytest.skip("Ray is not installed (the 'ray' extra: pip install 'pycram[ray]')")
-    from pycram.experiments.runner import ray_runtime_env
+    from pycram.apps.experiments.runner import ray_runtime_env
 
     ray.init(num_cpus=2, include_dashboard=False, runtime_env=ray_runtime_env(), logging_level="WARNING")
     session_dir = ray._private.worker._global_node.get_session_dir_path()
@@ -196,12 +196,12 @@ def test_bad_input_exits_with_2_naming_the_valid_choices(tmp_path, args, expecte
 
 
 def test_set_table_is_registered_lazily():
-    from pycram.experiments.scenarios import SCENARIOS, UnknownScenario, get_scenario
+    from pycram.apps.experiments.scenarios import SCENARIOS, UnknownScenario, get_scenario
 
     entry = SCENARIOS["set-table"]
-    assert entry.target == "pycram.demos.set_table:run_set_table"
+    assert entry.target == "pycram.apps.demos.set_table:run_set_table"
     try:
-        import pycram.demos.set_table  # noqa: F401
+        import pycram.apps.demos.set_table  # noqa: F401
     except ModuleNotFoundError:
         with pytest.raises(
             UnknownScenario,
@@ -213,7 +213,7 @@ def test_set_table_is_registered_lazily():
 
 
 def test_seed_parsing():
-    from pycram.experiments.runner import ExperimentInputError, parse_seeds
+    from pycram.apps.experiments.runner import ExperimentInputError, parse_seeds
 
     assert parse_seeds("1-3,7, 2,10-11") == [1, 2, 3, 7, 10, 11]
     for bad in ("", "-1", "1-", "3-2", "a", "1.5"):
@@ -227,7 +227,7 @@ def test_a_scenario_error_is_recorded_and_run_again_on_resume(tmp_path, monkeypa
     db = tmp_path / "t.sqlite3"
     args = ["experiment", "--scenario", DOUBLE, "--robot", "pr2,tiago", "--seeds", "1-2", "--name", "e"]
     args += ["--db", str(db), "--output", str(tmp_path / "out"), "--workers", "1"]
-    from pycram.experiments import runner as experiment_runner
+    from pycram.apps.experiments import runner as experiment_runner
 
     real = experiment_runner.execute_run
     calls = []
@@ -256,7 +256,7 @@ def test_a_scenario_error_is_recorded_and_run_again_on_resume(tmp_path, monkeypa
 
 def _run_inline(prepared, workers, stop, finished, outcome):
     """`_run_local` without worker processes (the test patches `execute_run` in this process)."""
-    from pycram.experiments import runner as experiment_runner
+    from pycram.apps.experiments import runner as experiment_runner
 
     for robot, seed, variant in prepared.todo:
         result = experiment_runner.execute_run(prepared.scenario.spec, robot, seed, variant, prepared.db)
@@ -282,7 +282,7 @@ def test_an_experiment_in_postgresql(tmp_path):
 
 def test_a_scenario_registered_in_the_driver_runs_in_the_workers(tmp_path):
     """Workers find a registered callable by its import path: no registration there."""
-    from pycram.experiments.scenarios import SCENARIOS, register_scenario
+    from pycram.apps.experiments.scenarios import SCENARIOS, register_scenario
     from pycram.testing import scenario_double
 
     register_scenario("double", scenario_double, faults=("drop", "slow"))

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from pycram.block_forms import BlockSyntaxNotEnabled
+from pycram.core.block_forms import BlockSyntaxNotEnabled
 from pycram.fluent import Fluent, whenever
 from pycram.language import (
     RetriesExhausted,

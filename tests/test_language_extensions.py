@@ -379,7 +379,7 @@ def test_partial_order_block_syntax() -> None:
 
 
 def test_partial_order_block_needs_the_syntax() -> None:
-    from pycram.block_forms import BlockSyntaxNotEnabled
+    from pycram.core.block_forms import BlockSyntaxNotEnabled
 
     with pytest.raises(BlockSyntaxNotEnabled):
         with partial_order([(1, 2)]):

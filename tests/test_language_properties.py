@@ -26,9 +26,10 @@ from hypothesis import HealthCheck, event, given, seed, settings
 from hypothesis import strategies as st
 
 import pycram
+from pycram.core.expressions import RetryRequested
+from pycram.core.runtime.workers import shutdown_idle_workers, worker_count
 from pycram.fluent import Fluent
 from pycram.language import (
-    RetryRequested,
     State,
     failure_handling,
     par,
@@ -40,7 +41,6 @@ from pycram.language import (
     with_timeout,
 )
 from pycram.runtime import Task, TaskStatus, current_task
-from pycram.runtime.workers import shutdown_idle_workers, worker_count
 
 PLAN_TIMEOUT = 5.0  # [s] a plan that has not ended by then is a hang
 MAX_DEPTH = 4

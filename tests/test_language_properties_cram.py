@@ -35,6 +35,7 @@ import test_language_properties as base
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from pycram.core.runtime.workers import shutdown_idle_workers
 from pycram.fluent import Fluent
 from pycram.language import (
     PolicyConditionMet,
@@ -50,7 +51,6 @@ from pycram.language import (
     with_tags,
 )
 from pycram.runtime import Task, TaskStatus, add_task_listener, current_task, remove_task_listener
-from pycram.runtime.workers import shutdown_idle_workers
 
 S, F, E, R, P = (
     TaskStatus.SUCCEEDED,

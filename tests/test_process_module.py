@@ -453,7 +453,7 @@ def test_cancel_while_running_plain_python_execute():
 
 
 def test_executions_and_performed_designators_are_published_as_events():
-    from pycram import events
+    from pycram.core import events
 
     executed, performed = [], []
     unsubscribe = [

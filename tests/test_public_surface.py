@@ -168,7 +168,7 @@ def test_the_public_modules_are_found():
         "pycram.trace",
     ):
         assert core in MODULES
-    assert "pycram.sim._runtime" not in MODULES
+    assert "pycram.backends.sim._runtime" not in MODULES
 
 
 @pytest.mark.parametrize("module_name", MODULES)

@@ -124,7 +124,7 @@ def _record_a_run(db_url: str, tmp_path: Path) -> None:
     env = dict(os.environ, PYTHONPATH=str(REPO), PYCRAM_DB_URL=db_url)
     env.pop("PYCRAM_RECORD", None)
     out = subprocess.run(
-        [sys.executable, "-m", "pycram.cli", "run", str(plan)],
+        [sys.executable, "-m", "pycram.apps.cli", "run", str(plan)],
         capture_output=True,
         text=True,
         env=env,

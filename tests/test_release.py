@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 import pycram
 from pycram._version import __version__
-from pycram.cli import app
+from pycram.apps.cli import app
 
 ROOT = Path(__file__).resolve().parent.parent
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))

@@ -10,6 +10,7 @@ import time
 
 import pytest
 
+from pycram.core.runtime.workers import shutdown_idle_workers, worker_count
 from pycram.fluent import Fluent
 from pycram.language import State, par, pursue, seq, with_timeout
 from pycram.runtime import (
@@ -24,7 +25,6 @@ from pycram.runtime import (
     sleep,
     use_clock,
 )
-from pycram.runtime.workers import shutdown_idle_workers, worker_count
 
 WAIT = 5.0
 

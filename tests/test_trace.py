@@ -21,7 +21,7 @@ import pytest
 
 sa = pytest.importorskip("sqlalchemy")
 
-import pycram.events as events  # noqa: E402
+import pycram.core.events as events  # noqa: E402
 from pycram.fluent import Fluent  # noqa: E402
 from pycram.language import State, par, pursue, seq  # noqa: E402
 from pycram.runtime import run_subtask, sleep  # noqa: E402
@@ -456,7 +456,7 @@ def test_recording_switch_from_environment(monkeypatch, value, default, expected
 
 def test_library_import_does_not_load_sqlalchemy():
     code = (
-        "import sys, pycram, pycram.trace, pycram.language, pycram.events; "
+        "import sys, pycram, pycram.trace, pycram.language, pycram.core.events; "
         "assert 'sqlalchemy' not in sys.modules, 'sqlalchemy imported'; "
         "assert 'matplotlib' not in sys.modules; print('ok')"
     )
@@ -552,7 +552,7 @@ def test_sigkilled_run_keeps_its_trace_up_to_the_last_second(db_url, tmp_path):
     # once its heartbeat is 10 s old; until then as running)
     from typer.testing import CliRunner
 
-    from pycram.cli import app
+    from pycram.apps.cli import app
     from pycram.trace.pictures import write_run_pictures
 
     shown = CliRunner().invoke(app, ["show", str(run_id), "--db", db_url, "--max-nodes", "50"])

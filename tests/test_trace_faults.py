@@ -22,8 +22,8 @@ sa = pytest.importorskip("sqlalchemy")
 
 from typer.testing import CliRunner  # noqa: E402
 
-import pycram.events as events  # noqa: E402
-from pycram.cli import app  # noqa: E402
+import pycram.core.events as events  # noqa: E402
+from pycram.apps.cli import app  # noqa: E402
 from pycram.language import State, seq  # noqa: E402
 from pycram.trace import query  # noqa: E402
 from pycram.trace.db import TraceDatabaseError  # noqa: E402
@@ -278,7 +278,7 @@ def test_pycram_run_tells_how_many_records_were_lost_and_succeeds(tmp_path):
 def test_the_demo_succeeds_and_tells_how_many_records_were_lost(tmp_path, capsys, monkeypatch):
     """The demo's database loses its task table right after the run started: the plan
     succeeds, the pictures are drawn from memory, the end output says what was lost."""
-    import pycram.demos.kitchen as kitchen
+    import pycram.apps.demos.kitchen as kitchen
 
     path = tmp_path / "runs.sqlite3"
     start = kitchen._start_recorder

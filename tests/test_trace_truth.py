@@ -14,7 +14,7 @@ sa = pytest.importorskip("sqlalchemy")
 
 from typer.testing import CliRunner  # noqa: E402
 
-from pycram.cli import app  # noqa: E402
+from pycram.apps.cli import app  # noqa: E402
 from pycram.language import seq, try_in_order  # noqa: E402
 from pycram.runtime import ManualClock, as_task, run_subtask, use_clock  # noqa: E402
 from pycram.trace import query  # noqa: E402
@@ -26,9 +26,9 @@ runner = CliRunner()
 @pytest.fixture
 def wide(monkeypatch):
     """One terminal line per tree line and per run (the CLI console is 80 columns in tests)."""
-    import pycram.cli
+    import pycram.apps.cli
 
-    monkeypatch.setattr(pycram.cli.console, "width", 250)
+    monkeypatch.setattr(pycram.apps.cli.console, "width", 250)
 
 
 def _invoke(*args: str):
@@ -148,7 +148,7 @@ def test_the_demo_database_counts_each_failed_grasp_once_and_shows_every_executi
     """A real demo run with no item: three grasps fail (each re-raised by its `try_in_order`
     step and the `try_in_order`), the run's error is recorded, and the task tree lists the
     blocking reaching motions."""
-    from pycram.demos.kitchen import DemoOptions, run_demo
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
 
     url = f"sqlite:///{tmp_path / 'runs.sqlite3'}"
     result = run_demo(DemoOptions(output=tmp_path / "out", quiet=True, db=url, item_at=0, animation=False))

@@ -17,7 +17,7 @@ robot or world by an action resolver of its own (asked before the library's).
 """
 
 from pycram.designators.action import ActionDesignator
-from pycram.failures import ObjectNotFound
+from pycram.execution.failures import ObjectNotFound
 
 from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
 from .containers import Close, Open, believed_open

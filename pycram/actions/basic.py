@@ -26,12 +26,12 @@ import math
 from functools import partial
 from typing import Any
 
+from pycram.core.expressions import State, par
 from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
-from pycram.language import State, par
+from pycram.execution.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
 
 from .core import RECOVERABLE, ActionParameterError, action_plan, arm_name, arms, attempt, make_action, motion, unwrap
 from .core import solutions as location_solutions
@@ -143,7 +143,7 @@ def navigating(designator: ActionDesignator) -> Any:
 
 
 def _is_motion_failure(error: BaseException) -> bool:
-    from pycram.failures import MotionFailure
+    from pycram.execution.failures import MotionFailure
 
     return isinstance(unwrap(error), MotionFailure)
 
@@ -162,8 +162,8 @@ def point_of(target: Any) -> tuple[float, float, float]:
     if pose is not None and not callable(pose) and len(pose) == 3:
         return (float(pose[0]), float(pose[1]), float(pose[2]))
     if isinstance(target, str):
-        from pycram.locations.targets import as_target
-        from pycram.robot import current_robot
+        from pycram.execution.robot import current_robot
+        from pycram.reasoning.locations.targets import as_target
 
         belief = getattr(current_robot(), "belief", None)
         environment = getattr(belief, "environment", None)

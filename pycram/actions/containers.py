@@ -20,7 +20,7 @@ door must be measured at least 60 deg open (`DOOR_USEFUL`) or within 10 deg of t
 below 4 deg (`DOOR_CLOSED`). A robot whose grip carries a door only part of the way (its
 description's `DOOR_PULL_LIMIT`, the TIAGo) pulls it that far by the handle, lets go, and pushes
 it on from inside with its hand (no grasp) from a standing pose of its own
-(``('to_open', door), ('pushing', 'inside')``, tool poses from `pycram.locations.doors` and the
+(``('to_open', door), ('pushing', 'inside')``, tool poses from `pycram.reasoning.locations.doors` and the
 robot's `DOOR_PUSH`). `Close("fridge")` pushes the handle back along the arc from the pose the
 door was opened from by its handle alone; else (opened by pushing, after a failed opening, or
 by someone else) it pushes the door shut by its outside face from where location reasoning
@@ -47,11 +47,11 @@ from typing import Any
 
 from pycram.designators.action import ActionDesignator
 from pycram.designators.location import LocationDesignator
-from pycram.designators.perform import perform
-from pycram.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
-from pycram.locations import doors
-from pycram.locations.reasoning import DRAWER_PUSH_BEYOND
-from pycram.robot import current_robot
+from pycram.execution.failures import ContainerFailure, ContainerStuck, HandleMissed, ObjectOutOfReach
+from pycram.execution.perform import perform
+from pycram.execution.robot import current_robot
+from pycram.reasoning.locations import doors
+from pycram.reasoning.locations.reasoning import DRAWER_PUSH_BEYOND
 
 from .core import (
     RECOVERABLE,
@@ -490,7 +490,7 @@ def _stepped_in(location: Any, distance: float) -> Any:
     (prospection); else None."""
     from dataclasses import replace
 
-    from pycram.robot import current_prospection
+    from pycram.execution.robot import current_prospection
 
     x = location.x + distance * math.cos(location.yaw)
     y = location.y + distance * math.sin(location.yaw)
@@ -559,7 +559,7 @@ def _operate_door(
 
     Opening: by the handle along the arc -- for a robot whose grip carries a door only part of
     the way (its description's `DOOR_PULL_LIMIT`), by the handle that far and then pushed on
-    from inside (`pycram.locations.doors`) from a standing pose of its own. Closing: by the
+    from inside (`pycram.reasoning.locations.doors`) from a standing pose of its own. Closing: by the
     handle from the pose it was opened from (when it was opened by the handle alone), else
     pushed shut by its outside face from where location reasoning finds, else by the handle
     from a new standing pose."""

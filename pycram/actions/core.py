@@ -33,16 +33,16 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from pycram.core.expressions import State, pursue
+from pycram.core.fluent import Fluent
+from pycram.core.runtime.task_variables import TaskVariable
 from pycram.designators.action import ActionDesignator
 from pycram.designators.core import DesignatorError, NoSolutionError, PropertyError
 from pycram.designators.motion import MotionDesignator
-from pycram.designators.perform import perform
-from pycram.failures import PlanFailure
-from pycram.fluent import Fluent
-from pycram.language import State, pursue
-from pycram.process_module import ProcessModuleError, ProcessModuleFailure
-from pycram.robot import current_robot
-from pycram.runtime.task_variables import TaskVariable
+from pycram.execution.failures import PlanFailure
+from pycram.execution.perform import perform
+from pycram.execution.process_module import ProcessModuleError, ProcessModuleFailure
+from pycram.execution.robot import current_robot
 
 __all__ = [
     "ACTION_PLANS",
@@ -267,6 +267,6 @@ def best_effort(what: str, *steps: Callable[[], Any]) -> None:
 
 def attempt(name: str, body: Callable[[], Any]) -> Any:
     """Run `body` as a task called `name` (so the task tree shows each attempt of an action)."""
-    from pycram.runtime import run_subtask
+    from pycram.core.runtime import run_subtask
 
     return run_subtask(name, body, kind="attempt")

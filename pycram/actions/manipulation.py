@@ -42,12 +42,12 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
+from pycram.core.expressions import State, pursue
 from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.designators.perform import perform
-from pycram.failures import (
+from pycram.execution.failures import (
     GraspFailed,
     GripperEmpty,
     NavigationFailure,
@@ -57,9 +57,9 @@ from pycram.failures import (
     PlacingFailed,
     PlanFailure,
 )
-from pycram.language import State, pursue
-from pycram.locations.targets import KnownObject
-from pycram.robot import current_robot
+from pycram.execution.perform import perform
+from pycram.execution.robot import current_robot
+from pycram.reasoning.locations.targets import KnownObject
 from pycram.world.belief import PerceivedObject
 from pycram.world.objects import OBJECT_TYPES, Grasp, object_type
 

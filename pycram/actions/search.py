@@ -40,14 +40,14 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
+from pycram.core.fluent import Fluent
+from pycram.core.runtime import as_task
 from pycram.designators.core import DesignatorError
 from pycram.designators.motion import MotionDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.designators.perform import perform
-from pycram.failures import ObjectNotFound, PlanFailure
-from pycram.fluent import Fluent
-from pycram.process_module import ProcessModuleError
-from pycram.runtime import as_task
+from pycram.execution.failures import ObjectNotFound, PlanFailure
+from pycram.execution.perform import perform
+from pycram.execution.process_module import ProcessModuleError
 from pycram.world.belief import BeliefState, PerceivedObject
 from pycram.world.environment import Environment, Surface
 from pycram.world.objects import OBJECT_TYPES
@@ -191,7 +191,7 @@ def lookouts(
 
 
 def _robot_belief() -> BeliefState:
-    from pycram.robot import current_robot
+    from pycram.execution.robot import current_robot
 
     robot = current_robot()
     belief = getattr(robot, "belief", None)

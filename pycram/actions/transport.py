@@ -21,9 +21,9 @@ from typing import Any
 
 from pycram.designators.action import ActionDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.designators.perform import perform
-from pycram.failures import GripperEmpty, ObjectSlipped
-from pycram.robot import current_robot
+from pycram.execution.failures import GripperEmpty, ObjectSlipped
+from pycram.execution.perform import perform
+from pycram.execution.robot import current_robot
 
 from .containers import CLOSED, DOOR_CLOSED, Close
 from .core import ActionParameterError, action_plan, arms, attempt, make_action

@@ -1,4 +1,11 @@
-"""Designators by kind; :mod:`pycram.designator` is the thesis-compatible import path."""
+"""The designators layer: symbolic descriptions of motions, objects, locations and actions,
+resolved lazily into solutions (thesis ch. 3.3), one module per kind, and the resolver sets that
+say which resolvers are active (:mod:`pycram.designators.resolvers`).
+
+May import: :mod:`pycram.core` and the standard library. Performing a designator is execution's
+(:func:`pycram.execution.perform.perform`); :mod:`pycram.designator` is the thesis' import path
+for both.
+"""
 
 from pycram.designators.action import ActionDesignator, plan_for
 from pycram.designators.core import (
@@ -15,7 +22,6 @@ from pycram.designators.location import LocationDesignator
 from pycram.designators.motion import MotionDesignator
 from pycram.designators.motion_types import GoalOutsideEnvironment, MotionKey, MotionPropertyError, MotionType
 from pycram.designators.object import Belief, BelievedObject, ObjectDesignator
-from pycram.designators.perform import perform
 
 __all__ = [
     "ActionDesignator",
@@ -36,6 +42,5 @@ __all__ = [
     "PropertyError",
     "ResolverError",
     "UnknownKindError",
-    "perform",
     "plan_for",
 ]

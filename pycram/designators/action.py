@@ -31,7 +31,7 @@ class ActionDesignator(LazyDesignator):
     kind_name = "action designator"
 
     def _current_resolvers(self) -> list[Any]:
-        from pycram.robot import gather
+        from pycram.designators.resolvers import gather
 
         return gather("action_resolvers", ActionDesignator.resolvers)
 

@@ -104,14 +104,14 @@ def callable_name(f: Any) -> str:
 
 def _now() -> float:
     """Current time [s] of the active pycram clock."""
-    from pycram.runtime import current_clock
+    from pycram.core.runtime import current_clock
 
     return current_clock().now()
 
 
 def _wait(condition: threading.Condition, predicate: Callable[[], bool]) -> None:
     """Block on ``condition`` until ``predicate()`` (evaluated with it held); evaporable."""
-    from pycram.runtime import wait_until
+    from pycram.core.runtime import wait_until
 
     wait_until(condition, predicate)
 
@@ -154,7 +154,7 @@ def _merge(properties: list[Property], key: Any, value: Any) -> None:
 def known_solution(designator: Any) -> Any:
     """The solution of ``designator`` if it was already resolved (is effective), else ``None``.
 
-    Never resolves and never blocks (for reporting, e.g. :mod:`pycram.events`).
+    Never resolves and never blocks (for reporting, e.g. :mod:`pycram.core.events`).
     """
     if isinstance(designator, Designator) and designator._effective:
         return designator._data
@@ -581,7 +581,7 @@ class LazyDesignator(Designator):
 
     def _no_solution_message(self) -> str:
         names = [callable_name(r) for r in self._resolvers_for_message()]
-        from pycram.robot import describe_active_robot
+        from pycram.designators.resolvers import describe_active_robot
 
         which = "no" if self._index == 0 else f"no solution #{self._index} (only {self._index})"
         return (

@@ -45,12 +45,12 @@ class LocationDesignator(LazyDesignator):
     kind_name = "location designator"
 
     def _current_generators(self) -> list[Any]:
-        from pycram.robot import gather
+        from pycram.designators.resolvers import gather
 
         return gather("location_generators", LocationDesignator.generators)
 
     def _current_validators(self) -> list[Any]:
-        from pycram.robot import gather
+        from pycram.designators.resolvers import gather
 
         return gather("location_validators", LocationDesignator.validators)
 
@@ -84,7 +84,7 @@ class LocationDesignator(LazyDesignator):
             if verdict is not None:
                 affirmed = True
         if not affirmed:
-            from pycram.robot import describe_active_robot
+            from pycram.designators.resolvers import describe_active_robot
 
             raise DesignatorError(
                 f"Cannot tell whether {pose!r} is in {self!r}: no location validator applies "

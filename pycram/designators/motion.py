@@ -33,7 +33,7 @@ class MotionDesignator(LazyDesignator):
         return getattr(self, "_used_resolvers", None) or self._current_resolvers()
 
     def _current_resolvers(self) -> list[Any]:
-        from pycram.robot import gather
+        from pycram.designators.resolvers import gather
 
         return gather("motion_resolvers", MotionDesignator.resolvers)
 

@@ -208,7 +208,7 @@ class MotionType:
 
 def active_motion_types() -> dict[Any, MotionType]:
     """The motion types declared by the active world and robot (the robot's win)."""
-    from pycram.robot import active_resolver_sets
+    from pycram.designators.resolvers import active_resolver_sets
 
     merged: dict[Any, MotionType] = {}
     for resolver_set in reversed(active_resolver_sets()):
@@ -219,7 +219,7 @@ def active_motion_types() -> dict[Any, MotionType]:
 def describe_known_types(types: Mapping[Any, MotionType], wanted: Any = None) -> str:
     """``known motion types of active robot 'pr2': [...]`` (with a suggestion close to
     ``wanted``)."""
-    from pycram.robot import describe_active_robot
+    from pycram.designators.resolvers import describe_active_robot
 
     names = sorted(str(t) for t in types)
     close = difflib.get_close_matches(str(wanted), names, n=1) if wanted is not None else []
@@ -300,7 +300,7 @@ def _is_pose2d(value: Any) -> bool:
 
 
 def _is_fluent(value: Any) -> bool:
-    from pycram.fluent import Fluent
+    from pycram.core.fluent import Fluent
 
     return isinstance(value, Fluent)
 

@@ -120,7 +120,7 @@ class ObjectDesignator(LazyDesignator):
     kind_name = "object designator"
 
     def _current_resolvers(self) -> list[Any]:
-        from pycram.robot import gather
+        from pycram.designators.resolvers import gather
 
         return gather("object_resolvers", ObjectDesignator.resolvers)
 

@@ -1,28 +1,7 @@
-"""Location reasoning: where to stand to reach, see or open something, and where to put things.
+"""Location reasoning: where to stand, where to look, where to put things.
 
-`LocationReasoner` resolves the location vocabulary (``to_reach``, ``to_see``, ``to_open``,
-``on``, ``in``) for any robot in any environment: costmap layers over the floor, ranked
-best-first, each candidate validated with prospection. Robot numbers come from the robot's
-description (`RobotGeometry`), environment facts from the environment's description. This
-package is reasoning: it asks `pycram.world.prospection`, never a simulator.
+A public face: the implementation is :mod:`pycram.reasoning.locations`.
 """
 
-from .costmap import Costmap, FloorGrid
-from .reasoning import VOCABULARY, LocationReasoner, grasp_sequence
-from .robot_geometry import RobotGeometry
-from .solutions import BaseLocation, Spot
-from .targets import KnownObject, Target, as_target
-
-__all__ = [
-    "LocationReasoner",
-    "RobotGeometry",
-    "BaseLocation",
-    "Spot",
-    "Target",
-    "KnownObject",
-    "as_target",
-    "Costmap",
-    "FloorGrid",
-    "VOCABULARY",
-    "grasp_sequence",
-]
+from pycram.reasoning.locations import *  # noqa: F401,F403
+from pycram.reasoning.locations import __all__  # noqa: F401

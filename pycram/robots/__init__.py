@@ -17,7 +17,7 @@ ROBOT_NAMES = ("pr2", "tiago")
 
 def load(name: str, world: Any) -> Any:
     """The robot ``name`` (``'pr2'`` or ``'tiago'``) of the simulated ``world``, as a
-    :class:`pycram.robots.sim_modules.SimRobot` with all process modules online and its motion,
+    :class:`pycram.robots.common.sim_modules.SimRobot` with all process modules online and its motion,
     process-module and location resolvers registered. Activate it with ``with robot:``; stop it
     with ``robot.shutdown()``. Raises ``ValueError`` for an unknown name or a world built for
     another robot.

@@ -1,23 +1,7 @@
-"""The ROS backend: process modules and sensors over ROS 1 (the thesis ran on a real PR2 this way).
+"""ROS 1: process modules that drive a robot over ROS, and the transport they use.
 
-Layout (one concept per module; ``rospy`` is imported only by :mod:`pycram.ros.ros1` and
-:mod:`pycram.ros.bridge`, so ``import pycram.ros`` works without ROS):
-
-* :mod:`pycram.ros.transport` -- the small interface the process modules talk through (actions,
-  topics, messages); a ROS 2 transport can be added beside the ROS 1 one.
-* :mod:`pycram.ros.ros1` -- that interface over rospy/actionlib, with a liveness watchdog.
-* :mod:`pycram.ros.config` -- per-robot interface names (PR2's real names, TIAGo's), as data.
-* :mod:`pycram.ros.modules` -- the process modules (navigation, head, torso, arms, grippers,
-  perception) and the sensor fluents.
-* :mod:`pycram.ros.detections` -- perception reports as detections messages and back (the
-  ROS perception module folds them into the robot's belief).
-* :mod:`pycram.ros.robot` -- :func:`~pycram.ros.robot.make_ros_robot` (with a belief state).
-* :mod:`pycram.ros.bridge` -- ``pycram sim-ros-bridge``: the simulator served over ROS.
-* :mod:`pycram.ros.launch` -- roscore and the bridge as subprocesses, on loopback.
-* :mod:`pycram.ros.sim_environment` -- the demo's simulated environment (items, the helper's
-  hands) reached through the bridge.
-
-Set-up: ``scripts/install_ros.sh`` (Debian's ROS 1 packages + generated messages).
+A public face: the ROS backend is :mod:`pycram.backends.ros`; importing it needs no ROS.
 """
 
-__all__: list[str] = []
+from pycram.backends.ros import *  # noqa: F401,F403
+from pycram.backends.ros import __all__  # noqa: F401

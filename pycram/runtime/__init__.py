@@ -1,56 +1,7 @@
-"""The task runtime: tasks, the task tree, evaporation and clocks (standard library only).
+"""The task runtime: tasks, evaporation, suspension, tags, clocks and worker threads.
 
-Naming rules, as in trio: `wait_*` and `sleep` block (and are evaporable); `current_*` read the
-state of the calling thread; `check_evaporation` raises, `is_evaporating` only tells.
+A public face: the implementation is :mod:`pycram.core.runtime` (one module per concept).
 """
 
-from pycram.runtime.clock import Clock, ManualClock, WallClock, current_clock, set_clock, use_clock
-from pycram.runtime.evaporation import (
-    Evaporated,
-    check_evaporation,
-    is_evaporating,
-    no_evaporation,
-    sleep,
-    wait_until,
-)
-from pycram.runtime.task import (
-    Task,
-    TaskGroup,
-    TaskListener,
-    TaskStatus,
-    add_task_listener,
-    as_task,
-    current_task,
-    end_thread_root,
-    format_task_tree,
-    remove_task_listener,
-    run_subtask,
-    task_scope,
-)
-
-__all__ = [
-    "Clock",
-    "ManualClock",
-    "WallClock",
-    "current_clock",
-    "set_clock",
-    "use_clock",
-    "Evaporated",
-    "check_evaporation",
-    "is_evaporating",
-    "no_evaporation",
-    "sleep",
-    "wait_until",
-    "Task",
-    "TaskGroup",
-    "TaskListener",
-    "TaskStatus",
-    "add_task_listener",
-    "as_task",
-    "current_task",
-    "end_thread_root",
-    "format_task_tree",
-    "remove_task_listener",
-    "run_subtask",
-    "task_scope",
-]
+from pycram.core.runtime import *  # noqa: F401,F403
+from pycram.core.runtime import __all__  # noqa: F401

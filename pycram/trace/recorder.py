@@ -55,10 +55,10 @@ from collections.abc import Iterable
 from enum import Enum
 from typing import Any, Literal
 
-from pycram import events
-from pycram.fluent import Fluent
-from pycram.runtime import Task, add_task_listener, current_clock, current_task, remove_task_listener
-from pycram.runtime.clock import Clock, add_clock_listener, remove_clock_listener
+from pycram.core import events
+from pycram.core.fluent import Fluent
+from pycram.core.runtime import Task, add_task_listener, current_clock, current_task, remove_task_listener
+from pycram.core.runtime.clock import Clock, add_clock_listener, remove_clock_listener
 
 log = logging.getLogger(__name__)
 

@@ -40,8 +40,8 @@ from typing import Any, cast
 
 import numpy as np
 
+from pycram.core.fluent import Fluent
 from pycram.designators.object import Belief, BelievedObject
-from pycram.fluent import Fluent
 
 from .environment import Environment, Surface
 from .objects import OBJECT_TYPES

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pycram.failures import GoalUnreachable, NavigationFailure
+from pycram.execution.failures import GoalUnreachable, NavigationFailure
 
 from .prospection import BasePose, as_base_pose
 

@@ -26,7 +26,7 @@ tuple; an end-effector pose is anything with ``position`` and ``orientation`` at
 (position, orientation) pair (orientation ``None``: position only).
 
 This module is backend-neutral (stdlib only). The simulator's implementation is
-``pycram.sim.prospection.SimProspection``; reasoning code gets the active one from
+``pycram.backends.sim.prospection.SimProspection``; reasoning code gets the active one from
 :func:`pycram.robot.current_prospection` and never imports a backend.
 """
 

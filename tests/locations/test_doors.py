@@ -1,4 +1,4 @@
-"""Tool poses of pushing a door (`pycram.locations.doors`): pure geometry on the apartment's
+"""Tool poses of pushing a door (`pycram.reasoning.locations.doors`): pure geometry on the apartment's
 fridge with the robots' own `DOOR_PUSH` data."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import pytest
 
 from pycram.environments.apartment import ENVIRONMENT as APARTMENT
-from pycram.locations import doors
+from pycram.reasoning.locations import doors
 from pycram.robots.pr2 import description as pr2
 from pycram.robots.tiago import description as tiago
 

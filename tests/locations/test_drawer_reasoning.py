@@ -12,7 +12,7 @@ from test_location_reasoning import APARTMENT, CUP_ON_TABLE, ScriptedProspection
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.locations import KnownObject, LocationReasoner, RobotGeometry
-from pycram.locations.reasoning import DOOR_CLEARANCE, DRAWER_CLEARANCE, RIM_CLEARANCE
+from pycram.reasoning.locations.reasoning import DOOR_CLEARANCE, DRAWER_CLEARANCE, RIM_CLEARANCE
 from pycram.robot import ResolverSet
 from pycram.robots.pr2 import description as pr2
 

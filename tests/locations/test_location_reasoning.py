@@ -16,8 +16,8 @@ from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.environments import load
 from pycram.locations import BaseLocation, Costmap, FloorGrid, KnownObject, LocationReasoner, RobotGeometry, Spot
-from pycram.locations.costmap import occupancy_layer
-from pycram.locations.reasoning import MAX_CANDIDATES, SPACING
+from pycram.reasoning.locations.costmap import occupancy_layer
+from pycram.reasoning.locations.reasoning import MAX_CANDIDATES, SPACING
 from pycram.robot import ResolverSet
 from pycram.robots.pr2 import description as pr2
 from pycram.robots.tiago import description as tiago
@@ -279,7 +279,7 @@ def test_pushing_a_door_checks_each_tool_pose_with_the_door_where_it_will_be_and
     import dataclasses
 
     from pycram.designators.core import NoSolutionError
-    from pycram.locations import doors
+    from pycram.reasoning.locations import doors
 
     asked = []
 

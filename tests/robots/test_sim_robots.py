@@ -65,7 +65,7 @@ def wait_value(predicate, fluents, timeout=T):
 
 def test_load_builds_the_robot_with_its_modules(robot):
     from pycram import robots
-    from pycram.robots.sim_modules import SimRobot
+    from pycram.robots.common.sim_modules import SimRobot
 
     assert isinstance(robot, SimRobot)
     assert robot.world.robot == robot.name

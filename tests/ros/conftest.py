@@ -32,7 +32,7 @@ def ros_master():
     reason = _ros_missing()
     if reason:
         pytest.skip(reason)
-    from pycram.ros.launch import RosMaster
+    from pycram.backends.ros.launch import RosMaster
 
     saved = {k: os.environ.get(k) for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOSTNAME")}
     master = RosMaster()
@@ -55,13 +55,13 @@ def ros_master():
 @pytest.fixture(scope="session")
 def transport(ros_master):
     """The test process's ROS 1 transport (its node lives for the session)."""
-    from pycram.ros.ros1 import ros1_transport
+    from pycram.backends.ros.ros1 import ros1_transport
 
     return ros1_transport()
 
 
 def _start_bridge(robot: str, master, item_at: int = 1):
-    from pycram.ros.launch import BridgeProcess
+    from pycram.backends.ros.launch import BridgeProcess
 
     return BridgeProcess(robot, master.uri, item_at=item_at)
 
@@ -82,7 +82,7 @@ def start_bridge(ros_master):
 
 def _robot_behind_bridge(robot_name: str, master, transport):
     """A bridge for `robot_name` (the demo's mug on slot 1) and the robot over ROS, active."""
-    from pycram.ros.robot import make_ros_robot
+    from pycram.robots.common.ros_robot import make_ros_robot
 
     bridge = _start_bridge(robot_name, master)
     try:

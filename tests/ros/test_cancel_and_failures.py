@@ -28,7 +28,7 @@ def _moved_from(fluent: Fluent, start, distance: float) -> Fluent:
 @pytest.fixture
 def pr2_over_ros(start_bridge, transport):
     """A bridge of this test's own and the PR2 over ROS (the test may kill the bridge)."""
-    from pycram.ros.robot import make_ros_robot
+    from pycram.robots.common.ros_robot import make_ros_robot
 
     bridge = start_bridge("pr2")
     robot = make_ros_robot("pr2", transport)
@@ -90,7 +90,7 @@ def test_evaporating_a_drive_cancels_the_move_base_goal_and_the_base_stops(pr2_o
 
 
 def test_bridge_killed_mid_drive_fails_with_action_server_lost(pr2_over_ros, transport):
-    from pycram.ros.transport import ActionServerLost, ActionServerUnavailable
+    from pycram.backends.ros.transport import ActionServerLost, ActionServerUnavailable
 
     robot, bridge = pr2_over_ros
     start = robot.state.base_pose.get_value()

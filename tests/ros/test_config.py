@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from pycram.ros.config import ROBOT_CONFIGS, config_from_dict, robot_config
-from pycram.ros.launch import check_master_uri
+from pycram.backends.ros.config import ROBOT_CONFIGS, config_from_dict, robot_config
+from pycram.backends.ros.launch import check_master_uri
 
 
 def test_pr2_defaults_are_the_pr2s_real_interface_names():
@@ -63,7 +63,7 @@ def test_master_uri_must_be_on_loopback_unless_allowed():
 
 
 def test_demo_refuses_an_unknown_backend():
-    from pycram.demos.kitchen import DemoOptions, run_demo
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
 
     with pytest.raises(ValueError, match="--backend must be 'sim' or 'ros', not 'ros2'"):
         run_demo(DemoOptions(backend="ros2", record=False))
@@ -74,14 +74,14 @@ def test_pycram_ros_imports_without_rospy():
     import sys
 
     code = (
-        "import sys; import pycram.ros, pycram.ros.transport, pycram.ros.config, pycram.ros.launch; "
+        "import sys; import pycram.ros, pycram.backends.ros.transport, pycram.backends.ros.config, pycram.backends.ros.launch; "
         "assert 'rospy' not in sys.modules, 'rospy imported'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
 def test_bridge_cli_refuses_an_unknown_robot_and_a_remote_master(monkeypatch, capsys):
-    from pycram.cli import main
+    from pycram.apps.cli import main
 
     monkeypatch.setenv("ROS_MASTER_URI", "http://127.0.0.1:11311")
     assert main(["sim-ros-bridge", "--robot", "r2d2"]) == 2

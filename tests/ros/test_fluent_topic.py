@@ -11,8 +11,8 @@ def test_pose_topic_drives_a_fluent_network_and_wakes_wait_for(transport):
     import rospy
     from geometry_msgs.msg import PoseWithCovarianceStamped
 
-    from pycram.ros.config import robot_config
-    from pycram.ros.modules import RosRobotState
+    from pycram.backends.ros.config import robot_config
+    from pycram.backends.ros.modules import RosRobotState
 
     config = robot_config("pr2").replace(pose_topic="/test/fluent_pose", joint_states_topic="/test/fluent_joints")
     state = RosRobotState(transport, config)

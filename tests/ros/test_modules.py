@@ -61,7 +61,7 @@ def test_reach_out_of_range_fails_with_the_simulators_reason(ros_robot):
     with pytest.raises(ProcessModuleFailure) as info:
         motion(type="reaching", arm="right", target=[0.8, 0.6, 4.0])
     cause = info.value.cause
-    from pycram.ros.transport import RosMotionFailed
+    from pycram.backends.ros.transport import RosMotionFailed
 
     assert isinstance(cause, RosMotionFailed)
     assert cause.reason == "unreachable", cause
@@ -93,7 +93,7 @@ def test_gripper_subscription_follows_the_opening(ros_robot):
 
 
 def test_detecting_sees_the_mug(ros_robot):
-    from pycram.demos.kitchen_world import SLOTS
+    from pycram.apps.demos.kitchen_world import SLOTS
 
     x, y = SLOTS[1]
     here = ros_robot.state.base_pose.get_value()

@@ -22,13 +22,13 @@ def motion(**properties):
 
 def _message_factory():
     pytest.importorskip("pycram_msgs.msg", reason="pycram_msgs not generated (run scripts/install_ros.sh)")
-    from pycram.ros.ros1 import message_class
+    from pycram.backends.ros.ros1 import message_class
 
     return lambda msg_type, **fields: message_class(msg_type)(**fields)
 
 
 def test_a_report_survives_the_message_round_trip():
-    from pycram.ros.detections import detections_message, quaternion_of, report_of, rotation_of
+    from pycram.backends.ros.detections import detections_message, quaternion_of, report_of, rotation_of
 
     message = _message_factory()
     angle = 0.7
@@ -78,7 +78,7 @@ def test_a_report_survives_the_message_round_trip():
 
 
 def test_a_message_without_a_view_marks_nothing_gone():
-    from pycram.ros.detections import report_of
+    from pycram.backends.ros.detections import report_of
     from pycram.world.belief import BeliefState
 
     message = _message_factory()
@@ -100,7 +100,7 @@ def robot(pr2_with_mug):
 
 
 def _look_at_slot(robot) -> tuple[float, float]:
-    from pycram.demos.kitchen_world import SLOTS
+    from pycram.apps.demos.kitchen_world import SLOTS
 
     x, y = SLOTS[1]
     here = robot.state.base_pose.get_value()

@@ -17,8 +17,8 @@ def motion(**properties):
 @pytest.fixture(scope="module")
 def blind_robot(ros_master, transport):
     """The PR2 behind a bridge whose camera misses every object (``--miss-probability 1``)."""
-    from pycram.ros.launch import BridgeProcess
-    from pycram.ros.robot import make_ros_robot
+    from pycram.backends.ros.launch import BridgeProcess
+    from pycram.robots.common.ros_robot import make_ros_robot
 
     bridge = BridgeProcess("pr2", ros_master.uri, item_at=1, extra_args=("--miss-probability", "1"))
     try:
@@ -31,7 +31,7 @@ def blind_robot(ros_master, transport):
 
 
 def test_a_camera_that_misses_everything_fills_no_belief(blind_robot):
-    from pycram.demos.kitchen_world import SLOTS
+    from pycram.apps.demos.kitchen_world import SLOTS
 
     x, y = SLOTS[1]
     here = blind_robot.state.base_pose.get_value()

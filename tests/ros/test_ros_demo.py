@@ -6,7 +6,7 @@ import os
 import subprocess
 import sys
 
-from pycram.demos.kitchen import DemoOptions, run_demo
+from pycram.apps.demos.kitchen import DemoOptions, run_demo
 
 
 def test_demo_over_ros_recovers_from_failed_grasps_and_a_theft_pr2(start_bridge, transport, tmp_path):

@@ -18,7 +18,7 @@ def robot(pr2_with_mug):
 
 def test_search_finds_the_mug_over_ros(robot):
     from pycram.actions import Search
-    from pycram.demos.kitchen_world import SLOTS
+    from pycram.apps.demos.kitchen_world import SLOTS
 
     assert robot.belief.present() == []
     found = perform(Search(ObjectDesignator(type="mug")))

@@ -210,7 +210,7 @@ class MissingDetections(_CameraDouble):
         self.looks = 0
 
     def look(self, original: Any, *args: Any, **kwargs: Any) -> Any:
-        from pycram.sim.perception import PerceptionFaults
+        from pycram.backends.sim.perception import PerceptionFaults
 
         self.looks += 1
         if len(self.missed) >= self.misses or not self.when():
@@ -243,7 +243,7 @@ class HiddenBehindRaisedArm(_CameraDouble):
 
         import numpy as np
 
-        from pycram.sim.handle import CommandHandle
+        from pycram.backends.sim.handle import CommandHandle
 
         handle = original(*args, **kwargs)
         if max(p.position[2] for p in self.world.tool_poses.get_value().values()) <= self.height:

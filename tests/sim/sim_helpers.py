@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from pycram.backends.sim.controllers import Controller
 from pycram.fluent import Fluent
-from pycram.sim.controllers import Controller
 
 T = 60.0  # generous simulated-time limit for a single command [s]
 

@@ -340,7 +340,7 @@ def test_perception_tells_a_toppled_object_from_a_standing_one(type_name, tells)
 def test_a_look_after_placing_that_misses_the_object_is_taken_again():
     # the first look after letting go misses the cup (a missed detection, as perception faults
     # make them): Place parks the arm, looks again and succeeds -- not PlacingFailed 'not seen'
-    from pycram.sim.perception import PerceptionFaults
+    from pycram.backends.sim.perception import PerceptionFaults
 
     with apartment_with("pr2", {"cup": COUNTER}) as (world, robot):
         ready()

@@ -60,7 +60,7 @@ def test_non_finite_inputs_are_refused_and_nothing_moves(world):
 
 
 def test_the_process_modules_refuse_a_time_out_that_never_expires(world):
-    from pycram.robots.sim_modules import NavigationModule
+    from pycram.robots.common.sim_modules import NavigationModule
 
     module = NavigationModule(world)
     sent = []

@@ -11,7 +11,7 @@ OBSTACLE_HALF = 0.15  # [m] half width of `place_obstacle`'s box
 
 
 def _footprint_radius(world) -> float:
-    from pycram.sim.path_drive import navigation_of
+    from pycram.backends.sim.path_drive import navigation_of
 
     nav = ok(world._call("navigation", navigation_of))
     return nav.footprint.inscribed_radius

@@ -16,7 +16,7 @@ import pytest
 from belief_helpers import SURFACES, TYPES, apartment, look, open_container, put
 from sim_helpers import ok
 
-from pycram.sim.perception import PerceptionFaults
+from pycram.backends.sim.perception import PerceptionFaults
 from pycram.world.belief import BeliefState, color_name
 from pycram.world.objects import OBJECT_TYPES, object_type
 

@@ -195,7 +195,7 @@ def test_prospection_does_not_change_the_running_world(world):
 
 
 def test_eight_threads_give_the_same_answers_as_one(world):
-    from pycram.sim.prospection import SimProspection
+    from pycram.backends.sim.prospection import SimProspection
 
     frozen = world._state  # one published state, so that every answer is about the same world
     p = SimProspection(world.scene, lambda: frozen)

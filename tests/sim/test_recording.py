@@ -16,11 +16,11 @@ import pytest
 from PIL import Image
 from sim_helpers import ok, wait_wall
 
+from pycram.backends.sim.gif import TRANSPARENT, GifEncoder
+from pycram.backends.sim.recording import FrameRecorder, RecordedFrames, StateSnapshot
+from pycram.backends.sim.render import write_animation
+from pycram.backends.sim.scene import build_scene, initial_state
 from pycram.sim import World
-from pycram.sim.gif import TRANSPARENT, GifEncoder
-from pycram.sim.recording import FrameRecorder, RecordedFrames, StateSnapshot
-from pycram.sim.render import write_animation
-from pycram.sim.scene import build_scene, initial_state
 
 
 def recorder_threads() -> list[threading.Thread]:

@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("matplotlib")
 from typer.testing import CliRunner  # noqa: E402
 
-from pycram.cli import app  # noqa: E402
+from pycram.apps.cli import app  # noqa: E402
 
 runner = CliRunner()
 

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from pycram.demos import set_table
-from pycram.demos.set_table import FAULTS, OBJECTS, check_faults, place_settings, run_set_table, start_scene
+from pycram.apps.demos import set_table
+from pycram.apps.demos.set_table import FAULTS, OBJECTS, check_faults, place_settings, run_set_table, start_scene
 from pycram.environments import load as load_environment
 
 #: Seeds that set the whole table, measured (never the seeds the experiments report, 1-200), with
@@ -83,7 +83,7 @@ def test_a_person_moving_an_object_from_the_cabinet_top_puts_it_clear_of_the_oth
     import random
     from types import SimpleNamespace
 
-    from pycram.demos.set_table import START_REGIONS, Faults
+    from pycram.apps.demos.set_table import START_REGIONS, Faults
     from pycram.fluent import Fluent
 
     environment = load_environment("apartment")
@@ -116,7 +116,7 @@ def test_the_demo_command_refuses_an_unknown_scenario_or_fault_naming_the_valid_
     pytest.importorskip("typer")
     from typer.testing import CliRunner
 
-    from pycram.cli import app
+    from pycram.apps.cli import app
 
     runner = CliRunner()
     result = runner.invoke(app, ["demo", "--scenario", "dinner"])
@@ -281,7 +281,7 @@ def test_a_search_is_ended_by_pursue_when_a_look_while_driving_turns_the_object_
     from action_helpers import apartment_with, run_as_task, tasks_named
 
     from pycram.actions.core import while_driving
-    from pycram.demos.set_table_plan import PlanRecord, find, look_for_the_next
+    from pycram.apps.demos.set_table_plan import PlanRecord, find, look_for_the_next
 
     with apartment_with("pr2", {"cup": ("cabinet top", (0.5, 2.8))}, base_pose=(4.3, 0.9, math.pi / 2)) as (world, _):
         record = PlanRecord()

@@ -14,11 +14,11 @@ import mujoco
 import pytest
 from sim_helpers import Recorder, T, ok, wait_wall
 
+from pycram.backends.sim.errors import WorldClosedError
+from pycram.backends.sim.world import REALTIME_SLACK
 from pycram.fluent import Fluent
 from pycram.runtime import current_clock, sleep
 from pycram.sim import World
-from pycram.sim.errors import WorldClosedError
-from pycram.sim.world import REALTIME_SLACK
 
 
 def test_plans_sleep_and_time_out_in_simulated_time():

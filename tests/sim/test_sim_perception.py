@@ -69,7 +69,7 @@ def test_occluded_and_out_of_view_items_are_not_reported(robot):
     the crate gone the mug is; with the head turned away nothing is."""
     crate = ItemSpec("crate", "crate", "box", (0.12, 0.06, 0.2), 1.0, (0.1, -1.2, None), (0.6, 0.5, 0.3, 1))
     mug = ItemSpec("mug", "mug", "cylinder", (0.03, 0.05), 0.25, (0.1, -1.45, None), (0.85, 0.2, 0.15, 1))
-    from pycram.sim.robot_model import load_description
+    from pycram.backends.sim.robot_model import load_description
 
     base = load_description(robot).KITCHEN_BASE_POSES["cooker #2"]
     with World(robot, [crate, mug], base_pose=base) as world:

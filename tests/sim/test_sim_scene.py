@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from sim_helpers import facing_quat, to_map
 
+from pycram.backends.sim.errors import UnknownNameError
 from pycram.environments import load as load_environment
 from pycram.sim import DEFAULT_ITEMS, Pose, build_scene
-from pycram.sim.errors import UnknownNameError
 
 ROBOTS = ("pr2", "tiago")
 REPO = Path(__file__).resolve().parents[2]
@@ -72,7 +72,7 @@ def test_counters_are_0_9_m_high_with_two_cooker_areas():
 
 
 def test_models_come_from_installed_packages_not_the_repository():
-    from pycram.sim.assets import robot_data_dir
+    from pycram.backends.sim.assets import robot_data_dir
 
     data = robot_data_dir().resolve()
     assert Path(sys.prefix).resolve() in data.parents  # the installed example-robot-data package
@@ -84,7 +84,7 @@ def test_models_come_from_installed_packages_not_the_repository():
 
 
 def test_headless_gl_is_chosen_only_when_nothing_else_is(monkeypatch):
-    from pycram.sim._gl import configure_gl
+    from pycram.backends.sim._gl import configure_gl
 
     for name in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "DISPLAY", "WAYLAND_DISPLAY"):
         monkeypatch.delenv(name, raising=False)
@@ -119,9 +119,9 @@ def test_importing_the_simulation_without_display_renders_headless(tmp_path):
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_ik_solutions_respect_joint_limits(robot):
-    from pycram.sim.engine import Engine
-    from pycram.sim.ik import solve_ik
-    from pycram.sim.world import DEFAULT_BASE_POSE
+    from pycram.backends.sim.engine import Engine
+    from pycram.backends.sim.ik import solve_ik
+    from pycram.backends.sim.world import DEFAULT_BASE_POSE
 
     eng = Engine(build_scene(robot), DEFAULT_BASE_POSE)  # a private engine, used by this thread only
     model, arm = eng.model, eng.desc.DEFAULT_ARM

@@ -163,7 +163,7 @@ REACH_TOLERANCE = {"pre_grasp": 0.02, "grasp": 0.02, "pre_place": 0.02, "place":
 GRASP_CONTACT_MARGIN = 0.015
 
 #: How the hand meets a door's outside face when it pushes a door shut (see
-#: `pycram.locations.doors`; used when the door was not opened by its handle from a pose the
+#: `pycram.reasoning.locations.doors`; used when the door was not opened by its handle from a pose the
 #: robot remembers, e.g. after a failed opening): the finger tips (at the tool frame) into the
 #: face, the gripper open (with it closed or half open, location reasoning found no standing pose
 #: for the push from 30 deg to shut: 100 candidates, mostly the approach out of reach).

@@ -129,7 +129,7 @@ DOOR_PULL_LIMIT = 0.35
 #: closing from wide open, its fingers sank 2.7 mm into the 24 mm bar and then stayed there when
 #: told to open (measured on the fridge; from half open they sink 0.7 mm and let go).
 DOOR_GRIP_OPENING = 0.5
-#: How the hand meets a door's faces when it pushes them (see `pycram.locations.doors`). Inside:
+#: How the hand meets a door's faces when it pushes them (see `pycram.reasoning.locations.doors`). Inside:
 #: the tool points along the face towards the hinge (heading pi), the side of the palm (0.05 m
 #: from the tool axis, its centre 0.07 m behind the tool frame) against the face -- the back of a
 #: hand sweeping a door open. Outside: the finger tips (0.04 m beyond the tool frame) into the face.

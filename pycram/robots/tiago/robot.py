@@ -14,10 +14,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from pycram.process_module import ProcessModule
-from pycram.robots import sim_modules as sm
-from pycram.robots.sim_resolvers import make_location_generator, make_motion_resolver, physical_arm, physical_gripper
-from pycram.robots.sim_vocabulary import motion_types
+from pycram.execution.process_module import ProcessModule
+from pycram.robots.common import sim_modules as sm
+from pycram.robots.common.sim_resolvers import (
+    make_location_generator,
+    make_motion_resolver,
+    physical_arm,
+    physical_gripper,
+)
+from pycram.robots.common.sim_vocabulary import motion_types
 from pycram.robots.tiago import description
 
 __all__ = ["make_robot"]

@@ -1,0 +1,666 @@
+"""`pycram demo`: the thesis demo in the simulated kitchen, headless, with pictures.
+
+Builds the kitchen with the chosen robot and the item at the chosen position, activates the
+robot and the kitchen's location resolvers, runs `kitchen_plan.fetch_and_place` while showing
+live progress, then prints the task tree, writes snapshots, an animation (each frame captioned
+with the plan's phase and the simulated time), the task-tree SVG and the timeline PNG to the
+run's own output folder, and returns 0 only when the item rests on cooker #1.
+
+SIGINT (Ctrl-C) and SIGTERM stop the plan (the robot stops), the pictures of what happened are
+still written, the run is recorded as "interrupted" with the reason, and the exit code is 130 /
+143; a second signal while stopping exits at once (`pycram.core.interrupts.StopSignals`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import logging
+import math
+import os
+import random
+import signal
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # imported where used: the ROS backend is optional
+    from pycram.apps.demos.ros_kitchen_world import RosSimEnvironment
+
+log = logging.getLogger("pycram.demo")
+
+#: A plan that has not ended after this much simulated time is evaporated and reported as
+#: failed [s]. The default run needs about 20 s, three failed grasps about 40 s.
+SIM_TIME_LIMIT = 300.0
+#: Backstop for a simulation that stops advancing (e.g. a crashed simulator thread) [s of wall
+#: time]. Neither limit applies with `--interactive`, where a person may take their time.
+WALL_TIME_LIMIT = 600.0
+#: The animation: frames per second of simulated time, and how much faster it plays.
+ANIMATION_FPS = 8.0
+ANIMATION_SPEED_UP = 2.0
+#: How long [s of wall time] the animation's recorder may take to render the frames still
+#: pending when the plan ended (a few seconds normally; much more on a heavily loaded machine).
+RENDER_CATCH_UP = 300.0
+#: Size of the animation's frames [px]; snapshots are 640 x 480.
+ANIMATION_SIZE = (480, 360)
+#: Where the pictures' camera frames bodies [m]: the kitchen (x_min, y_min, x_max, y_max); an
+#: item put aside out of the kitchen is not followed.
+KITCHEN_REGION = (-1.3, -1.8, 3.2, 3.6)
+#: The camera looks at the robot and the item from the side facing this point [m] (the open
+#: corner of the room, away from the walls).
+ROOM_MIDDLE = (2.0, 2.0)
+
+
+@dataclass
+class DemoOptions:
+    robot: str = "pr2"
+    output: Path | None = None
+    item_at: int = 1
+    steal: int = 0
+    seed: int = 0
+    realtime: bool = False
+    interactive: bool = False
+    db: str | None = None
+    record: bool = True
+    quiet: bool = False
+    animation: bool = True  # record run.gif (False: no animation, a faster run)
+    pictures: bool = True  # write start/end snapshots and the run's pictures (False: none, no folder)
+    backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
+
+
+@dataclass
+class DemoResult:
+    """What a demo run produced: exit code, message, counts and where the pictures are."""
+
+    exit_code: int
+    message: str
+    output: Path
+    run_id: Any = None
+    sim_time: float = 0.0  # simulated time the plan ran [s]
+    wall_time: float = 0.0  # wall time of the whole run: world, plan, pictures [s]
+    plan_wall_time: float = 0.0  # wall time the plan ran [s]
+    failed_grasps: int = 0
+    recoveries: int = 0
+    item_on_cooker_1: bool = False
+    interrupted: bool = False  # stopped by SIGINT/SIGTERM (exit code 130/143)
+    files: list[Path] = field(default_factory=list)
+    captions: list[tuple[float, str]] = field(default_factory=list)  # the animation's (sim time [s], caption)
+    tree_text: str = ""  # the plan's task tree as plain text, one line per task
+    plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
+    trace_loss: str | None = None  # "N trace records could not be written: why", if any were lost
+
+    @property
+    def speed_factor(self) -> float:
+        """Simulated time per wall time while the plan ran (> 1: faster than real time)."""
+        return self.sim_time / self.plan_wall_time if self.plan_wall_time > 0 else 0.0
+
+
+def default_output(robot: str, run_id: Any = None) -> Path:
+    """The run's own folder: `output/demo-ROBOT-RUNID` for a recorded run, else
+    `output/demo-ROBOT-YYYYmmdd-HHMMSS` (with a suffix if that folder exists already)."""
+    if run_id is not None:
+        return Path("output") / f"demo-{robot}-{run_id}"
+    stem = Path("output") / f"demo-{robot}-{time.strftime('%Y%m%d-%H%M%S')}"
+    folder, n = stem, 1
+    while folder.exists():
+        n += 1
+        folder = stem.with_name(f"{stem.name}-{n}")
+    return folder
+
+
+class PlanRun:
+    """The plan, run as task `fetch_and_place` in a thread of its own, so the driver can watch it.
+
+    `task` is the plan's task (its whole tree, the reset included); `error` is what made the
+    plan fail (e.g. `NoItemGrasped`), its evaporation on a time limit or Ctrl-C, or a bug.
+    """
+
+    def __init__(self, plan: Any, robot: Any, facts: Any) -> None:
+        self.plan, self.robot, self.facts = plan, robot, facts
+        self.task: Any = None
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="pycram-demo-plan", daemon=True)
+        self._started_wall = self._ended_wall = 0.0
+        self._started_sim = 0.0
+
+    def start(self, sim_now: float) -> None:
+        self._started_sim = sim_now
+        self._started_wall = time.monotonic()
+        self._thread.start()
+
+    def _run(self) -> None:
+        from pycram.core.runtime import current_task, end_thread_root, run_subtask
+
+        def whole_plan() -> Any:
+            self.task = current_task()
+            with self.robot, self.facts:
+                return self.plan.fetch_and_place()
+
+        try:
+            run_subtask("fetch_and_place", whole_plan, kind="plan")
+        except BaseException as error:  # the plan failed, or was evaporated
+            self.error = error
+        finally:
+            end_thread_root(self.error)  # the thread's root task ends with the thread, as the plan did
+            self._ended_wall = time.monotonic()
+
+    def join(self, timeout: float) -> bool:
+        """Wait at most `timeout` [s of wall time] for the plan's thread; True once it ended."""
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Evaporate the plan and wait (at most `timeout` [s]) for its thread to end."""
+        if self.task is not None:
+            self.task.evaporate()
+        self._thread.join(timeout)
+
+    @property
+    def wall_time(self) -> float:
+        """Wall time [s] from the start to the end of the plan (or to now while it runs)."""
+        end = self._ended_wall or time.monotonic()
+        return end - self._started_wall
+
+    def sim_time(self, sim_now: float) -> float:
+        """Simulated time [s] the plan ran; `sim_now` is the simulation's current time."""
+        if self.task is not None and self.task.end_time is not None and self.task.start_time is not None:
+            return self.task.end_time - self.task.start_time
+        return sim_now - self._started_sim
+
+
+def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
+    """Run the demo once; never raises for plan failures (they are in the result).
+
+    `stop` (a `pycram.core.interrupts.StopSignals`, e.g. the one `main` installs): once it is
+    requested, the plan is stopped, the pictures are written, and the run ends "interrupted"
+    with the signal's exit code (130 / 143). A `KeyboardInterrupt` while the plan runs counts as
+    SIGINT. The output folder is `options.output`, else the run's own (`default_output`).
+    """
+    from pycram.core.interrupts import StopSignals
+
+    if options.item_at not in (0, 1, 2, 3):
+        raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {options.item_at}")
+    if options.backend not in ("sim", "ros"):
+        raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
+    if options.robot not in ("pr2", "tiago"):
+        raise ValueError(f"--robot must be 'pr2' or 'tiago', not {options.robot!r}")
+    stop = stop if stop is not None else StopSignals()  # never signalled unless entered
+    started_wall = time.monotonic()
+    recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
+    run_id = recorder.run_id if recorder is not None else None
+    output = Path(options.output) if options.output else default_output(options.robot, run_id)
+    result = DemoResult(exit_code=1, message="", output=output, run_id=run_id)
+    error: BaseException | None = None
+    try:
+        if options.pictures:
+            output.mkdir(parents=True, exist_ok=True)
+        _run_in_world(options, result, recorder, stop)
+    except BaseException as exc:
+        error = exc
+        raise
+    finally:
+        result.wall_time = time.monotonic() - started_wall
+        if isinstance(error, KeyboardInterrupt):
+            stop.request(signal.SIGINT)
+        if stop.requested:
+            _mark_interrupted(result, stop)
+        if recorder is not None:
+            outcome = "succeeded" if result.exit_code == 0 else "interrupted" if result.interrupted else "failed"
+            reason = result.message if result.exit_code != 0 else None
+            if error is not None and not isinstance(error, KeyboardInterrupt):
+                reason = f"{type(error).__name__}: {error}"
+            result.run_id = recorder.finish(outcome, reason)
+            result.trace_loss = recorder.loss_report()
+    if recorder is not None and options.pictures:
+        result.files.extend(_write_run_pictures(result, recorder))
+    return result
+
+
+def _mark_interrupted(result: DemoResult, stop: Any) -> None:
+    """Make `result` say that a signal ended the run (exit code 130/143), and what had happened."""
+    result.interrupted = True
+    result.exit_code = stop.exit_code
+    if result.item_on_cooker_1:
+        result.message = f"{stop.reason} after the plan had placed the item on cooker #1"
+    elif result.plan_task is None:
+        result.message = f"{stop.reason} before the plan started"
+    else:
+        result.message = (
+            f"{stop.reason} after {result.sim_time:.1f} s of simulated time; the plan and the robot were stopped"
+        )
+
+
+def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop: Any) -> None:
+    """Build the kitchen, run the plan in it, fill in `result`, write the pictures."""
+    from pycram import robots as robot_packages
+    from pycram.apps.demos import kitchen_plan as plan
+    from pycram.apps.demos.kitchen_world import (
+        ITEM_NAME,
+        START_POSE,
+        Helper,
+        KitchenFacts,
+        Operator,
+        Thief,
+        demo_items,
+        operator_resolver,
+    )
+    from pycram.backends.sim import FollowView, Pose2D, World
+    from pycram.backends.sim.render import write_animation
+    from pycram.core.runtime import add_task_listener, format_task_tree, remove_task_listener
+    from pycram.environments import load as load_environment
+
+    output = result.output
+    rng = random.Random(options.seed)
+    items = demo_items(options.item_at)
+    mug = demo_items(1)[0]  # the mug's size, also when it is not in the kitchen
+    camera: Any = "overview"
+    world: World | RosSimEnvironment
+    if options.backend == "ros":  # plan -> ROS process modules -> roscore -> sim-ros-bridge -> MuJoCo
+        from pycram.apps.demos.ros_kitchen_world import open_ros_world
+
+        world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
+        counter_height = load_environment("thesis-kitchen").surface("cooker #1").height
+    else:
+        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+        robot = None
+        counter_height = world.environment.surface("cooker #1").height
+        camera = FollowView(
+            (world.description.ROOT_LINK, *(item.name for item in items)),
+            region=KITCHEN_REGION,
+            side_of=ROOM_MIDDLE,
+            elevation=-50.0,
+            min_distance=2.8,
+            margin=2.2,
+        )
+    thief = None
+    story = None
+    frames: list = []
+    try:
+        robot = robot or robot_packages.load(options.robot, world)
+        helper = Helper(world, interactive=options.interactive)
+        gripper_of = _gripper_mapper(world)
+        operator = Operator(helper, gripper_of)
+        robot.add_process_module("operator", operator)
+        robot.process_module_resolvers.append(operator_resolver(operator))
+        facts = KitchenFacts(mug.half_height, counter_height, Pose2D(*START_POSE))
+        thief = Thief(world, helper, plan.phase, plan.goal, gripper_of(plan.GRIPPER), options.steal, rng)
+        if recorder is not None:
+            recorder.set_run_info(robot=options.robot)
+            for fluent in (plan.phase, world.base_pose):
+                recorder.watch(fluent, fluent.name, max_rate_hz=5.0)
+        if options.pictures:
+            world.snapshot(output / "start.png", camera=camera)
+            result.files.append(output / "start.png")
+        plan.forget_state()
+        story = _Story(plan, thief, stop)
+        add_task_listener(story)
+        if options.animation and options.pictures:
+            world.start_recording(
+                camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1], caption=story.caption
+            )
+        run = PlanRun(plan, robot, facts)
+        thief.start()
+        run.start(world.sim_time.get_value())
+        result.message = _watch(run, world, plan, helper, thief, options, stop)
+        thief.stop()
+        result.plan_wall_time = run.wall_time
+        result.sim_time = run.sim_time(world.sim_time.get_value())
+        result.plan_task = run.task
+        result.tree_text = format_task_tree(run.task) if run.task is not None else ""
+        result.failed_grasps = failed_grasps(run.task)
+        result.recoveries = recoveries(run.task)
+        result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
+        if options.pictures:
+            world.snapshot(output / "end.png", camera=camera)
+            result.files.append(output / "end.png")
+        # the recorder may lag behind on a busy machine: let it finish rather than lose the end
+        frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation and options.pictures else []
+        if result.item_on_cooker_1:
+            result.exit_code, result.message = 0, "the item rests on cooker #1"
+        elif not result.message:
+            result.message = _failure_message(run)
+    finally:
+        if story is not None:
+            remove_task_listener(story)
+        if thief is not None:
+            thief.stop()
+        world.close()
+    result.captions = list(getattr(frames, "captions", []))
+    if frames:  # encoded after the simulation stopped, so the two do not compete for the CPU
+        result.files.append(write_animation(output / "run.gif", frames, ANIMATION_SPEED_UP * ANIMATION_FPS))
+
+
+def _gripper_mapper(world: Any):
+    grippers = list(world.gripper_openings)
+
+    def gripper_of(name: str) -> str:
+        if name in grippers:
+            return name
+        if len(grippers) == 1:  # a one-armed robot serves requests for either gripper
+            return grippers[0]
+        return {"0": "left", "1": "right"}.get(str(name), name)
+
+    return gripper_of
+
+
+def _item_on_cooker_1(world: Any, item: str, counter_height: float) -> bool:
+    """True when `item` stands upright on cooker #1 and no gripper holds it."""
+    from pycram.apps.demos.kitchen_world import PLACE_XY
+
+    pose = world.item_poses.get_value().get(item)
+    if pose is None:
+        return False
+    x, y, z = pose.position
+    held = any(state.get_value().holding == item for state in world.gripper_states.values())
+    on_top = counter_height < z < counter_height + 0.15
+    near = math.hypot(x - PLACE_XY[0], y - PLACE_XY[1]) < 0.15
+    tilt = _tilt(pose.orientation)
+    log.info(
+        "the %s ends at (%.2f, %.2f, %.2f), tilted %.0f deg%s",
+        item,
+        x,
+        y,
+        z,
+        math.degrees(tilt),
+        ", held" if held else "",
+    )
+    return not held and on_top and near and tilt < math.radians(20)
+
+
+def _tilt(quaternion: tuple[float, float, float, float]) -> float:
+    """Angle [rad] between an item's own z axis and the vertical, from its (w, x, y, z) orientation."""
+    w, x, y, z = quaternion
+    up_z = 1.0 - 2.0 * (x * x + y * y)  # z component of the item's z axis in the map frame
+    return math.acos(max(-1.0, min(1.0, up_z)))
+
+
+def _failed(task: Any) -> bool:
+    return task.status.get_value().value == "failed"
+
+
+def _error(task: Any) -> str:
+    return type(task.exception).__name__ if task.exception is not None else ""
+
+
+def _count(task: Any, predicate) -> int:
+    return 0 if task is None else sum(1 for t in task.walk() if predicate(t))
+
+
+def failed_grasps(plan_task: Any) -> int:
+    """How many grasp attempts in the plan's task tree failed with `GraspFailed`."""
+    return _count(plan_task, lambda t: t.kind == "step" and _failed(t) and _error(t) == "GraspFailed")
+
+
+def recoveries(plan_task: Any) -> int:
+    """How many transport attempts ended in `retry()` (one per recovered theft)."""
+    return _count(plan_task, lambda t: t.kind == "attempt" and _error(t) == "RetryRequested")
+
+
+def _failure_message(run: PlanRun) -> str:
+    """Why the item is not on cooker #1: what stopped the plan, if anything did."""
+    if run.error is not None:
+        return f"{type(run.error).__name__}: {run.error}"
+    return "the plan ended, but the item is not on cooker #1"
+
+
+def _start_recorder(options: DemoOptions, plan_name: str) -> Any:
+    if not options.record:
+        return None
+    try:
+        from pycram.trace import start_recording
+    except ImportError:
+        log.info("recording unavailable (pycram.trace not installed)")
+        return None
+    return start_recording(url=options.db, plan=plan_name)
+
+
+def _write_run_pictures(result: DemoResult, recorder: Any) -> list[Path]:
+    """The task-tree SVG and timeline PNG of the recorded run; drawn from the plan's task in
+    memory when the trace database cannot be read (a broken database never fails the demo)."""
+    try:
+        from pycram.trace.db import TraceDatabaseError
+        from pycram.trace.pictures import write_run_pictures, write_task_pictures
+        from pycram.trace.query import RunNotFound
+    except ImportError:
+        return []
+    try:
+        return list(write_run_pictures(result.run_id, result.output, url=recorder.url))
+    except (TraceDatabaseError, RunNotFound) as error:
+        log.warning(
+            "cannot read run %s back from the trace database (%s); drawing the pictures from memory",
+            result.run_id,
+            error,
+        )
+    if result.plan_task is None:
+        return []
+    return list(write_task_pictures(result.plan_task, result.output))
+
+
+def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions, stop: Any) -> str:
+    """Show live progress until the plan ends; stop it on a time limit, a stop signal or Ctrl-C.
+
+    Returns "" when the plan ended by itself, otherwise why it was stopped. Without
+    `--interactive` the plan is stopped after `SIM_TIME_LIMIT` of simulated time or
+    `WALL_TIME_LIMIT` of wall time, whichever comes first: the demo never hangs.
+    """
+    limited = not options.interactive
+    sim_deadline = world.sim_time.get_value() + SIM_TIME_LIMIT
+    wall_deadline = time.monotonic() + WALL_TIME_LIMIT
+    progress = None if options.quiet else _ProgressLine(run, world, plan, thief)
+    if progress is not None:
+        helper.prompt = progress.ask  # --interactive: pause the live line while asking
+    reason = ""
+    with progress or contextlib.nullcontext():
+        try:
+            # Wake on the end of the plan, and 4 times a second of wall time to refresh the
+            # progress line and check the limits (a display refresh, not the plan's logic).
+            while not run.join(0.25):
+                if progress is not None:
+                    progress.refresh()
+                if stop.requested:
+                    reason = stop.reason
+                elif limited and world.sim_time.get_value() > sim_deadline:
+                    reason = f"the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
+                elif limited and time.monotonic() > wall_deadline:
+                    reason = f"the plan did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
+                if reason:
+                    break
+        except KeyboardInterrupt:  # no StopSignals installed (library use): Ctrl-C raised here
+            stop.request(signal.SIGINT)
+            reason = stop.reason
+        if not reason and stop.requested:  # the signal came as the plan ended
+            reason = stop.reason
+        if reason:
+            log.warning("stopping the plan: %s", reason)
+            run.stop()
+    return reason
+
+
+class _Story:
+    """What the animation's captions say: the plan's phase in words, with the failed grasps
+    (counted as `grab_item` tasks fail: a task listener, O(1) per task end), the thefts and the
+    recovery (read from the simulated gripper: this is for people watching, not for the plan).
+    `caption` is called by the simulation thread at each frame time: it only reads."""
+
+    GRASP_POSITIONS = 3
+
+    def __init__(self, plan: Any, thief: Any, stop: Any) -> None:
+        self.plan, self.thief, self.stop = plan, thief, stop
+        self.failed_grasps = 0
+
+    def task_started(self, task: Any) -> None:
+        pass
+
+    def task_ended(self, task: Any) -> None:
+        if task.name == "grab_item" and _failed(task):
+            self.failed_grasps += 1
+
+    def caption(self) -> str:
+        if self.stop.requested:
+            return f"{self.stop.reason}: stopping"
+        phase = self.plan.phase.get_value()
+        failed, stolen = self.failed_grasps, self.thief.stolen
+        if phase == "fetching":
+            if failed:
+                return f"fetching: grasp {failed} of {self.GRASP_POSITIONS} failed, trying position {failed + 1}"
+            return f"fetching: grasp 1 of {self.GRASP_POSITIONS}"
+        if phase == "transporting":
+            if stolen and self.thief.world.gripper_states[self.thief.gripper].get_value().holding is None:
+                return f"item taken ({stolen}x): recovering"  # until the gripper holds it again
+            return f"transporting (recovered {stolen}x)" if stolen else "transporting"
+        if phase == "failed" and failed >= self.GRASP_POSITIONS:
+            return f"failed: all {self.GRASP_POSITIONS} grasps failed"
+        return {"initialising": "getting ready", "resetting": "resetting the robot"}.get(phase, phase)
+
+
+class _ProgressLine:
+    """One live terminal line: step, failed grasps, recoveries, thefts, simulated and wall time."""
+
+    def __init__(self, run: PlanRun, world: Any, plan: Any, thief: Any) -> None:
+        from rich.live import Live
+
+        self.run, self.world, self.plan, self.thief = run, world, plan, thief
+        self._started = time.monotonic()
+        self._live = Live(self._text(), console=_stderr_console(), refresh_per_second=4, transient=False)
+
+    def _text(self) -> str:
+        task = self.run.task
+        return (
+            f"step: {self.plan.phase.get_value():<13} failed grasps: {failed_grasps(task)}  "
+            f"recoveries: {recoveries(task)}  "
+            f"thefts: {self.thief.stolen}  sim {self.world.sim_time.get_value():6.1f} s  "
+            f"wall {time.monotonic() - self._started:5.1f} s"
+        )
+
+    def __enter__(self) -> _ProgressLine:
+        self._live.__enter__()
+        return self
+
+    def refresh(self) -> None:
+        self._live.update(self._text())
+
+    def ask(self, question: str) -> str:
+        """Ask the user at the terminal, with the live line paused so it does not hide the question."""
+        self._live.stop()
+        try:
+            return input(question)
+        finally:
+            self._live.start()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.refresh()
+        self._live.__exit__(*exc)
+
+
+def _task_tree_display(result: DemoResult, url: str | None) -> Any:
+    """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
+    on one line, with the blocking process-module executions when the run was recorded), or as
+    plain text when the trace extra is not installed."""
+    if result.plan_task is None:
+        return "(the plan did not start)"
+    try:
+        from pycram.trace.display import task_tree
+        from pycram.trace.query import records_from_task
+    except ImportError:
+        return result.tree_text
+    records = records_from_task(result.plan_task)
+    if result.run_id is not None:
+        records += _recorded_executions(result.run_id, url, records)
+    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", records)
+    return tree
+
+
+def _recorded_executions(run_id: Any, url: str | None, records: list) -> list:
+    """The recorded process-module executions below the plan's tasks (none if unreadable)."""
+    from pycram.trace import query
+
+    ids = {r.task_id for r in records}
+    try:
+        executions = [x for x in query.executions(run_id, url=url) if x.task_id in ids]
+    except (query.TraceDatabaseError, query.RunNotFound) as error:
+        log.warning("cannot read the process-module executions of run %s: %s", run_id, error)
+        return []
+    return query.execution_nodes(records, executions)
+
+
+@functools.cache
+def _stderr_console() -> Any:
+    """The one rich console of the demo's terminal output (progress line and log records)."""
+    from rich.console import Console
+
+    return Console(stderr=True)
+
+
+def _log_to_terminal() -> None:
+    """Show the demo's INFO records above the live progress line (rich keeps them apart)."""
+    from rich.logging import RichHandler
+
+    demo_log = logging.getLogger("pycram.demo")
+    if not any(isinstance(h, RichHandler) for h in demo_log.handlers):
+        demo_log.addHandler(RichHandler(console=_stderr_console(), show_path=False, markup=False))
+        demo_log.setLevel(logging.INFO)
+        demo_log.propagate = False
+
+
+def main(
+    robot: str = "pr2",
+    output: str | None = None,
+    item_at: int = 1,
+    steal: int = 0,
+    seed: int = 0,
+    realtime: bool = False,
+    interactive: bool = False,
+    db: str | None = None,
+    record: bool = True,
+    quiet: bool = False,
+    animation: bool = True,
+    backend: str = "sim",
+) -> int:
+    """Run the demo, print the task tree and a summary; return the process exit code (0: the item
+    rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
+    from rich.console import Console
+
+    from pycram.core.interrupts import StopSignals
+
+    if not quiet:
+        _log_to_terminal()
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    console = Console()
+    options = DemoOptions(
+        robot=robot,
+        output=Path(output) if output else None,
+        item_at=item_at,
+        steal=steal,
+        seed=seed,
+        realtime=realtime,
+        interactive=interactive,
+        db=db,
+        record=record,
+        quiet=quiet,
+        animation=animation,
+        backend=backend,
+    )
+    try:
+        with StopSignals(on_second=lambda: _stderr_console().show_cursor(True)) as stop:
+            result = run_demo(options, stop)
+    except ValueError as error:  # an option out of range: say which, no traceback
+        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
+        return 2
+    console.print()
+    console.print(_task_tree_display(result, options.db))
+    console.print(
+        f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
+        f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s"
+    )
+    console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")
+    console.print(f"pictures in {result.output.resolve()}: " + ", ".join(p.name for p in result.files))
+    if result.run_id is not None:
+        console.print(f"recorded as run {result.run_id} (see `pycram show {result.run_id}`)")
+    if result.trace_loss:
+        console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]", highlight=False)
+    colour = "green" if result.exit_code == 0 else "yellow" if result.interrupted else "red"
+    verdict = "SUCCESS" if result.exit_code == 0 else "INTERRUPTED" if result.interrupted else "FAILURE"
+    console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")
+    return result.exit_code

@@ -1,0 +1,196 @@
+"""What an experiment found: success rates, failure causes and times, as a table and a plot.
+
+`summarize(runs)` groups the recorded runs (`pycram.apps.experiments.store.RunRecord`) by robot and
+variant; `summary_table` renders that as a `rich` table, `write_plot` draws success rate, times
+and failure causes into a PNG (matplotlib, the `db` extra).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+__all__ = ["GroupSummary", "summarize", "percentile", "variant_label", "summary_table", "causes_table", "write_plot"]
+
+
+def percentile(values: Iterable[float], p: float) -> float | None:
+    """The `p`-th percentile (0–100) of `values` by the nearest-rank method; None when empty."""
+    ordered = sorted(v for v in values if v is not None)
+    if not ordered:
+        return None
+    rank = max(1, math.ceil(p / 100.0 * len(ordered)))
+    return ordered[min(rank, len(ordered)) - 1]
+
+
+def variant_label(variant: str) -> str:
+    """How a variant key reads in tables: "none", or its fault names "a,b"."""
+    return variant if variant else "none"
+
+
+@dataclass
+class GroupSummary:
+    """The runs of one robot in one variant: counts, success rate, times [s], failure causes."""
+
+    robot: str
+    variant: str
+    runs: int = 0
+    successes: int = 0
+    errors: int = 0  # runs whose scenario raised
+    sim_times: list[float] = field(default_factory=list)
+    wall_times: list[float] = field(default_factory=list)
+    causes: Counter[str] = field(default_factory=Counter)
+
+    @property
+    def success_rate(self) -> float:
+        """Successful runs / runs (0 without runs)."""
+        return self.successes / self.runs if self.runs else 0.0
+
+    @property
+    def real_time_factors(self) -> list[float]:
+        """Simulated time / wall time of each run with both."""
+        return [s / w for s, w in zip(self.sim_times, self.wall_times) if w and w > 0 and s is not None]
+
+
+def summarize(runs: Iterable[Any]) -> list[GroupSummary]:
+    """Group recorded runs by (robot, variant), in order of appearance."""
+    groups: dict[tuple[str, str], GroupSummary] = {}
+    for run in runs:
+        group = groups.setdefault((run.robot, run.variant), GroupSummary(run.robot, run.variant))
+        group.runs += 1
+        group.successes += bool(run.success)
+        group.errors += run.status == "error"
+        if run.sim_time is not None and run.wall_time is not None:
+            group.sim_times.append(run.sim_time)
+            group.wall_times.append(run.wall_time)
+        if not run.success:
+            group.causes.update(run.failure_causes or ["unknown"])
+    return sorted(groups.values(), key=lambda g: (g.variant, g.robot))
+
+
+def _seconds(value: float | None) -> str:
+    return "–" if value is None else f"{value:.1f}"
+
+
+def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
+    """A `rich.table.Table`: per robot and variant the runs, success rate, simulated and wall
+    time p50/p95 [s] and the median real-time factor."""
+    from rich.table import Table
+
+    table = Table(title=title or None, header_style="bold")
+    table.add_column("robot")
+    table.add_column("faults", overflow="fold")
+    for name in ("runs", "success", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
+        table.add_column(name, justify="right", no_wrap=True)
+    for g in groups:
+        rate = g.success_rate
+        style = "green" if rate >= 0.95 else "yellow" if rate >= 0.85 else "red"
+        rtf = percentile(g.real_time_factors, 50)
+        table.add_row(
+            g.robot,
+            variant_label(g.variant),
+            str(g.runs),
+            f"[{style}]{100 * rate:.1f} %[/{style}] ({g.successes})",
+            f"{_seconds(percentile(g.sim_times, 50))} / {_seconds(percentile(g.sim_times, 95))}",
+            f"{_seconds(percentile(g.wall_times, 50))} / {_seconds(percentile(g.wall_times, 95))}",
+            "–" if rtf is None else f"{rtf:.1f}",
+        )
+    return table
+
+
+def causes_table(groups: list[GroupSummary]) -> Any:
+    """A `rich.table.Table` of failure causes: how many failed runs each robot and variant had
+    per cause (a run with several causes counts for each), most frequent first."""
+    from rich.table import Table
+
+    total: Counter[str] = Counter()
+    for g in groups:
+        total.update(g.causes)
+    table = Table(title="failure causes", header_style="bold")
+    table.add_column("cause")
+    for g in groups:
+        table.add_column(f"{g.robot}\nfaults: {variant_label(g.variant)}", justify="right", overflow="fold")
+    for cause, _ in total.most_common():
+        table.add_row(cause, *(str(g.causes.get(cause, 0)) for g in groups))
+    if not total:
+        table.add_row("(no failures)", *("0" for _ in groups))
+    return table
+
+
+def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
+    """Draw success rate, simulated and wall time (p50 with a bar up to p95) per robot and
+    variant, and the failure causes, into the PNG `path` (folders created). Returns `path`."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    labels = [f"{g.robot}\nfaults: {variant_label(g.variant)}" for g in groups]
+    xs = list(range(len(groups)))
+    fig, (ax_rate, ax_time, ax_causes) = plt.subplots(1, 3, figsize=(15, 4.8))
+    try:
+        rates = [100 * g.success_rate for g in groups]
+        bars = ax_rate.bar(xs, rates, color=["#3a7" if r >= 95 else "#db3" if r >= 85 else "#c44" for r in rates])
+        for bar, g in zip(bars, groups):
+            ax_rate.annotate(
+                f"{g.successes}/{g.runs}",
+                (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
+        ax_rate.set_xticks(xs, labels, fontsize=8)
+        ax_rate.set_ylim(0, 105)
+        ax_rate.set_ylabel("success rate [%]")
+        ax_rate.set_title("success rate")
+
+        width = 0.38
+        for offset, name, values, colour in (
+            (-width / 2, "simulated", [g.sim_times for g in groups], "#47a"),
+            (width / 2, "wall", [g.wall_times for g in groups], "#a74"),
+        ):
+            p50 = [percentile(v, 50) or 0.0 for v in values]
+            p95 = [percentile(v, 95) or 0.0 for v in values]
+            ax_time.bar([x + offset for x in xs], p50, width, label=f"{name} p50", color=colour)
+            ax_time.errorbar(
+                [x + offset for x in xs],
+                p50,
+                yerr=[[0] * len(xs), [b - a for a, b in zip(p50, p95)]],
+                fmt="none",
+                ecolor="black",
+                capsize=3,
+            )
+        ax_time.set_xticks(xs, labels, fontsize=8)
+        ax_time.set_ylabel("time per run [s] (bar: p50, whisker: p95)")
+        ax_time.set_title("time per run")
+        ax_time.legend(fontsize=8)
+
+        causes: Counter[str] = Counter()
+        for g in groups:
+            causes.update(g.causes)
+        names = [c for c, _ in causes.most_common(12)]
+        if names:
+            left = [0.0] * len(names)
+            for g, label in zip(groups, labels):
+                counts = [g.causes.get(c, 0) for c in names]
+                ax_causes.barh(names, counts, left=left, label=label.replace("\n", ", "))
+                left = [a + b for a, b in zip(left, counts)]
+            ax_causes.invert_yaxis()
+            ax_causes.legend(fontsize=7)
+        else:
+            ax_causes.text(0.5, 0.5, "no failures", ha="center", va="center", transform=ax_causes.transAxes)
+            ax_causes.set_yticks([])
+        ax_causes.set_xlabel("failed runs")
+        ax_causes.set_title("failure causes")
+        if title:
+            fig.suptitle(title)
+        fig.tight_layout()
+        fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)
+    return path

@@ -1,0 +1,205 @@
+"""Driving the base along a planned, collision-free path, re-planning when the way gets blocked.
+
+`PlannedDrive` is the controller behind `World.drive_to`: it plans a path on the occupancy grid
+of the current state (`pycram.world.navigation.PathPlanner`; the straight line when it is free)
+and drives it waypoint by waypoint with `BaseDrive` segments. Every control tick it watches the
+movable parts of the environment (obstacles, doors, drawers); when one moved and the rest of
+the path is no longer free, it stops the base, waits until it stands still, and plans again
+from where it stopped. It fails with reason "no_path" (message: the planner's reason) only when
+no path exists; contact and lag failures of the segments stay what they are ("collision",
+"blocked"), as the last line of defence.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
+from pycram.world.prospection import BasePose
+from pycram.world.types import Outcome, Pose2D
+
+from .controllers import BaseDrive, Controller, fail, invalid_input
+from .engine import Engine
+from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, robot_parts
+from .prospection import SimProspection
+from .recording import StateSnapshot
+from .robot_model import BASE_JOINTS
+
+_log = logging.getLogger(__name__)
+
+#: Tolerances [m], [rad] at intermediate waypoints (the goal keeps BaseDrive's own).
+WAYPOINT_TOLERANCE = (0.03, 0.05)
+#: A movable part of the environment counts as moved when a coordinate of its pose or joint
+#: changed by more than this [m, rad or quaternion component] (less than a grid cell).
+MOVED = 0.01
+#: The base counts as stopped below this planar speed [m/s] (and a tenth of it in [rad/s]).
+STOPPED_SPEED = 0.02
+
+
+class Navigation:
+    """A scene's floor map, the robot's footprint and the planner of the current state; used by
+    the simulation thread only. The planner is rebuilt when a movable geom moved."""
+
+    def __init__(self, eng: Engine) -> None:
+        self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
+        self.footprint: Footprint = base_footprint(eng.scene, eng.data)
+        self._state: np.ndarray | None = None
+        self._outline = np.zeros(0)
+        self._robot_parts = robot_parts(eng.scene)
+        self._planner: PathPlanner | None = None
+        self._robot_state = StateSnapshot.of(eng.data)
+        # no tolerance: a drive fails on any contact
+        self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=0.0)
+
+    def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
+        """Whether the whole robot, in its configuration now, touches nothing of the environment
+        at a base pose (x, y, yaw): the 3D check behind the planner's outlines. Answers are
+        memoized per pose (to 1 mm / 1 mrad) for this state."""
+        self._robot_state = StateSnapshot.of(eng.data)
+        return memoized_free(self._prospection)
+
+    def planner(self, eng: Engine, refresh_outline: bool = True) -> tuple[PathPlanner, bool]:
+        """The planner of the current state, and whether it is new (something moved by more
+        than `MOVED` since the planner was built; smaller motions, e.g. a door settling, do not
+        rebuild it). The robot's outline is taken anew only with `refresh_outline` (or when
+        something moved): drives take it when they plan.
+
+        Each height band of obstacles is kept off by the outline of the robot as it stands
+        (arms included) below that band's top: the base alone keeps off a counter whose top
+        the arms reach over, the whole robot keeps off walls and tall boxes."""
+        state = self.floor.movable_state(eng.data)
+        moved = self._state is None or float(np.abs(state - self._state).max(initial=0.0)) > MOVED
+        if self._planner is not None and not moved and not refresh_outline:
+            return self._planner, False
+        bands = self.floor.bands(eng.model, eng.data)
+        outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, self._robot_parts) for top in bands}
+        # the robot's pose, to the cm
+        key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
+        if (
+            self._planner is not None
+            and not moved
+            and key.shape == self._outline.shape
+            and float(np.abs(key - self._outline).max(initial=0.0)) <= MOVED
+        ):
+            return self._planner, False
+        self._state, self._outline = state, key
+        layers = [(mask, outlines[top]) for top, mask in bands.items()]
+        nothing = OccupancyGrid(self.floor.origin, self.floor.resolution, np.zeros(self.floor.shape, bool))
+        self._planner = PathPlanner(nothing, self.footprint, layers=layers)
+        return self._planner, True
+
+
+def memoized_free(prospection: SimProspection) -> Callable[[float, float, float], bool]:
+    """(x, y, yaw) -> the robot touches nothing there (`prospection.in_collision`), memoized per
+    pose to 1 mm / 1 mrad (for one plan: the state must not change meanwhile)."""
+    memo: dict[tuple[int, int, int], bool] = {}
+
+    def free(x: float, y: float, yaw: float) -> bool:
+        key = (round(x * 1e3), round(y * 1e3), round(yaw * 1e3))
+        answer = memo.get(key)
+        if answer is None:
+            answer = memo[key] = not prospection.in_collision((x, y, yaw))
+        return answer
+
+    return free
+
+
+def navigation_of(eng: Engine) -> Navigation:
+    """The engine's `Navigation`, built on first use (a few ms)."""
+    nav = getattr(eng, "_navigation", None)
+    if nav is None:
+        nav = eng._navigation = Navigation(eng)  # type: ignore[attr-defined]
+    return nav
+
+
+def _pose(p: Pose2D) -> BasePose:
+    return BasePose(p.x, p.y, p.yaw)
+
+
+class PlannedDrive(Controller):
+    """Drive the base to `goal` (map frame) around obstacles; see the module docstring.
+
+    The outcome's value is the final `Pose2D` (also on failure: where the base stopped).
+    `replans` counts the plans made after the first (for tests and traces).
+    """
+
+    channel = "base"
+
+    def __init__(self, goal: Pose2D) -> None:
+        self.goal = goal
+        self.waypoints: list[BasePose] = []
+        self.segment: BaseDrive | None = None
+        self.stopping = False
+        self.replans = 0
+
+    def _plan(self, eng: Engine) -> Outcome | None:
+        nav = navigation_of(eng)
+        planner, _ = nav.planner(eng)
+        here = eng.base_pose()
+        try:
+            self.waypoints = planner.plan(_pose(here), _pose(self.goal), nav.exact_check(eng))
+        except NoPathError as exc:
+            return fail("no_path", str(exc), here)
+        if len(self.waypoints) > 1:
+            _log.info(
+                "drive to (%.2f, %.2f): path around obstacles with %d waypoints",
+                self.goal.x,
+                self.goal.y,
+                len(self.waypoints),
+            )
+        return self._next_segment(eng)
+
+    def _next_segment(self, eng: Engine) -> Outcome | None:
+        w = self.waypoints.pop(0)
+        if self.waypoints:
+            self.segment = BaseDrive(Pose2D(w.x, w.y, w.yaw), *WAYPOINT_TOLERANCE)
+        else:
+            self.segment = BaseDrive(self.goal)
+        return self.segment.start(eng)
+
+    def start(self, eng: Engine) -> Outcome | None:
+        refused = invalid_input(goal=(self.goal.x, self.goal.y, self.goal.yaw))
+        if refused is not None:  # "invalid" before anything is planned or moves, as BaseDrive
+            return refused
+        return self._plan(eng)
+
+    def _remaining_free(self, eng: Engine, planner: PathPlanner) -> bool:
+        rest = (
+            [BasePose(self.segment.goal.x, self.segment.goal.y, self.segment.goal.yaw)]
+            if self.segment is not None
+            else []
+        ) + self.waypoints
+        return planner.path_free(_pose(eng.base_pose()), rest, navigation_of(eng).exact_check(eng))
+
+    def update(self, eng: Engine, t: float) -> Outcome | None:
+        if self.stopping:
+            v = math.hypot(*(float(eng.data.qvel[i]) for i in eng.base_dof[:2]))
+            if v > STOPPED_SPEED or abs(float(eng.data.qvel[eng.base_dof[2]])) > STOPPED_SPEED * 10:
+                return None
+            self.stopping = False
+            self.replans += 1
+            return self._plan(eng)
+        planner, changed = navigation_of(eng).planner(eng, refresh_outline=False)
+        if changed and not self._remaining_free(eng, planner):
+            _log.info("drive to (%.2f, %.2f): the path is blocked; stopping to re-plan", self.goal.x, self.goal.y)
+            eng.hold(list(BASE_JOINTS))
+            self.segment = None
+            self.stopping = True
+            return None
+        assert self.segment is not None
+        out = self.segment.update(eng, t)
+        if out is None or not out.succeeded:
+            return out
+        if self.waypoints:
+            return self._next_segment(eng)
+        return out
+
+    def stop(self, eng: Engine) -> None:
+        eng.hold(list(BASE_JOINTS))
+
+
+__all__ = ["PlannedDrive", "Navigation", "navigation_of"]

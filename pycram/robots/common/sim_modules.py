@@ -1,0 +1,459 @@
+"""Simulated process modules, shared by every robot of :mod:`pycram.sim` (PR2, TIAGo).
+
+A process module is the only place that talks to the simulator. Each module here serves one
+component of the robot and is parametrised by the robot's world (and arm / gripper name); the
+robot packages (:mod:`pycram.robots.pr2`, :mod:`pycram.robots.tiago`) build one set per robot.
+
+Every module executes the *solution* of its motion designator (``designator.reference()``, a
+``dict`` with a ``'cmd'`` key produced by the robot's motion resolver, thesis ch. 4.2.1) by
+sending one thread-safe command to the :class:`pycram.sim.World` and waiting -- evaporably, on
+the command handle's ``result`` fluent -- for its outcome.
+
+Guarantees
+----------
+- ``_execute`` returns the outcome's value on success (e.g. the reached ``Pose2D``, the measured
+  gripper opening [m]) and raises :class:`SimMotionFailed` otherwise; its message names the
+  command, the outcome reason and the simulator's message ("drive to (x, y, yaw) failed:
+  collision: base touches obstacle_0 (stopped at ...)").
+- A command that does not end within its time-out [s of simulated time] is cancelled and
+  reported as ``SimMotionFailed`` with reason ``'timeout'``.
+- ``_cancel`` (run by :class:`ProcessModule` when the executing task is evaporated) cancels the
+  running simulator command, which leaves the part at rest (base stopped, arm holding).
+- :class:`BaseStopModule` is separate from :class:`NavigationModule`, so ``cancelling_movement``
+  never queues behind the drive it is meant to stop.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from typing import Any
+
+from pycram.core.fluent import Fluent
+from pycram.execution.failures import MotionFailure, NavigationFailure
+from pycram.execution.process_module import ProcessModule, ProcessModuleStatus
+from pycram.execution.robot import Robot
+
+__all__ = [
+    "SimMotionFailed",
+    "NavigationFailed",
+    "SimProcessModule",
+    "NavigationModule",
+    "BaseStopModule",
+    "HeadModule",
+    "TorsoModule",
+    "ArmModule",
+    "GripperModule",
+    "SensorModule",
+    "PerceptionModule",
+    "SimRobot",
+    "cancel_running_handle",
+    "seen_objects",
+    "shutdown_modules",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Default time-out of one simulator command [s of simulated time].
+COMMAND_TIMEOUT = 60.0
+
+
+class SimMotionFailed(MotionFailure):
+    """A simulator command ended without success.
+
+    Attributes: ``command`` (what was asked, readable), ``reason`` (the
+    :class:`pycram.sim.Outcome` reason: ``'blocked'``, ``'collision'``, ``'unreachable'``,
+    ``'timeout'``, ``'cancelled'``, ``'preempted'``, ``'invalid'``, ``'closed'``, ...),
+    ``outcome`` (the simulator's outcome, or ``None`` after a time-out).
+    """
+
+    def __init__(self, command: str, reason: str, message: str, outcome: Any = None) -> None:
+        super().__init__(f"{command} failed: {reason}: {message}")
+        self.command = command
+        self.reason = reason
+        self.message = message
+        self.outcome = outcome
+
+
+class NavigationFailed(SimMotionFailed, NavigationFailure):
+    """The base found no collision-free path to its goal (``reason`` ``'no_path'``); a
+    :class:`pycram.world.navigation.NavigationFailure`, so plans can catch it without knowing
+    the backend. The message says why (goal in collision, no connection, off the map)."""
+
+
+def _fmt(values: Any) -> str:
+    try:
+        return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
+    except TypeError:
+        return repr(values)
+
+
+def _fmt_pose2d(pose: Any) -> str:
+    if pose is None:
+        return "?"
+    return f"(x={pose.x:.3f}, y={pose.y:.3f}, yaw={pose.yaw:.3f})"
+
+
+class SimProcessModule(ProcessModule):
+    """Base class: a process module running commands on a :class:`pycram.sim.World`.
+
+    Subclasses call :meth:`_run_command` from ``_execute``. The running command's handle is
+    kept so that the cancel hook can stop it.
+    """
+
+    def __init__(self, name: str, world: Any) -> None:
+        super().__init__(name)
+        self.world = world
+        self._handle: Any = None
+
+    def _run_command(
+        self,
+        start: Callable[[], Any],
+        command: str,
+        timeout: float = COMMAND_TIMEOUT,
+        describe_failure: Callable[[Any], str] | None = None,
+    ) -> Any:
+        """Send a command (``start()`` returns its handle), wait for it and return its value.
+
+        Blocks until the command ends or ``timeout`` [s, simulated] passes (then the command is
+        cancelled). Evaporable: the caller's evaporation interrupts the wait (the module's cancel
+        hook stops the command). Raises :class:`SimMotionFailed` on any unsuccessful outcome,
+        ``ValueError`` (before sending anything) for a time-out that is not a positive finite
+        number -- a NaN time-out would never expire.
+        """
+        if not (isinstance(timeout, (int, float)) and math.isfinite(timeout) and timeout > 0):
+            raise ValueError(f"{command}: the time-out must be a positive number of seconds, got {timeout!r}")
+        handle = start()
+        self._handle = handle
+        if not handle.result.wait_for(timeout):
+            self._handle = None
+            handle.cancel()
+            raise SimMotionFailed(command, "timeout", f"did not end within {timeout:.1f} s of simulated time")
+        outcome = handle.result.get_value()
+        self._handle = None
+        if not outcome.succeeded:
+            message = outcome.message
+            if describe_failure is not None:
+                message = f"{message} {describe_failure(outcome)}".strip()
+            raise SimMotionFailed(command, outcome.reason, message, outcome)
+        logger.debug("%s: %s succeeded", self.name, command)
+        return outcome.value
+
+    def _cancel(self, designator: Any) -> None:
+        cancel_running_handle(self, designator)
+
+
+def cancel_running_handle(module: Any, designator: Any) -> None:
+    """The cancel hook of a module that keeps its running command's handle in ``module._handle``
+    (a simulator command, a ROS goal: anything with ``name``, ``done`` and ``cancel()``): cancel
+    it -- unless ``designator`` was evaporated while still queued, when the running command
+    belongs to another caller."""
+    current = module.current
+    if current is None or current.designator is not designator:
+        return
+    handle, module._handle = module._handle, None
+    if handle is not None and not handle.done:
+        logger.info("%s: cancelling %s", module.name, handle.name)
+        handle.cancel()
+
+
+class NavigationModule(SimProcessModule):
+    """Drives the base (``'cmd': 'navigate'`` with ``'pose'``: a ``Pose2D`` in the map frame)
+    along a collision-free path around the environment and obstacles, re-planning when the
+    path gets blocked (see :mod:`pycram.backends.sim.path_drive`).
+
+    Returns the reached ``Pose2D``. Fails with :class:`NavigationFailed` (reason ``no_path``)
+    when no path exists, otherwise with the outcome reason (``collision``: the base touched
+    something; ``blocked``: it could not follow its path; ``timeout``; ``cancelled`` by
+    ``cancelling_movement``) and the pose where the base stopped.
+    """
+
+    def __init__(self, world: Any, name: str = "navigation") -> None:
+        super().__init__(name, world)
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "navigate")
+        pose = solution["pose"]
+        distance = math.hypot(pose.x - self.world.base_pose.get_value().x, pose.y - self.world.base_pose.get_value().y)
+        try:
+            return self._run_command(
+                lambda: self.world.move_base(pose),
+                f"drive to {_fmt_pose2d(pose)}",
+                timeout=30.0 + 4.0 * distance,
+                describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})",
+            )
+        except SimMotionFailed as exc:
+            if exc.reason != "no_path":
+                raise
+            raise NavigationFailed(exc.command, exc.reason, exc.message, exc.outcome) from None
+
+
+class BaseStopModule(SimProcessModule):
+    """Stops the base (``'cmd': 'stop_base'``): cancels whatever drives it, waited or not.
+
+    Separate from :class:`NavigationModule` so that it does not queue behind the drive it stops.
+    The stopped drive's execution ends ``CANCELLED`` (a non-waited one) or ``FAILED`` with
+    reason ``cancelled`` (a waited one). Returns the base pose after stopping.
+    """
+
+    def __init__(self, world: Any, navigation: NavigationModule, name: str = "base_stop") -> None:
+        super().__init__(name, world)
+        self.navigation = navigation
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "stop_base")
+        execution = self.navigation.current
+        if execution is not None:
+            execution.cancel()  # a non-waited drive: evaporates its task (cancel hook stops it)
+        self._run_command(lambda: self.world.cancel("base"), "stop the base", timeout=5.0)
+        if execution is not None:  # its cancel hook has run once its status is an outcome
+            waiter = Fluent(lambda: True if execution.done else None)
+            execution.status.add_child(waiter)
+            waiter.wait_for(5.0)
+        return self.world.base_pose.get_value()
+
+
+class HeadModule(SimProcessModule):
+    """Points the head camera (``'cmd': 'point_head'``, ``'point'`` [m, map]).
+
+    ``'track': False`` waits until the camera looks at the point (within ~1 deg) and returns the
+    remaining angle [rad]. ``'track': True`` (a ``('wait', False)`` designator) starts tracking
+    the point -- the camera stays on it while the base moves -- and returns at once; the next
+    head command replaces it.
+    """
+
+    def __init__(self, world: Any, name: str = "head") -> None:
+        super().__init__(name, world)
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "point_head")
+        point = tuple(float(v) for v in solution["point"])
+        if solution.get("track"):
+            self.world.track_point(point)
+            return None
+        return self._run_command(lambda: self.world.point_head(point), f"point the head at {_fmt(point)}", timeout=10.0)
+
+
+class TorsoModule(SimProcessModule):
+    """Moves the torso lift joint (``'cmd': 'set_torso'``, ``'height'`` [m])."""
+
+    def __init__(self, world: Any, name: str = "torso") -> None:
+        super().__init__(name, world)
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "set_torso")
+        height = float(solution["height"])
+        return self._run_command(lambda: self.world.set_torso(height), f"set the torso to {height:.3f} m", timeout=20.0)
+
+
+class ArmModule(SimProcessModule):
+    """One physical arm: ``'cmd': 'move_arm'`` (``'positions'`` [rad], joint order of the
+    description) and ``'cmd': 'reach'`` (``'position'`` [m, map], ``'orientation'`` (w, x, y, z)
+    or ``None``, ``'tolerance'`` [m]).
+
+    ``reach`` returns the reached tool ``Pose``; an unreachable target fails with reason
+    ``'unreachable'``.
+    """
+
+    def __init__(self, world: Any, arm: str, name: str | None = None) -> None:
+        super().__init__(name or f"arm_{arm}", world)
+        self.arm = arm
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        cmd = solution.get("cmd")
+        if cmd == "move_arm":
+            positions = tuple(float(v) for v in solution["positions"])
+            what = solution.get("configuration") or _fmt(positions)
+            return self._run_command(
+                lambda: self.world.move_arm(self.arm, positions), f"move the {self.arm} arm to {what}", timeout=30.0
+            )
+        if cmd == "reach":
+            position = tuple(float(v) for v in solution["position"])
+            orientation = solution.get("orientation")
+            phase = solution.get("phase")
+            what = f"reach with the {self.arm} arm to {_fmt(position)}" + (
+                f" ({phase} of {_fmt(solution['target'])})" if phase else ""
+            )
+            return self._run_command(
+                lambda: self.world.reach(
+                    self.arm, position, orientation, tolerance=float(solution.get("tolerance", 0.01))
+                ),
+                what,
+                timeout=30.0,
+            )
+        _check_cmd(self, solution, "move_arm", "reach")
+
+
+class GripperModule(SimProcessModule):
+    """One gripper: ``'cmd': 'set_gripper'`` with ``'opening'`` [m] and ``'effort'`` [N] or
+    ``None``. Returns the measured opening [m] (closing on an item stalls at its width)."""
+
+    def __init__(self, world: Any, gripper: str, name: str | None = None) -> None:
+        super().__init__(name or f"gripper_{gripper}", world)
+        self.gripper = gripper
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "set_gripper")
+        opening = float(solution["opening"])
+        effort = solution.get("effort")
+        return self._run_command(
+            lambda: self.world.set_gripper(self.gripper, opening, effort),
+            f"set the {self.gripper} gripper to {opening:.3f} m",
+            timeout=10.0,
+        )
+
+
+class _Relay(Fluent):
+    """A child of a sensor fluent that copies the sensor's value into a user's fluent on every
+    pulse (in the thread that updates the sensor), so the user's fluent pulses with it."""
+
+    __slots__ = ("_source", "_target", "_convert", "active")
+
+    def __init__(self, source: Fluent, target: Fluent, convert: Callable[[Any], Any]) -> None:
+        super().__init__(None, name=f"relay({source.name} -> {target.name})")
+        self._source, self._target, self._convert = source, target, convert
+        self.active = True
+
+    def pulse(self) -> None:
+        if self.active:
+            self._target.set_value(self._convert(self._source.get_value()))
+        super().pulse()
+
+
+class SensorModule(SimProcessModule):
+    """Subscriptions (``'cmd': 'subscribe'``): make a user's fluent follow a sensor fluent.
+
+    ``'source': 'base_pose'`` (a ``Pose2D``, map frame) or ``'gripper_opening'`` (with
+    ``'gripper'``, [m]). The user's fluent ``'fl'`` gets the current value at once and is set
+    (so pulsed) on every sensor update of the simulation until :meth:`unsubscribe_all`.
+    Returns the fluent.
+    """
+
+    def __init__(self, world: Any, name: str = "sensors") -> None:
+        super().__init__(name, world)
+        self._relays: list[_Relay] = []  # strong references: sensor fluents hold children weakly
+
+    def _source(self, solution: dict) -> Fluent:
+        source = solution["source"]
+        if source == "base_pose":
+            return self.world.base_pose
+        if source == "gripper_opening":
+            return self.world.gripper_openings[solution["gripper"]]
+        raise ValueError(f"unknown sensor {source!r}; available: base_pose, gripper_opening")
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "subscribe")
+        target = solution["fl"]
+        if not isinstance(target, Fluent):
+            raise TypeError(f"'fl' must be a Fluent, got {target!r}")
+        source = self._source(solution)
+        convert = float if solution["source"] == "gripper_opening" else (lambda v: v)
+        relay = _Relay(source, target, convert)
+        self._relays.append(relay)
+        target.set_value(convert(source.get_value()))
+        source.add_child(relay)
+        logger.debug("%s: %s follows %s", self.name, target.name, source.name)
+        return target
+
+    def unsubscribe_all(self) -> None:
+        """Stop updating every subscribed user fluent (they keep their last value)."""
+        for relay in self._relays:
+            relay.active = False
+        self._relays.clear()
+
+
+class PerceptionModule(SimProcessModule):
+    """Object perception with the head camera (``'cmd': 'perceive'``), filling the robot's belief.
+
+    Each execution takes one look (:meth:`pycram.sim.World.detect`: segmentation, depth and
+    colour images measured into detections) and folds it into ``belief`` (a
+    :class:`pycram.world.belief.BeliefState`). Returns the believed objects seen in this look
+    (:class:`pycram.world.belief.PerceivedObject`, most visible first), restricted by
+    ``'object'`` when given: a type or belief name, or an object designator; for a designator
+    the best match is recorded with ``designator.perceived(obj)`` (equated to it, thesis 3.3).
+    The look's :class:`pycram.world.belief.BeliefUpdate` is kept in ``last_update``.
+    """
+
+    def __init__(self, world: Any, belief: Any, name: str = "perception") -> None:
+        super().__init__(name, world)
+        self.belief = belief
+        self.last_update: Any = None
+
+    def _execute(self, designator: Any) -> Any:
+        solution = designator.reference()
+        _check_cmd(self, solution, "perceive")
+        report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
+        update = self.last_update = self.belief.update(report)
+        return seen_objects(update, solution.get("object"), report.stamp)
+
+
+def seen_objects(update: Any, wanted: Any, stamp: float) -> list[Any]:
+    """What a ``detecting`` motion returns, on every backend: the believed objects seen in one
+    look (``update``, a :class:`pycram.world.belief.BeliefUpdate`), most visible first,
+    restricted by ``wanted`` when given -- a type or belief name, or an object designator, whose
+    best match is then recorded with ``designator.perceived(obj, timestamp=stamp)`` (``stamp``
+    [s]: the look's time)."""
+    from pycram.designators.object import ObjectDesignator
+
+    seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
+    if wanted is None:
+        return seen
+    if isinstance(wanted, ObjectDesignator):
+        matching = [obj for obj in seen if wanted.matches(obj)]
+        if matching:
+            wanted.perceived(matching[0], timestamp=stamp)
+        return matching
+    return [obj for obj in seen if wanted in (obj.name, obj.type)]
+
+
+def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
+    if not isinstance(solution, dict) or solution.get("cmd") not in expected:
+        raise ValueError(f"{module.name} executes commands {list(expected)}, got solution {solution!r}")
+
+
+def shutdown_modules(robot: Robot) -> None:
+    """End every subscription of ``robot``'s sensor modules and take all its process modules
+    offline (running motions finish); idempotent."""
+    for module in robot.process_modules.values():
+        if isinstance(module, SensorModule):
+            module.unsubscribe_all()
+        if module.status.get_value() is not ProcessModuleStatus.OFFLINE:
+            module.shutdown()
+
+
+class SimRobot(Robot):
+    """A :class:`pycram.robot.Robot` bound to a simulated :class:`pycram.sim.World`.
+
+    ``world`` is the world, ``description`` the robot's description module, ``belief`` the
+    robot's :class:`pycram.world.belief.BeliefState` (its resolver is the robot's object
+    resolver, so object designators resolve against what it perceived). :meth:`shutdown`
+    ends every subscription and takes every process module offline (idempotent).
+    """
+
+    def __init__(self, name: str, world: Any, description: Any) -> None:
+        from pycram.world.belief import BeliefState
+
+        super().__init__(name)
+        self.world = world
+        self.description = description
+        #: What this robot believes is in the world: filled by its perception module, read by
+        #: its object resolver.
+        self.belief = BeliefState(getattr(world, "environment", None))
+        self.object_resolvers.append(self.belief.resolver)
+        make_prospection = getattr(world, "prospection", None)
+        self.prospection = make_prospection() if callable(make_prospection) else None
+
+    def shutdown(self) -> None:
+        """Stop subscriptions and take all process modules offline (running motions finish)."""
+        shutdown_modules(self)
+
+    def __repr__(self) -> str:
+        return f"SimRobot({self.name!r}, {self.world!r})"
