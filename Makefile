@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 # ROS 1 from Debian's packages (apt-get only when something is missing) + generated messages.
-$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/ros/interfaces/*/*.msg pycram/ros/interfaces/*/*.action pycram/ros/interfaces/*/*.srv) pycram/ros/interfaces/generate.py
+$(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/backends/ros/interfaces/*/*.msg pycram/backends/ros/interfaces/*/*.action pycram/backends/ros/interfaces/*/*.srv) pycram/backends/ros/interfaces/generate.py
 	scripts/install_ros.sh $(VENV)
 	touch $(ROS)
 
@@ -35,17 +35,18 @@ bench: $(STAMP)
 docs: $(STAMP) $(ROS)
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
-# Lint and format check (zero findings; CI runs it).
+# Lint, format check and the layering contracts (zero findings; CI runs it).
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/lint-imports
 
 # Type check (zero errors; CI runs it): strict on the language core, default settings on the rest
 # (the configuration is in pyproject.toml).
 types: $(STAMP)
 	$(VENV)/bin/mypy
 
-# Lint, format, types and docs: everything CI checks besides the wheel and the tests.
+# Lint, format, layering, types and docs: everything CI checks besides the wheel and the tests.
 check: lint
 	$(VENV)/bin/mypy
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet

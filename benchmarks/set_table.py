@@ -1,6 +1,6 @@
 """How often the set-table scenario succeeds, why it fails, and how long it takes (issue 17).
 
-Runs `pycram.apps.demos.set_table.run_set_table` for each robot and seed, one run per fresh process
+Runs `pycram.apps.scenarios.set_table.run_set_table` for each robot and seed, one run per fresh process
 (as `pycram experiment` does), and prints per robot: success rate, failure causes, simulated and
 wall time p50/p95, and the speed factor (simulated / wall time). The scenes are those of
 `pycram experiment --scenario set-table` (the cup in drawer 2 in about a third of the seeds);
@@ -28,7 +28,7 @@ from _worlds import percentile  # noqa: E402
 
 
 def _one(args: tuple) -> dict:
-    from pycram.apps.demos.set_table import OBJECTS, run_set_table
+    from pycram.apps.scenarios.set_table import OBJECTS, run_set_table
 
     robot, seed, faults, objects, in_containers = args
     return run_set_table(robot, seed, frozenset(faults), objects=tuple(objects or OBJECTS), in_containers=in_containers)

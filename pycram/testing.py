@@ -23,6 +23,7 @@ from typing import Any
 from pycram.core.runtime import wait_until
 from pycram.core.runtime.evaporation import runtime_code
 from pycram.execution.process_module import ProcessModule
+from pycram.world.robot_registry import robot_names
 
 __all__ = ["ScriptedProcessModule", "CountingGenerator", "scenario_double", "SCENARIO_DOUBLE_FAULTS"]
 
@@ -180,7 +181,8 @@ def scenario_double(
 
     Succeeds unless `"drop"` is among `faults` and the seed is divisible by 3 (then the cause is
     `ObjectSlipped`); `sim_time` is 10 + seed % 7 [s] (twice that with `"slow"`). Knows the
-    robots pr2 and tiago and the faults in `SCENARIO_DOUBLE_FAULTS` (`ValueError` otherwise).
+    registered robots (:func:`pycram.world.robot_registry.robot_names`) and the faults in
+    `SCENARIO_DOUBLE_FAULTS` (`ValueError` otherwise).
     For tests across processes it reads two environment variables: with
     `$PYCRAM_SCENARIO_DOUBLE_LOG` set it appends "robot seed variant" to that file for every run;
     when `$PYCRAM_SCENARIO_DOUBLE_INTERRUPT` is the seed, it sends SIGINT to its parent process
@@ -192,8 +194,8 @@ def scenario_double(
     import time
 
     started = time.monotonic()
-    if robot not in ("pr2", "tiago"):
-        raise ValueError(f"unknown robot {robot!r}; available robots: pr2, tiago")
+    if robot not in robot_names():
+        raise ValueError(f"unknown robot {robot!r}; available robots: {', '.join(robot_names())}")
     unknown = sorted(set(faults) - set(SCENARIO_DOUBLE_FAULTS))
     if unknown:
         raise ValueError(f"unknown fault(s) {', '.join(unknown)}; known: {', '.join(SCENARIO_DOUBLE_FAULTS)}")

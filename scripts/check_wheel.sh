@@ -29,7 +29,7 @@ echo "check_wheel: built $(basename "$WHEEL")"
 "$PYTHON" - "$WHEEL" <<'PY'
 import sys, zipfile
 names = zipfile.ZipFile(sys.argv[1]).namelist()
-missing = [n for n in ("pycram/py.typed", "pycram/_version.py", "pycram/cli.py") if n not in names]
+missing = [n for n in ("pycram/py.typed", "pycram/_version.py", "pycram/apps/cli/__init__.py") if n not in names]
 if missing:
     sys.exit(f"check_wheel: the wheel lacks {missing}")
 if any(n.startswith("tests/") for n in names):

@@ -5,7 +5,7 @@
 #
 # 1. apt-get installs the Debian packages below -- only when one of them is missing.
 # 2. genpy generates the messages Debian does not package (control_msgs, pycram_msgs) from
-#    pycram/ros/interfaces into VENV/ros-msgs.
+#    pycram/backends/ros/interfaces into VENV/ros-msgs.
 # 3. VENV's site-packages gets pycram-ros.pth: VENV/ros-msgs, then /usr/lib/python3/dist-packages.
 #    .pth entries come AFTER the venv's own site-packages, so the venv's pinned numpy, yaml, ...
 #    always win over Debian's; Debian's packages only fill in what the venv lacks (rospy, ...).

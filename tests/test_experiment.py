@@ -199,9 +199,9 @@ def test_set_table_is_registered_lazily():
     from pycram.apps.experiments.scenarios import SCENARIOS, UnknownScenario, get_scenario
 
     entry = SCENARIOS["set-table"]
-    assert entry.target == "pycram.apps.demos.set_table:run_set_table"
+    assert entry.target == "pycram.apps.scenarios.set_table:run_set_table"
     try:
-        import pycram.apps.demos.set_table  # noqa: F401
+        import pycram.apps.scenarios.set_table  # noqa: F401
     except ModuleNotFoundError:
         with pytest.raises(
             UnknownScenario,

@@ -20,9 +20,12 @@ from pycram.designators.action import ActionDesignator
 from pycram.execution.failures import ObjectNotFound
 
 from .basic import Detect, LookAt, MoveTorso, Navigate, ParkArms, Search, SetGripper
-from .containers import Close, Open, believed_open
+from .container_state import believed_open
+from .containers import Close, Open
 from .core import ACTION_PLANS, ActionParameterError, resolve_action
-from .manipulation import Held, PickUp, Place, held_objects
+from .held import Held, held_objects
+from .pick_up import PickUp
+from .place import Place
 from .search import Lookout, look_around, lookouts, search_for
 from .transport import Transport
 

@@ -172,7 +172,7 @@ def arms() -> list[str]:
     """The active robot's arms, its default arm first (a one-armed robot has one)."""
     d = _description()
     names = list(d.ARMS)
-    default = getattr(d, "DEFAULT_ARM", names[0])
+    default = d.DEFAULT_ARM
     return [default] + [a for a in names if a != default]
 
 
@@ -181,7 +181,7 @@ def arm_name(action: str, requested: Any) -> str | None:
     if requested is None:
         return None
     d = _description()
-    aliases = getattr(d, "ARM_ALIASES", {a: a for a in d.ARMS})
+    aliases = d.ARM_ALIASES
     if requested not in aliases:
         raise ActionParameterError(
             action, "arm", f"the robot has no arm {requested!r}", sorted(str(a) for a in aliases)

@@ -25,9 +25,12 @@ from pycram.execution.failures import GripperEmpty, ObjectSlipped
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 
-from .containers import CLOSED, DOOR_CLOSED, Close
+from .container_state import CLOSED, DOOR_CLOSED
+from .containers import Close
 from .core import ActionParameterError, action_plan, arms, attempt, make_action
-from .manipulation import PickUp, Place, believed_object, held_objects
+from .held import held_objects
+from .pick_up import PickUp, believed_object
+from .place import Place
 
 __all__ = ["Transport", "TRANSPORT_ROUNDS"]
 

@@ -1,7 +1,10 @@
 """Per-robot packages: descriptions (data), simulated hardware settings, resolvers and process modules.
 
-``load(name, world)`` builds the :class:`pycram.robot.Robot` of a simulated world; importing this
-package stays cheap (the robot modules, which need the simulation, are imported by ``load``).
+Which robots exist is the robot registry's business (:mod:`pycram.world.robot_registry`: the
+``pycram.robots`` entry points); each robot package holds ``description.py`` (data) and
+``robot.py`` (``make_robot(world)``). ``load(name, world)`` builds the :class:`pycram.robot.Robot`
+of a simulated world; importing this package stays cheap (the robot modules, which need the
+simulation, are imported by ``load``).
 """
 
 from __future__ import annotations
@@ -9,14 +12,16 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from pycram.world.robot_registry import robot_names, robot_package
+
 __all__ = ["ROBOT_NAMES", "load"]
 
-#: Robots with a simulated implementation.
-ROBOT_NAMES = ("pr2", "tiago")
+#: Robots with a simulated implementation: the registered robots.
+ROBOT_NAMES = robot_names()
 
 
 def load(name: str, world: Any) -> Any:
-    """The robot ``name`` (``'pr2'`` or ``'tiago'``) of the simulated ``world``, as a
+    """The robot ``name`` (one of `ROBOT_NAMES`) of the simulated ``world``, as a
     :class:`pycram.robots.common.sim_modules.SimRobot` with all process modules online and its motion,
     process-module and location resolvers registered. Activate it with ``with robot:``; stop it
     with ``robot.shutdown()``. Raises ``ValueError`` for an unknown name or a world built for
@@ -24,5 +29,5 @@ def load(name: str, world: Any) -> Any:
     """
     if name not in ROBOT_NAMES:
         raise ValueError(f"unknown robot {name!r}; available: {', '.join(ROBOT_NAMES)}")
-    module = importlib.import_module(f"pycram.robots.{name}.robot")
+    module = importlib.import_module(f"{robot_package(name)}.robot")
     return module.make_robot(world)

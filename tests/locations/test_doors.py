@@ -9,8 +9,10 @@ import pytest
 
 from pycram.environments.apartment import ENVIRONMENT as APARTMENT
 from pycram.reasoning.locations import doors
-from pycram.robots.pr2 import description as pr2
-from pycram.robots.tiago import description as tiago
+from pycram.world.robot_registry import robot_description
+
+pr2 = robot_description("pr2")
+tiago = robot_description("tiago")
 
 FRIDGE = APARTMENT.container("fridge")
 

@@ -12,9 +12,12 @@ from test_location_reasoning import APARTMENT, CUP_ON_TABLE, ScriptedProspection
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.locations import KnownObject, LocationReasoner, RobotGeometry
-from pycram.reasoning.locations.reasoning import DOOR_CLEARANCE, DRAWER_CLEARANCE, RIM_CLEARANCE
+from pycram.reasoning.locations.reach import RIM_CLEARANCE
+from pycram.reasoning.locations.standing import DOOR_CLEARANCE, DRAWER_CLEARANCE
 from pycram.robot import ResolverSet
-from pycram.robots.pr2 import description as pr2
+from pycram.world.robot_registry import robot_description
+
+pr2 = robot_description("pr2")
 
 DRAWER_2 = APARTMENT.container("drawer 2")
 OPENING = 0.38

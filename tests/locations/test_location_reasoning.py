@@ -17,10 +17,12 @@ from pycram.designators.location import LocationDesignator
 from pycram.environments import load
 from pycram.locations import BaseLocation, Costmap, FloorGrid, KnownObject, LocationReasoner, RobotGeometry, Spot
 from pycram.reasoning.locations.costmap import occupancy_layer
-from pycram.reasoning.locations.reasoning import MAX_CANDIDATES, SPACING
+from pycram.reasoning.locations.search import MAX_CANDIDATES, SPACING
 from pycram.robot import ResolverSet
-from pycram.robots.pr2 import description as pr2
-from pycram.robots.tiago import description as tiago
+from pycram.world.robot_registry import robot_description
+
+pr2 = robot_description("pr2")
+tiago = robot_description("tiago")
 
 APARTMENT = load("apartment")
 CUP_ON_TABLE = KnownObject("cup", "cup", (4.3, 1.7, 0.795))

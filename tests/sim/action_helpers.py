@@ -13,7 +13,7 @@ from typing import Any
 from sim_helpers import ok, tilt
 
 from pycram import robots
-from pycram.actions.manipulation import BACK_AWAY
+from pycram.actions.handling import BACK_AWAY
 from pycram.sim import World
 from pycram.world.objects import object_type
 

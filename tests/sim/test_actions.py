@@ -41,7 +41,7 @@ from pycram.actions import (
     Transport,
     held_objects,
 )
-from pycram.actions.manipulation import resting_problem
+from pycram.actions.place import resting_problem
 from pycram.designator import LocationDesignator, MotionDesignator, ObjectDesignator, perform
 from pycram.failures import (
     GoalUnreachable,
@@ -296,7 +296,7 @@ def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
     """Where the TIAGo stands to push the cupboard shut, the arm's way up to ``carry_top`` meets
     the cupboard: the arm going up before a pick-up's drive backs the base away first (the
     faulted set-table run of seed 14 failed to pick up the bowl after closing the cupboard)."""
-    from pycram.actions.manipulation import _arm_to_drive
+    from pycram.actions.pick_up import _arm_to_drive
     from pycram.robots.tiago.description import ARM_CONFIGURATIONS
 
     near_cupboard = (4.625, 4.025, 2.949)
@@ -396,7 +396,7 @@ def test_an_action_looking_at_an_object_looks_again_after_a_missed_detection(rob
     # what PickUp does on arriving at its standing pose and Place after letting go: a look that
     # misses the cup in plain view is taken again, and the cup is still believed there (one
     # look believed it gone, and PickUp searched for it all over again)
-    from pycram.actions.manipulation import _look_again
+    from pycram.actions.handling import _look_again
 
     with apartment_with(robot_name, {"cup": COUNTER}) as (world, robot):
         ready()

@@ -238,7 +238,7 @@ def test_a_drawer_pulled_out_beside_the_one_closed_is_seen_and_closed_too():
     """Closing a drawer looks at its neighbours' handles: one pulled out meanwhile (by a person
     here; by the TIAGo's arm going up from drawer 1 in the faulted set-table runs) is believed
     open and `close_opened_containers` closes it as well."""
-    from pycram.apps.demos.set_table_plan import close_opened_containers
+    from pycram.apps.scenarios.set_table.plan import close_opened_containers
 
     with apartment_with("tiago", {"cup": TABLE}) as (world, robot):
         perform(ParkArms())

@@ -217,14 +217,14 @@ import sys, threading
 from pycram.sim import World
 
 class InterruptAt:
-    """A trace function raising KeyboardInterrupt at the k-th new line run in pycram/sim/ (this
+    """A trace function raising KeyboardInterrupt at the k-th new line run in pycram/backends/sim/ (this
     thread). A line already run in the same frame is skipped: that is a loop, or the end of a
     `with` block, where an exception from a trace function lands after the lock was taken and
     before the block's exit runs (which Python's own `with lock:` cannot survive either)."""
     def __init__(self, k):
         self.k, self.lines, self.hit = k, 0, False
     def __call__(self, frame, event, arg):
-        if "/pycram/sim/" not in frame.f_code.co_filename:
+        if "/pycram/backends/sim/" not in frame.f_code.co_filename:
             return None
         seen = set()
         def line(frame, event, arg):
@@ -264,7 +264,7 @@ print(f"interrupted at {points} points of {probe.lines}")
 
 def test_an_interrupted_stop_recording_leaves_no_thread_after_close(tmp_path):
     """`stop_recording` is interrupted (KeyboardInterrupt raised by a trace hook) at every third
-    line it runs in pycram/sim/ — in the world, the handle, the recorder's `finish` — each time in
+    line it runs in pycram/backends/sim/ — in the world, the handle, the recorder's `finish` — each time in
     a fresh world; `close()` must then leave no thread of ours, and the process must exit normally
     (before the fix the recorder thread outlived `close()`, and a daemon thread still inside MuJoCo
     at interpreter shutdown crashed the process with SIGSEGV)."""

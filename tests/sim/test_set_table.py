@@ -14,8 +14,17 @@ from pathlib import Path
 
 import pytest
 
-from pycram.apps.demos import set_table
-from pycram.apps.demos.set_table import FAULTS, OBJECTS, check_faults, place_settings, run_set_table, start_scene
+from pycram.apps.scenarios import set_table
+from pycram.apps.scenarios.set_table import (
+    FAULTS,
+    OBJECTS,
+    check_faults,
+    driver,
+    place_settings,
+    run_set_table,
+    scene,
+    start_scene,
+)
 from pycram.environments import load as load_environment
 
 #: Seeds that set the whole table, measured (never the seeds the experiments report, 1-200), with
@@ -45,7 +54,7 @@ def test_the_start_scene_comes_from_the_seed_and_stays_in_the_start_regions():
     first, again, other = start_scene(env, 5), start_scene(env, 5), start_scene(env, 6)
     assert first == again and first != other
     # seed 221's first draw leaves no room for the milk on the counter: drawn again, not refused
-    assert set_table._draw_scene(env, 221, OBJECTS, True, random.Random(221)) is None
+    assert scene._draw_scene(env, 221, OBJECTS, True, random.Random(221)) is None
     assert [p.type for p in start_scene(env, 221)] == list(OBJECTS) and start_scene(env, 221) == start_scene(env, 221)
     inside: set[tuple[str, str]] = set()
     for seed in range(30):
@@ -83,7 +92,7 @@ def test_a_person_moving_an_object_from_the_cabinet_top_puts_it_clear_of_the_oth
     import random
     from types import SimpleNamespace
 
-    from pycram.apps.demos.set_table import START_REGIONS, Faults
+    from pycram.apps.scenarios.set_table import START_REGIONS, Faults
     from pycram.fluent import Fluent
 
     environment = load_environment("apartment")
@@ -281,7 +290,7 @@ def test_a_search_is_ended_by_pursue_when_a_look_while_driving_turns_the_object_
     from action_helpers import apartment_with, run_as_task, tasks_named
 
     from pycram.actions.core import while_driving
-    from pycram.apps.demos.set_table_plan import PlanRecord, find, look_for_the_next
+    from pycram.apps.scenarios.set_table.plan import PlanRecord, find, look_for_the_next
 
     with apartment_with("pr2", {"cup": ("cabinet top", (0.5, 2.8))}, base_pose=(4.3, 0.9, math.pi / 2)) as (world, _):
         record = PlanRecord()
@@ -331,7 +340,7 @@ def test_the_two_scenarios_write_the_pictures_of_a_seed_to_folders_of_their_own(
         folders.append(output)
         raise Stopped
 
-    monkeypatch.setattr(set_table, "run_scenario", run_scenario)
+    monkeypatch.setattr(driver, "run_scenario", run_scenario)
     for run in (set_table.run_set_table, set_table.run_set_table_on_open_surfaces):
         with pytest.raises(Stopped):
             run("pr2", 7, pictures=True)

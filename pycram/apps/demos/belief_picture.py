@@ -15,7 +15,7 @@ from typing import Any
 
 from pycram.apps.demos.scene_picture import _BOX, _OBJECT_COLOR, VIEW_SIZE, _Labels, _render, _save
 
-__all__ = ["write_belief_picture"]
+__all__ = ["write_belief_picture", "look_around_and_draw"]
 
 #: Matplotlib colours of the perceived colour names.
 _COLORS = {
@@ -188,3 +188,19 @@ def write_belief_picture(world: Any, belief: Any, path: str | Path, title: str |
         bbox={**_BOX, "facecolor": "white"},
     )
     return _save(fig, path, title or f"{env.name}: belief and ground truth")
+
+
+def look_around_and_draw(world: Any, robot_name: str, output: str | Path, title: str) -> tuple[Path, list[Any]]:
+    """The robot ``robot_name`` of the simulated ``world`` looks around from where it stands; its
+    belief is drawn beside the truth to ``output`` (:func:`write_belief_picture`). Returns the
+    picture's path and the believed objects. The robot is shut down afterwards."""
+    from pycram import robots
+    from pycram.actions import look_around
+
+    robot = robots.load(robot_name, world)
+    try:
+        with robot:
+            look_around()
+    finally:
+        robot.shutdown()
+    return write_belief_picture(world, robot.belief, output, title=title), list(robot.belief.objects())

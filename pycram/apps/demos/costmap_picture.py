@@ -11,12 +11,13 @@ location is not found.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["write_costmap_picture", "parse_location"]
+__all__ = ["write_costmap_picture", "parse_location", "perceive_named_objects", "draw_location_costmap", "DrawnCostmap"]
 
 
 def parse_location(text: str) -> list[tuple[str, Any]]:
@@ -141,3 +142,58 @@ def _describe(s: Any) -> str:
         extra = "".join(f" {k}={getattr(s, k)}" for k in ("arm", "grasp") if getattr(s, k, None))
         return f"({s.x:.2f}, {s.y:.2f}, {s.yaw:.2f}){extra}"
     return "(" + ", ".join(f"{v:.2f}" for v in s) + ")"
+
+
+def perceive_named_objects(robot: Any, properties: list[tuple[str, Any]]) -> list[str]:
+    """Reasoning knows objects only once perceived: ``robot`` looks around from where it stands,
+    then searches for each object type the location's ``properties`` name that it has not seen
+    yet. Returns the messages of the searches that found nothing (the picture is drawn anyway)."""
+    from pycram.actions import ObjectNotFound, look_around, search_for
+    from pycram.designators.object import ObjectDesignator
+    from pycram.world.objects import OBJECT_TYPES
+
+    not_found: list[str] = []
+    with robot:
+        look_around()
+        for _, value in properties:
+            if (
+                isinstance(value, str)
+                and value in OBJECT_TYPES
+                and not any(obj.type == value for obj in robot.belief.objects())
+            ):
+                try:
+                    search_for(ObjectDesignator(type=value))
+                except ObjectNotFound as e:
+                    not_found.append(str(e))
+    return not_found
+
+
+@dataclass(frozen=True)
+class DrawnCostmap:
+    """What :func:`draw_location_costmap` drew: the picture's ``path``, the location's
+    ``solutions`` (poses), its resolution ``error`` (``None`` when it had solutions) and the
+    searches that found nothing (``not_found``)."""
+
+    path: Path
+    solutions: list[Any]
+    error: str | None
+    not_found: list[str]
+
+
+def draw_location_costmap(
+    world: Any, robot_name: str, properties: list[tuple[str, Any]], output: str | Path, title: str
+) -> DrawnCostmap:
+    """The robot ``robot_name`` of the simulated ``world`` raises its torso (as plans do before
+    reaching), perceives the objects the location names (:func:`perceive_named_objects`), and
+    the location's costmap is drawn to ``output`` (:func:`write_costmap_picture`). The robot is
+    shut down afterwards; the world stays open."""
+    from pycram import robots
+
+    robot = robots.load(robot_name, world)
+    try:
+        world.set_torso(robot.description.TORSO_POSITIONS["up"]).wait(30.0)
+        not_found = perceive_named_objects(robot, properties)
+        path, solutions, error = write_costmap_picture(world, robot, properties, output, title=title)
+    finally:
+        robot.shutdown()
+    return DrawnCostmap(Path(path), list(solutions), error, not_found)

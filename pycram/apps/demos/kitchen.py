@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
+
 if TYPE_CHECKING:  # imported where used: the ROS backend is optional
     from pycram.apps.demos.ros_kitchen_world import RosSimEnvironment
 
@@ -55,7 +57,7 @@ ROOM_MIDDLE = (2.0, 2.0)
 
 @dataclass
 class DemoOptions:
-    robot: str = "pr2"
+    robot: str = DEFAULT_ROBOT
     output: Path | None = None
     item_at: int = 1
     steal: int = 0
@@ -184,8 +186,8 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
         raise ValueError(f"--item-at must be 0 (no item) or a position 1, 2 or 3, not {options.item_at}")
     if options.backend not in ("sim", "ros"):
         raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
-    if options.robot not in ("pr2", "tiago"):
-        raise ValueError(f"--robot must be 'pr2' or 'tiago', not {options.robot!r}")
+    if options.robot not in robot_names():
+        raise ValueError(f"--robot must be {robot_choices()}, not {options.robot!r}")
     stop = stop if stop is not None else StopSignals()  # never signalled unless entered
     started_wall = time.monotonic()
     recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
@@ -605,7 +607,7 @@ def _log_to_terminal() -> None:
 
 
 def main(
-    robot: str = "pr2",
+    robot: str = DEFAULT_ROBOT,
     output: str | None = None,
     item_at: int = 1,
     steal: int = 0,

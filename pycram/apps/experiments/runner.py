@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from pycram.apps.experiments.scenarios import RunInterrupted, Scenario, UnknownScenario, get_scenario
+from pycram.world.robot_registry import DEFAULT_ROBOT
 
 log = logging.getLogger(__name__)
 
@@ -199,7 +200,7 @@ def prepare_experiment(
         entry = get_scenario(spec)
     except UnknownScenario as e:
         raise ExperimentInputError(str(e)) from None
-    robot_list = parse_list(robots) if robots is not None else list(existing.robots) if existing else ["pr2"]
+    robot_list = parse_list(robots) if robots is not None else list(existing.robots) if existing else [DEFAULT_ROBOT]
     if not robot_list:
         raise ExperimentInputError(f"--robot: no robot given; available robots: {', '.join(entry.robots)}")
     unknown = [r for r in robot_list if r not in entry.robots]

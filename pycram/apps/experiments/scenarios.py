@@ -30,6 +30,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from pycram.world.robot_registry import robot_names
+
 log = logging.getLogger(__name__)
 
 __all__ = [
@@ -49,8 +51,9 @@ __all__ = [
 #: The signature of a scenario: `(robot, seed, faults, db_url, pictures) -> result dict`.
 ScenarioFunction = Callable[..., dict[str, Any]]
 
-#: The robots every built-in scenario runs on.
-ROBOTS = ("pr2", "tiago")
+#: The robots every built-in scenario runs on: the registered robots
+#: (:func:`pycram.world.robot_registry.robot_names`).
+ROBOTS = robot_names()
 
 #: The faults of the thesis scenario: `steal` takes the item from the gripper during transport
 #: (once or twice, by the seed); `misplaced` puts the item at position 2 or 3 (by the seed), so
@@ -286,11 +289,11 @@ register_scenario(
 )
 register_scenario(
     "set-table",
-    "pycram.apps.demos.set_table:run_set_table",
+    "pycram.apps.scenarios.set_table:run_set_table",
     description="set the table for breakfast in the apartment, objects on counters and in a drawer (issue 17)",
 )
 register_scenario(
     "set-table-open",
-    "pycram.apps.demos.set_table:run_set_table_on_open_surfaces",
+    "pycram.apps.scenarios.set_table:run_set_table_on_open_surfaces",
     description="set the table, every object starting on an open surface (none in a closed drawer)",
 )

@@ -1,7 +1,8 @@
 """Per-robot ROS configuration, as data: action and topic names, joint names, frames.
 
-:data:`ROBOT_CONFIGS` holds the defaults: the PR2's real interface names (thesis ch. 4.1,
-``control.py``) and TIAGo's. Point PyCRAM at another robot, or at a PR2 whose controllers are
+:data:`ROBOT_CONFIGS` holds the defaults, one per registered robot, built from the ``ROS`` key of
+its description (:mod:`pycram.world.robot_registry`): the PR2's real interface names (thesis
+ch. 4.1, ``control.py``) and TIAGo's. Point PyCRAM at another robot, or at a PR2 whose controllers are
 named differently, with :meth:`RosRobotConfig.replace` or :func:`config_from_dict` (e.g. from a
 YAML/JSON file) -- nothing else changes. The simulator bridge serves exactly the names of the
 configuration it is started with.
@@ -34,17 +35,9 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["ArmInterface", "GripperInterface", "RosRobotConfig", "ROBOT_CONFIGS", "robot_config", "config_from_dict"]
+from pycram.world.robot_registry import robot_description, robot_names
 
-_PR2_ARM_JOINTS = (
-    "shoulder_pan_joint",
-    "shoulder_lift_joint",
-    "upper_arm_roll_joint",
-    "elbow_flex_joint",
-    "forearm_roll_joint",
-    "wrist_flex_joint",
-    "wrist_roll_joint",
-)
+__all__ = ["ArmInterface", "GripperInterface", "RosRobotConfig", "ROBOT_CONFIGS", "robot_config", "config_from_dict"]
 
 
 @dataclass(frozen=True)
@@ -129,54 +122,32 @@ class RosRobotConfig:
         return result
 
 
-def _pr2() -> RosRobotConfig:
-    def arm(side: str) -> ArmInterface:
-        return ArmInterface(
-            f"/{side}_arm_controller/follow_joint_trajectory",
-            tuple(f"{side}_{j}" for j in _PR2_ARM_JOINTS),
-            f"/{side}_arm_reach",
-        )
-
-    return RosRobotConfig(
-        robot="pr2",
-        arms={"right": arm("r"), "left": arm("l")},
-        grippers={
-            "right": GripperInterface("/r_gripper_controller/gripper_action", ("r_gripper_joint",)),
-            "left": GripperInterface("/l_gripper_controller/gripper_action", ("l_gripper_joint",)),
-        },
-        head_action="/head_traj_controller/point_head_action",
-        head_pointing_frame="high_def_frame",
-        head_pointing_axis=(1.0, 0.0, 0.0),
-        torso_action="/torso_controller/position_joint_action",
-        torso_joint="torso_lift_joint",
-        torso_interface="single_joint_position",
-    )
+def _from_plain(data: dict[str, Any]) -> RosRobotConfig:
+    """A configuration from complete plain data (arms and grippers as mappings of their fields)."""
+    merged = dict(data)
+    merged["arms"] = {
+        k: ArmInterface(v["trajectory_action"], tuple(v["joint_names"]), v["reach_action"])
+        for k, v in merged["arms"].items()
+    }
+    merged["grippers"] = {
+        k: GripperInterface(v["action"], tuple(v["opening_joints"])) for k, v in merged["grippers"].items()
+    }
+    merged["head_pointing_axis"] = tuple(merged["head_pointing_axis"])
+    return RosRobotConfig(**merged)
 
 
-def _tiago() -> RosRobotConfig:
-    return RosRobotConfig(
-        robot="tiago",
-        arms={
-            "right": ArmInterface(
-                "/arm_controller/follow_joint_trajectory", tuple(f"arm_{i}_joint" for i in range(1, 8)), "/arm_reach"
-            )
-        },
-        grippers={
-            "right": GripperInterface(
-                "/gripper_controller/gripper_action", ("gripper_left_finger_joint", "gripper_right_finger_joint")
-            )
-        },
-        head_action="/head_controller/point_head_action",
-        head_pointing_frame="xtion_rgb_optical_frame",
-        head_pointing_axis=(0.0, 0.0, 1.0),
-        torso_action="/torso_controller/follow_joint_trajectory",
-        torso_joint="torso_lift_joint",
-        torso_interface="joint_trajectory",
-    )
+def _configs() -> dict[str, RosRobotConfig]:
+    """The default configuration of every registered robot whose description has a ``ROS`` key."""
+    configs = {}
+    for name in robot_names():
+        ros = robot_description(name).ROS
+        if ros is not None:
+            configs[name] = _from_plain({"robot": name, **ros})
+    return configs
 
 
-#: Default configurations by robot name.
-ROBOT_CONFIGS: dict[str, RosRobotConfig] = {"pr2": _pr2(), "tiago": _tiago()}
+#: Default configurations by robot name (from the ``ROS`` key of each robot's description).
+ROBOT_CONFIGS: dict[str, RosRobotConfig] = _configs()
 
 
 def robot_config(robot: str) -> RosRobotConfig:
@@ -196,13 +167,4 @@ def config_from_dict(data: dict[str, Any]) -> RosRobotConfig:
     unknown = sorted(set(data) - set(base))
     if unknown:
         raise ValueError(f"unknown ROS configuration keys {unknown}; valid: {sorted(base)}")
-    merged = {**base, **data}
-    merged["arms"] = {
-        k: ArmInterface(v["trajectory_action"], tuple(v["joint_names"]), v["reach_action"])
-        for k, v in merged["arms"].items()
-    }
-    merged["grippers"] = {
-        k: GripperInterface(v["action"], tuple(v["opening_joints"])) for k, v in merged["grippers"].items()
-    }
-    merged["head_pointing_axis"] = tuple(merged["head_pointing_axis"])
-    return RosRobotConfig(**merged)
+    return _from_plain({**base, **data})

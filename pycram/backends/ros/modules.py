@@ -38,8 +38,14 @@ from pycram.backends.ros.config import RosRobotConfig
 from pycram.backends.ros.detections import report_of
 from pycram.backends.ros.transport import ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed, Transport
 from pycram.core.fluent import Fluent
+from pycram.execution.module_support import (
+    cancel_running_handle,
+    check_command,
+    format_pose2d,
+    format_values,
+    seen_objects,
+)
 from pycram.execution.process_module import ProcessModule
-from pycram.robots.common.sim_modules import _check_cmd, _fmt, _fmt_pose2d, cancel_running_handle, seen_objects
 from pycram.world.belief import BeliefState, BeliefUpdate
 from pycram.world.types import Pose, Pose2D
 
@@ -232,7 +238,7 @@ class RosNavigationModule(RosProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "navigate")
+        check_command(self, solution, "navigate")
         pose = solution["pose"]
         here = self.state.base_pose.get_value()
         distance = math.hypot(pose.x - here.x, pose.y - here.y) if here is not None else 10.0
@@ -249,13 +255,13 @@ class RosNavigationModule(RosProcessModule):
                 ),
             ),
         )
-        command = f"drive to {_fmt_pose2d(pose)}"
+        command = f"drive to {format_pose2d(pose)}"
         try:
             self._run_goal(
                 self.config.move_base_action, "move_base_msgs/MoveBase", goal, command, timeout=30.0 + 4.0 * distance
             )
         except RosMotionFailed as e:
-            e.args = (f"{e.args[0]} (stopped at {_fmt_pose2d(self.state.base_pose.get_value())})",)
+            e.args = (f"{e.args[0]} (stopped at {format_pose2d(self.state.base_pose.get_value())})",)
             raise
         return self.state.fresh_base_pose()
 
@@ -277,7 +283,7 @@ class RosBaseStopModule(RosProcessModule):
         self.navigation = navigation
 
     def _execute(self, designator: Any) -> Any:
-        _check_cmd(self, designator.reference(), "stop_base")
+        check_command(self, designator.reference(), "stop_base")
         execution = self.navigation.current
         if execution is not None:
             execution.cancel()  # its cancel hook cancels its goal
@@ -299,7 +305,7 @@ class RosHeadModule(RosProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "point_head")
+        check_command(self, solution, "point_head")
         point = tuple(float(v) for v in solution["point"])
         m, c = self.transport.message, self.config
         goal = m("control_msgs/PointHeadGoal", pointing_frame=c.head_pointing_frame, max_velocity=1.0)
@@ -310,7 +316,9 @@ class RosHeadModule(RosProcessModule):
         if solution.get("track"):
             self._send(c.head_action, "control_msgs/PointHead", goal)
             return None
-        self._run_goal(c.head_action, "control_msgs/PointHead", goal, f"point the head at {_fmt(point)}", timeout=10.0)
+        self._run_goal(
+            c.head_action, "control_msgs/PointHead", goal, f"point the head at {format_values(point)}", timeout=10.0
+        )
         return None
 
 
@@ -324,7 +332,7 @@ class RosTorsoModule(RosProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "set_torso")
+        check_command(self, solution, "set_torso")
         height = float(solution["height"])
         c = self.config
         if c.torso_interface == "single_joint_position":
@@ -371,7 +379,7 @@ class RosArmModule(RosProcessModule):
                     f"the {self.arm} arm has {len(self.interface.joint_names)} joints "
                     f"{list(self.interface.joint_names)}, got {len(positions)} positions"
                 )
-            what = solution.get("configuration") or _fmt(positions)
+            what = solution.get("configuration") or format_values(positions)
             goal = _trajectory_goal(self.transport, self.interface.joint_names, positions)
             self._run_goal(
                 self.interface.trajectory_action,
@@ -383,7 +391,7 @@ class RosArmModule(RosProcessModule):
             return positions
         if cmd == "reach":
             return self._reach(solution)
-        _check_cmd(self, solution, "move_arm", "reach")
+        check_command(self, solution, "move_arm", "reach")
 
     def _reach(self, solution: dict) -> Pose:
         m = self.transport.message
@@ -407,8 +415,8 @@ class RosArmModule(RosProcessModule):
             tolerance=float(solution.get("tolerance", 0.01)),
         )
         phase = solution.get("phase")
-        what = f"reach with the {self.arm} arm to {_fmt(position)}" + (
-            f" ({phase} of {_fmt(solution['target'])})" if phase else ""
+        what = f"reach with the {self.arm} arm to {format_values(position)}" + (
+            f" ({phase} of {format_values(solution['target'])})" if phase else ""
         )
         result = self._run_goal(self.interface.reach_action, "pycram_msgs/Reach", goal, what, timeout=30.0)
         p, q = result.reached.position, result.reached.orientation
@@ -428,7 +436,7 @@ class RosGripperModule(RosProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "set_gripper")
+        check_command(self, solution, "set_gripper")
         opening = float(solution["opening"])
         effort = solution.get("effort")
         m = self.transport.message
@@ -482,7 +490,7 @@ class RosPerceptionModule(RosProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "perceive")
+        check_command(self, solution, "perceive")
         if self._subscription is None:
             self._subscription = self.transport.subscribe(
                 self.config.detections_topic, "pycram_msgs/DetectedItems", self.detections.tick

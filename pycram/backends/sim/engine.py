@@ -14,6 +14,7 @@ import numpy as np
 
 from pycram.world.types import GripperState, JointStates, Pose, Pose2D, Quat, Vec3
 
+from .furniture import Furniture
 from .robot_model import BASE_JOINTS, HEAD_CAMERA, pad_site, tool_site
 from .scene import Scene, initial_state, weld_name
 
@@ -131,8 +132,6 @@ class Engine:
             for j in range(self.model.njnt)
             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE and self.model.joint(j).name not in furniture_joints
         ]
-        from .furniture import Furniture  # (furniture's controllers import this module)
-
         self.furniture = Furniture(self)
         self.obstacles = {
             f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])

@@ -1,5 +1,4 @@
-"""Articulated furniture in the simulation thread: container joint positions, the "stuck" fault,
-and a hand that pushes or pulls a container (used by fault injection and tests).
+"""Articulated furniture in the simulation thread: container joint positions and the "stuck" fault.
 
 Drawers and doors are driven by contact only: their joints have no actuator, only damping and
 friction loss (see `environment_builder`), so they move when something pushes them hard enough
@@ -8,16 +7,14 @@ and stay where they are left. A stuck container is held where it is by its joint
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import mujoco
-import numpy as np
 
-from pycram.world.types import Outcome
-
-from .controllers import Controller, ok
-from .engine import Engine
 from .environment_builder import stuck_equality
+
+if TYPE_CHECKING:
+    from .engine import Engine
 
 
 class Furniture:
@@ -48,46 +45,4 @@ class Furniture:
         return bool(data.eq_active[self.stuck_eq[name]])
 
 
-class ContainerPush(Controller):
-    """A hand pushes container `name` with `force` [N, map frame] for `duration` [s].
-
-    The force acts at the handle's grasp point (default) or at `point` [m, map frame, taken with
-    the container as it is at the start], which moves with the container. Value: the container's
-    joint position at the end [m or rad].
-    """
-
-    def __init__(
-        self, name: str, force: Sequence[float], duration: float, point: Sequence[float] | None = None
-    ) -> None:
-        self.name, self.force, self.duration = name, np.asarray(force, float), float(duration)
-        self.point = None if point is None else np.asarray(point, float)
-        self.channel = f"hand:{name}"
-
-    def start(self, eng: Engine) -> Outcome | None:
-        f = eng.furniture
-        self.body = f.body[self.name]
-        if self.point is not None:  # the point in the body's frame
-            rot = eng.data.xmat[self.body].reshape(3, 3)
-            self.local = rot.T @ (self.point - eng.data.xpos[self.body])
-        self.end = eng.time + self.duration
-        return None
-
-    def _point(self, eng: Engine) -> np.ndarray:
-        if self.point is None:
-            return eng.data.site_xpos[eng.furniture.handle[self.name]].copy()
-        return eng.data.xpos[self.body] + eng.data.xmat[self.body].reshape(3, 3) @ self.local
-
-    def update(self, eng: Engine, t: float) -> Outcome | None:
-        if t >= self.end - 1e-9:
-            self.stop(eng)
-            return ok(eng.furniture.positions(eng.data)[self.name])
-        arm = self._point(eng) - eng.data.xipos[self.body]
-        eng.data.xfrc_applied[self.body, :3] = self.force
-        eng.data.xfrc_applied[self.body, 3:] = np.cross(arm, self.force)
-        return None
-
-    def stop(self, eng: Engine) -> None:
-        eng.data.xfrc_applied[self.body, :] = 0.0
-
-
-__all__ = ["Furniture", "ContainerPush"]
+__all__ = ["Furniture"]

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import itertools
+import time
 from collections.abc import Callable
 from typing import Any
 
+from pycram.core.fluent import Fluent
 from pycram.world.types import Outcome
 
-from ._runtime import Fluent
 from .errors import CommandFailed
 
 _ids = itertools.count(1)
@@ -67,3 +68,10 @@ class CommandHandle:
 
     def __repr__(self) -> str:
         return f"<CommandHandle {self.name}#{self.id} {self.outcome!r}>"
+
+
+def _wait_wall(handle: CommandHandle, timeout: float) -> None:
+    """Wait for `handle` by wall time (for blocking conveniences that must not hang on sim time)."""
+    deadline = time.monotonic() + timeout
+    while not handle.done and time.monotonic() < deadline:
+        handle.wait(0.05)  # wakes on completion or after 0.05 s of the active clock

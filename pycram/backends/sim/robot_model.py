@@ -1,24 +1,28 @@
 """Putting a robot description into a MuJoCo scene: URDF, omnidirectional base, actuators,
 grippers, head camera and tool sites.
 
-The robot's description module (`pycram.robots.<name>.description`) provides the names and
-numbers; this module only knows how to turn them into MJCF elements.
+The robot's validated description (:class:`pycram.world.robot_description.RobotDescription`,
+from the robot registry) provides the names and numbers; this module only knows how to turn them
+into MJCF elements.
 """
 
 from __future__ import annotations
 
-import importlib
-from types import ModuleType
+from typing import Any
 
 import mujoco
 import numpy as np
+
+from pycram.world.robot_description import RobotDescription
+from pycram.world.robot_registry import robot_description, robot_names
 
 from . import collision
 from .assets import urdf_text
 from .errors import UnknownNameError
 
-#: Names of the robots the simulator can load.
-ROBOTS = ("pr2", "tiago")
+#: Names of the robots the simulator can load: the registered robots
+#: (:func:`pycram.world.robot_registry.robot_names`).
+ROBOTS = robot_names()
 
 #: Names of the base joints added on the mount body.
 BASE_JOINTS = ("base_x", "base_y", "base_yaw")
@@ -33,11 +37,11 @@ HEAD_CAMERA = "head_camera"
 NOT_IK_SEEDS = frozenset({"carry_top"})
 
 
-def load_description(robot: str) -> ModuleType:
-    """The description module of `robot` (one of `ROBOTS`)."""
+def load_description(robot: str) -> RobotDescription:
+    """The validated description of `robot` (one of `ROBOTS`; `UnknownNameError` otherwise)."""
     if robot not in ROBOTS:
         raise UnknownNameError("robot", robot, ROBOTS)
-    return importlib.import_module(f"pycram.robots.{robot}.description")
+    return robot_description(robot)
 
 
 def tool_site(arm: str) -> str:
@@ -58,9 +62,8 @@ def _camera_quat() -> list[float]:
     return quat.tolist()
 
 
-def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
-    """Build the simple parallel gripper of `desc.GRIPPER_MODEL` (TIAGo) into the robot spec."""
-    g = desc.GRIPPER_MODEL
+def _add_parallel_gripper(spec: mujoco.MjSpec, desc: RobotDescription, g: dict[str, Any]) -> None:
+    """Build the simple parallel gripper `g` (`desc.GRIPPER_MODEL`, TIAGo) into the robot spec."""
     grip = next(iter(desc.GRIPPERS.values()))
     mount = spec.body(g["mount_link"])
     px, py, pz = g["palm_size"]
@@ -98,11 +101,11 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: ModuleType) -> None:
         )
 
 
-def build_robot_spec(desc: ModuleType) -> mujoco.MjSpec:
+def build_robot_spec(desc: RobotDescription) -> mujoco.MjSpec:
     """The robot's own spec: URDF with collision groups, gravity compensation, camera and sites."""
     spec = mujoco.MjSpec.from_string(urdf_text(desc.URDF))
-    if hasattr(desc, "GRIPPER_MODEL"):
-        _add_parallel_gripper(spec, desc)
+    if desc.GRIPPER_MODEL is not None:
+        _add_parallel_gripper(spec, desc, desc.GRIPPER_MODEL)
     for geom in spec.geoms:
         if geom.contype or geom.conaffinity:
             collision.set_group(geom, collision.ROBOT)
@@ -136,7 +139,7 @@ def _position_actuator(spec: mujoco.MjSpec, joint: str, kp: float, kv: float, fo
     act.forcerange = [-force, force]
 
 
-def add_robot(spec: mujoco.MjSpec, desc: ModuleType) -> None:
+def add_robot(spec: mujoco.MjSpec, desc: RobotDescription) -> None:
     """Give the robot of `desc` (already in `spec`, see `build_robot_spec`) an omnidirectional base
     (slide x, slide y, hinge yaw on its root link) and add its actuators.
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, cast
 
 import actionlib
@@ -41,6 +41,7 @@ import rospy
 from pycram.backends.ros.config import RosRobotConfig
 from pycram.backends.ros.detections import detections_message
 from pycram.backends.ros.ros1 import message_class
+from pycram.backends.sim.items import ItemSpec
 from pycram.backends.sim.perception import PerceptionFaults
 from pycram.world.types import Outcome, Pose2D, Vec3
 
@@ -385,29 +386,28 @@ def _pose_msg(pose: Any) -> Any:
 
 def run_bridge(
     robot: str,
-    item_at: int = 1,
-    base_pose: tuple[float, float, float] | None = None,
+    items: Sequence[ItemSpec],
+    base_pose: tuple[float, float, float],
     realtime: bool = False,
     publish_rate: float = 50.0,
     detection_rate: float = 2.0,
     ready: Callable[[], None] | None = None,
     perception_faults: PerceptionFaults | None = None,
 ) -> None:
-    """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the demo kitchen with
-    ``robot`` and the demo's mug at slot ``item_at`` (0: no item), at ``base_pose`` (default the
-    demo's start), the head camera's object perception with ``perception_faults`` (none by
-    default). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once everything
-    is served."""
-    from pycram.apps.demos.kitchen_world import START_POSE, demo_items
+    """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the thesis kitchen with
+    ``robot`` at ``base_pose`` (x [m], y [m], yaw [rad]) and ``items`` (the demo's mug: see
+    ``pycram sim-ros-bridge``), the head camera's object perception with ``perception_faults``
+    (none by default). Initialises the ROS node ``sim_ros_bridge``. ``ready()`` is called once
+    everything is served."""
     from pycram.backends.ros.config import robot_config
-    from pycram.backends.sim import World
+    from pycram.backends.sim.world import World
 
     config = robot_config(robot)
     rospy.init_node("sim_ros_bridge", disable_signals=False)
     world = World(
         robot,
-        demo_items(item_at),
-        base_pose=cast(Vec3, tuple(base_pose or START_POSE)),
+        list(items),
+        base_pose=cast(Vec3, tuple(base_pose)),
         realtime=realtime,
         perception_faults=perception_faults,
     )

@@ -9,13 +9,14 @@ import logging
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from types import ModuleType
 
 import mujoco
 import numpy as np
 
 from pycram import environments
 from pycram.world.environment import Environment
+from pycram.world.robot_description import RobotDescription
+from pycram.world.robot_registry import DEFAULT_ROBOT
 
 from .environment_builder import add_environment
 from .errors import UnknownNameError
@@ -37,7 +38,7 @@ class Scene:
     """A compiled scene: the model, the robot's description and name/id lookups."""
 
     model: mujoco.MjModel
-    description: ModuleType
+    description: RobotDescription
     items: tuple[ItemSpec, ...]
     environment: Environment
     robot_geoms: frozenset[int] = field(default_factory=frozenset)
@@ -46,7 +47,7 @@ class Scene:
 
     @property
     def robot(self) -> str:
-        """The robot's name ("pr2" or "tiago")."""
+        """The robot's name (a registered robot, :mod:`pycram.world.robot_registry`)."""
         return self.description.NAME
 
     def joint_qpos(self, joint: str) -> int:
@@ -121,12 +122,12 @@ def _subtree_bodies(model: mujoco.MjModel, root: int) -> set[int]:
 
 
 def build_scene(
-    robot: str = "pr2",
+    robot: str = DEFAULT_ROBOT,
     items: Sequence[ItemSpec] | None = None,
     offscreen_size: tuple[int, int] = (640, 480),
     environment: str | Environment = environments.DEFAULT_ENVIRONMENT,
 ) -> Scene:
-    """Compile `environment` (a name or a description) with `robot` ("pr2" or "tiago") and
+    """Compile `environment` (a name or a description) with `robot` (a registered robot) and
     `items` (default: `DEFAULT_ITEMS` in the thesis kitchen, none elsewhere).
 
     An item without a z stands on the highest open surface below it (the floor when there is

@@ -15,45 +15,51 @@ time-outs follow simulated time. Headless it runs as fast as it can; `realtime=T
 `realtime_factor` x wall time: over any interval, simulated time advances by at most
 `realtime_factor` x (wall time + `REALTIME_SLACK`); a machine that cannot keep up runs slower,
 and never races afterwards to catch up.
+
+This module holds `World` itself: construction, lifecycle (`close`), the simulation thread's loop
+and the sensor fluents it publishes. Its commands are grouped by concept in the classes it
+inherits: `commands.CommandQueue` (submitting, starting, cancelling and ending commands),
+`motion_commands.MotionCommands`, `sensing.Sensing` (cameras and perception),
+`recording_commands.RecordingCommands` and `interventions.Interventions` (items, obstacles and
+containers moved by a person, fault injection or a test).
 """
 
 from __future__ import annotations
 
 import atexit
-import copy
 import logging
 import queue
 import threading
 import time
 import weakref
-from collections.abc import Callable, Sequence
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from pycram.core.fluent import Fluent
+from pycram.core.runtime.clock import ManualClock, current_clock, set_clock
 from pycram.environments import DEFAULT_ENVIRONMENT
 from pycram.environments import load as load_environment
 from pycram.world.environment import Environment
 from pycram.world.objects import object_type
+from pycram.world.robot_registry import DEFAULT_ROBOT
 from pycram.world.scenes import random_scene
-from pycram.world.types import Outcome, Pose, Pose2D, Quat, Vec3, VisibleItem
+from pycram.world.types import Outcome, Pose, Pose2D
 
-from ._runtime import Fluent, ManualClock, current_clock, set_clock
-from .camera import FollowView
-from .controllers import BaseDrive, Controller, GiveItem, GripperCommand, HeadPointing, Instant, JointTrajectory, Reach
+from .controllers import Controller
 from .engine import Engine
-from .environment_builder import OBSTACLE_PARKING
-from .errors import UnknownNameError, WorldClosedError
-from .furniture import ContainerPush
+from .errors import UnknownNameError
 from .handle import CommandHandle
+from .interventions import Interventions
 from .items import ItemSpec
-from .path_drive import PlannedDrive
-from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
-from .recording import DEFAULT_MAX_PENDING, FrameRecorder, RecordedFrames, StateSnapshot
-from .render import Renderers, write_animation, write_png
-from .robot_model import HEAD_CAMERA
+from .motion_commands import MotionCommands
+from .perception import PerceptionFaults
+from .recording import FrameRecorder, StateSnapshot
+from .recording_commands import RecordingCommands
+from .render import Renderers
 from .scene import build_scene
+from .sensing import Sensing
 
 if TYPE_CHECKING:
     from .prospection import SimProspection
@@ -82,8 +88,8 @@ def _close_live_worlds() -> None:
             _log.debug("closing a world at exit failed", exc_info=True)
 
 
-class World:
-    """An environment (default: the thesis kitchen), a robot ("pr2" or "tiago") and items,
+class World(MotionCommands, Sensing, RecordingCommands, Interventions):
+    """An environment (default: the thesis kitchen), a robot (a name of `pycram.world.robot_registry`) and items,
     simulated in a background thread. The robot starts at `base_pose` (default: the
     environment's place "start").
 
@@ -102,7 +108,7 @@ class World:
 
     def __init__(
         self,
-        robot: str = "pr2",
+        robot: str = DEFAULT_ROBOT,
         items: Sequence[ItemSpec] | None = None,
         *,
         environment: str | Environment = DEFAULT_ENVIRONMENT,
@@ -306,40 +312,6 @@ class World:
         # wake anybody waiting on simulated time one last time
         self.clock.advance_to(self._engine.time + 1e9)
 
-    def _drain_inbox(self) -> None:
-        eng = self._engine
-        while True:
-            try:
-                kind, ctrl, handle = self._inbox.get_nowait()
-            except queue.Empty:
-                return
-            if kind == "cancel":
-                for channel, (_ctrl, h) in list(self._active.items()):
-                    if h is handle:
-                        self._end(channel, Outcome(False, "cancelled", "cancelled"), stop=True)
-                continue
-            try:
-                if ctrl.channel is not None and ctrl.channel in self._active:
-                    self._end(ctrl.channel, Outcome(False, "preempted", f"preempted by {handle.name}"), stop=False)
-                out = ctrl.start(eng)
-            except Exception as exc:  # a bad command must not kill the world
-                _log.exception("command %s failed to start", handle.name)
-                out = Outcome(False, "error", f"{type(exc).__name__}: {exc}")
-            if out is not None:
-                if not out.succeeded:
-                    ctrl.stop(eng)
-                self._finished.append((handle, out))
-            elif ctrl.channel is None:
-                self._finished.append((handle, Outcome(True, "succeeded")))
-            else:
-                self._active[ctrl.channel] = (ctrl, handle)
-
-    def _end(self, channel: str, outcome: Outcome, stop: bool) -> None:
-        ctrl, handle = self._active.pop(channel)
-        if stop or not outcome.succeeded:
-            ctrl.stop(self._engine)
-        self._finished.append((handle, outcome))
-
     def _tool_poses(self) -> dict[str, Pose]:
         eng = self._engine
         return {arm: eng.site_pose(s) for arm, s in eng.tool_sites.items()}
@@ -363,51 +335,7 @@ class World:
         if eng.furniture.containers:
             self.container_states.set_value(eng.furniture.positions(eng.data))
 
-    # ------------------------------------------------------------------ submitting
-    def submit(self, ctrl: Controller, name: str) -> CommandHandle:
-        """Queue a controller for the simulation thread; returns its handle at once."""
-        handle = CommandHandle(name, self._cancel)
-        with self._lock:
-            if self._closed or self._stop.is_set():
-                raise WorldClosedError(f"world is closed; cannot run {name}")
-            self._inbox.put(("start", ctrl, handle))
-        return handle
-
-    def _cancel(self, handle: CommandHandle) -> None:
-        with self._lock:
-            if not self._closed:
-                self._inbox.put(("cancel", None, handle))
-
-    def _call(self, name: str, fn: Callable[..., Any], *args: Any) -> CommandHandle:
-        return self.submit(Instant(fn, *args), name)
-
-    def _check_arm(self, arm: str) -> str:
-        if arm not in self.description.ARMS:
-            raise UnknownNameError("arm", arm, self.description.ARMS)
-        return arm
-
-    def _check_gripper(self, gripper: str) -> str:
-        if gripper not in self.description.GRIPPERS:
-            raise UnknownNameError("gripper", gripper, self.description.GRIPPERS)
-        return gripper
-
-    # ------------------------------------------------------------------ robot commands
-    def drive_to(self, x: float, y: float, yaw: float, plan_path: bool = True) -> CommandHandle:
-        """Drive the base to the map pose (x [m], y [m], yaw [rad]) with the base's limits.
-
-        With `plan_path` the base follows a collision-free path around the environment and the
-        obstacles (the straight line where that is free; see `pycram.backends.sim.path_drive`), stops and
-        re-plans when the path gets blocked, and ends with "no_path" when there is none; without,
-        it drives the straight line whatever is in the way. Ends with "collision"/"blocked"
-        (stopped where it is) or "timeout"; value: final `Pose2D`.
-        """
-        goal = Pose2D(x, y, yaw)
-        return self.submit(PlannedDrive(goal) if plan_path else BaseDrive(goal), "drive_to")
-
-    def move_base(self, pose: Pose2D, plan_path: bool = True) -> CommandHandle:
-        """`drive_to` with a `Pose2D`."""
-        return self.drive_to(pose.x, pose.y, pose.yaw, plan_path)
-
+    # ------------------------------------------------------------------ prospection
     def prospection(self) -> SimProspection:
         """The robot's prospection (`pycram.world.prospection.Prospection`) in this world: "what
         if" questions answered on scratch copies of the latest published state (thread-safe;
@@ -419,410 +347,6 @@ class World:
                 self._prospection = SimProspection(self.scene, lambda: self._state)
             return self._prospection
 
-    def set_torso(self, height: float, duration: float | None = None) -> CommandHandle:
-        """Move the torso lift joint to `height` [m]."""
-        joint = self.description.TORSO["joint"]
-        return self.submit(
-            JointTrajectory("torso", [joint], [height], duration, max_velocity=0.1, tolerance=0.005), "set_torso"
-        )
-
-    def move_arm(self, arm: str, positions: Sequence[float], duration: float | None = None) -> CommandHandle:
-        """Move the joints of `arm` (order: `description.ARMS[arm]["joints"]`) to `positions` [rad]."""
-        joints = self.description.ARMS[self._check_arm(arm)]["joints"]
-        if len(positions) != len(joints):
-            raise ValueError(f"{arm} arm has {len(joints)} joints, got {len(positions)} positions")
-        return self.submit(JointTrajectory(f"arm:{arm}", joints, positions, duration), f"move_arm:{arm}")
-
-    def move_arm_to(self, arm: str, configuration: str, duration: float | None = None) -> CommandHandle:
-        """Move `arm` to a named configuration of `description.ARM_CONFIGURATIONS[arm]`."""
-        configs = self.description.ARM_CONFIGURATIONS[self._check_arm(arm)]
-        if configuration not in configs:
-            raise UnknownNameError("arm configuration", configuration, configs)
-        return self.move_arm(arm, configs[configuration], duration)
-
-    def reach(
-        self,
-        arm: str,
-        position: Sequence[float],
-        orientation: Sequence[float] | None = None,
-        duration: float | None = None,
-        tolerance: float = 0.01,
-    ) -> CommandHandle:
-        """Move the tool frame of `arm` to `position` [m] (and `orientation` (w, x, y, z) if given).
-
-        Ends with "unreachable" when inverse kinematics finds no solution within the joint limits;
-        value: the reached tool `Pose`.
-        """
-        self._check_arm(arm)
-        goal = Pose(
-            cast(Vec3, tuple(map(float, position))),
-            cast(Quat, tuple(map(float, orientation))) if orientation is not None else (1.0, 0.0, 0.0, 0.0),
-        )
-        return self.submit(Reach(arm, goal, orientation is not None, duration, tolerance), f"reach:{arm}")
-
-    def point_head(self, point: Sequence[float]) -> CommandHandle:
-        """Turn the head camera to `point` [m, map frame]; succeeds when it looks at it (< ~1 deg)."""
-        return self.submit(HeadPointing(point), "point_head")
-
-    def track_point(self, point: Sequence[float]) -> CommandHandle:
-        """Keep the head camera on `point` [m, map frame], also while driving, until cancelled."""
-        return self.submit(HeadPointing(point, track=True), "track_point")
-
-    def set_gripper(self, gripper: str, opening: float, effort: float | None = None) -> CommandHandle:
-        """Open/close `gripper` to `opening` [m] with at most `effort` [N] at the finger tips
-        (default: the description's `default_effort`); value: measured opening [m].
-
-        The fingers never push harder than `effort` (the applied effort is published in
-        `gripper_states[gripper].effort`). Closing on an item that is between the fingers (both
-        touching it) grasps it with a weld; closing on nothing grasps nothing; opening wider
-        releases a held item. A non-positive effort ends with reason "invalid".
-        """
-        return self.submit(GripperCommand(self._check_gripper(gripper), opening, effort), f"gripper:{gripper}")
-
-    def cancel(self, part: str) -> CommandHandle:
-        """Cancel whatever runs on `part` ("base", "torso", "head", "arm:<arm>", "gripper:<g>")."""
-
-        def fn(eng: Engine) -> bool:
-            if part in self._active:
-                self._end(part, Outcome(False, "cancelled", "cancelled"), stop=True)
-                return True
-            return False
-
-        return self._call(f"cancel:{part}", fn)
-
-    # ------------------------------------------------------------------ cameras and perception
-    def _get_renderers(self) -> Renderers:
-        if self._renderers is None:
-            self._renderers = Renderers(self.scene.model)
-        return self._renderers
-
-    def _get_perception_renderers(self) -> Renderers:
-        """Renderers of object perception, on a copy of the model without multisampling (~2x
-        cheaper with a software renderer; the geometry is the model's, the state `eng.data`)."""
-        if self._perception_renderers is None:
-            model = copy.copy(self.scene.model)  # mj_copyModel: nothing shared afterwards
-            model.vis.quality.offsamples = 0
-            self._perception_renderers = Renderers(model)
-        return self._perception_renderers
-
-    def request_image(
-        self, camera: str | FollowView = HEAD_CAMERA, width: int = 320, height: int = 240, hide_objects: bool = False
-    ) -> CommandHandle:
-        """Render an RGB image (height x width x 3, uint8) from `camera` (a camera name or a
-        `FollowView`); also set `camera_image`.
-
-        `hide_objects` leaves the items out of the picture (e.g. a plan to draw a belief on).
-        """
-        self._check_camera(camera)
-
-        def fn(eng: Engine) -> np.ndarray:
-            geoms = [g for gs in eng.item_part_geoms.values() for g in gs] if hide_objects else []
-            saved = eng.model.geom_rgba[geoms, 3].copy()
-            eng.model.geom_rgba[geoms, 3] = 0.0  # fully transparent geoms are not drawn
-            try:
-                img = self._get_renderers().rgb(eng.data, camera, width, height)
-            finally:
-                eng.model.geom_rgba[geoms, 3] = saved
-            self.camera_image.set_value(img)
-            return img
-
-        return self._call(f"image:{camera}", fn)
-
-    def _check_camera(self, camera: str | FollowView) -> None:
-        """Raise for a camera name the scene does not have, or a `FollowView` of unknown bodies."""
-        if isinstance(camera, FollowView):
-            camera.check(self.scene.model)
-        else:
-            self.scene.camera(camera)
-
-    def snapshot(
-        self,
-        path: str | Path,
-        camera: str | FollowView = "overview",
-        width: int = 640,
-        height: int = 480,
-        timeout: float = 30.0,
-    ) -> Path:
-        """Render `camera` (a camera name or a `FollowView`) and write a PNG to `path` (blocks up
-        to `timeout` [s of wall time])."""
-        handle = self.request_image(camera, width, height)
-        _wait_wall(handle, timeout)
-        out = handle.outcome
-        if out is None or not out.succeeded:
-            raise WorldClosedError(f"snapshot failed: {out}")
-        return write_png(path, out.value)
-
-    def perceive(self, min_pixels: int = 20, width: int = 320, height: int = 240) -> CommandHandle:
-        """Items visible to the head camera (segmentation render): value `list[VisibleItem]`,
-        most visible first. An item hidden behind others or outside the view is not reported."""
-
-        def fn(eng: Engine) -> list[VisibleItem]:
-            ids = self._get_renderers().segmentation(eng.data, HEAD_CAMERA, width, height)
-            seen = []
-            for name, geoms in eng.item_part_geoms.items():
-                rows, cols = np.nonzero(np.isin(ids, geoms))
-                if len(rows) >= min_pixels:
-                    seen.append(
-                        VisibleItem(
-                            name,
-                            self.scene.item(name).type,
-                            eng.item_pose(name),
-                            len(rows),
-                            (float(cols.mean()), float(rows.mean())),
-                        )
-                    )
-            return sorted(seen, key=lambda v: -v.pixels)
-
-        return self._call("perceive", fn)
-
-    def detect(
-        self, width: int = 320, height: int = 240, min_pixels: int = MIN_PIXELS, max_range: float = MAX_RANGE
-    ) -> CommandHandle:
-        """One look of the head camera's object perception: value a
-        `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
-        colour images of `width` x `height` [px], most visible first; the camera view with its
-        depth image; the joint positions of the containers whose handle is in the image or that
-        an object was seen inside),
-        stamped with the simulated time.
-
-        Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
-        not reported; `perception_faults` apply. No simulator names or poses are reported.
-        """
-        return self._call("detect", lambda eng: self._detect(eng, width, height, min_pixels, max_range))
-
-    def _detect(self, eng: Engine, width: int, height: int, min_pixels: int, max_range: float) -> Any:
-        """`detect`'s work, in the simulation thread: render, measure, report."""
-        from pycram.world.belief import PerceptionReport
-
-        renderers = self._get_perception_renderers()
-        ids, depth = renderers.segmentation_and_depth(eng.data, HEAD_CAMERA, width, height)
-        rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
-        cam = eng.camera
-        view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]), depth, max_range)
-        objects = {it.name: (it.type, eng.item_part_geoms[it.name]) for it in self.scene.items}
-        states = eng.furniture.positions(eng.data) if eng.furniture.containers else {}
-        detections = measure_detections(
-            ids,
-            depth,
-            rgb,
-            view,
-            objects,
-            self.environment,
-            states,
-            self.perception_faults,
-            self._fault_rng,
-            min_pixels,
-        )
-        # the joint positions of the containers whose handle is in the image, and of those an
-        # object was seen inside (their inside is in view): the belief moves objects in a drawer
-        # with its measured opening, so an object's pose and its drawer's opening come together
-        in_view = {
-            name: q
-            for name, q in states.items()
-            if view.in_image(self.environment.container(name).handle_position(q))
-            or any(d.container == name for d in detections)
-        }
-        return PerceptionReport(eng.time, tuple(detections), view, in_view)
-
-    def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
-        """Render geom ids per pixel (height x width, -1: background) from `camera`."""
-        self.scene.camera(camera)
-        return self._call(
-            f"segmentation:{camera}", lambda eng: self._get_renderers().segmentation(eng.data, camera, width, height)
-        )
-
-    def start_recording(
-        self,
-        camera: str | FollowView = "overview",
-        fps: float = 10.0,
-        width: int = 320,
-        height: int = 240,
-        *,
-        max_pending: int = DEFAULT_MAX_PENDING,
-        caption: Callable[[], str] | None = None,
-    ) -> CommandHandle:
-        """Start recording frames of `camera` (width x height [px]) every 1/`fps` s of simulated
-        time, from the simulated time at which the command runs; a recording already running is
-        discarded.
-
-        The simulation thread only copies the state at each frame time (microseconds); a
-        recorder thread of its own renders and GIF-encodes the frames (`FrameRecorder`), so the
-        simulation never waits for rendering. If `max_pending` frames wait to be rendered, a new
-        one is dropped (counted and logged when the recording stops). Frames are not limited by
-        the world's `offscreen_size`, and are rendered without multisampling.
-
-        `camera` is a camera name or a `FollowView` (a free camera that keeps bodies in view).
-        With `caption` (called in the simulation thread at each frame time; it must be quick and
-        never block, e.g. read a fluent), each frame carries a caption: its text and the
-        simulated time.
-        """
-        self._check_camera(camera)
-        recorder = FrameRecorder(
-            self.scene.model,
-            camera,
-            fps,
-            width,
-            height,
-            max_pending,
-            name=f"pycram-recorder-{self.robot}",
-            caption=caption,
-        )
-        with self._lock:
-            self._recorders.append(recorder)
-
-        def fn(eng: Engine) -> None:
-            previous, self._recorder = self._recorder, recorder
-            if previous is not None:
-                _log.warning("start_recording: discarding the recording that was running")
-                previous.abort()
-            recorder.start_at(eng.time)
-
-        try:
-            return self._call("start_recording", fn)
-        except WorldClosedError:
-            self._forget_recorder(recorder, abort=True)
-            raise
-
-    def _forget_recorder(self, recorder: FrameRecorder, abort: bool) -> None:
-        """Stop tracking `recorder` for `close()`; with `abort`, end its thread first. A recorder
-        whose thread still runs is never forgotten (`close()` must end it)."""
-        if abort:
-            recorder.close()
-        if recorder.running:
-            return
-        with self._lock:
-            if recorder in self._recorders:
-                self._recorders.remove(recorder)
-
-    def stop_recording(self, path: str | Path | None = None, timeout: float = 30.0) -> list[np.ndarray]:
-        """Stop recording; write the animation to `path` (GIF by suffix) if given; return the frames.
-        The last frame shows the state at the simulated time the recording stopped.
-
-        Waits for the recorder thread to render the frames still pending and ends it. Blocks up
-        to `timeout` [s of wall time]; frames not rendered by then are dropped (logged). Returns
-        a `RecordedFrames` (a list of RGB arrays, height x width x 3 uint8, which also carries
-        the GIF encoding, so `write_animation` of these frames to a GIF is fast). Raises
-        `WorldClosedError` if the world is closed and `SimulationError` if rendering failed;
-        `ValueError` from writing when `path` is given but nothing was recorded.
-        """
-        deadline = time.monotonic() + timeout
-
-        def fn(eng: Engine) -> FrameRecorder | None:
-            recorder, self._recorder = self._recorder, None
-            if recorder is not None:
-                recorder.capture_last(eng.data)  # the animation ends with the state it stopped in
-            return recorder
-
-        handle = self._call("stop_recording", fn)
-        _wait_wall(handle, timeout)
-        out = handle.outcome
-        if out is None or not out.succeeded:
-            raise WorldClosedError(f"stop_recording failed: {out}")
-        recorder: FrameRecorder | None = out.value
-        if recorder is None:
-            frames = RecordedFrames()
-        else:
-            try:
-                frames = recorder.finish(max(0.0, deadline - time.monotonic()))
-            finally:  # if `finish` was interrupted (Ctrl-C), its thread runs on until close()
-                self._forget_recorder(recorder, abort=False)
-        if path is not None:
-            write_animation(path, frames, frames.fps)
-        return frames
-
-    # ------------------------------------------------------------------ fault injection
-    def take_item(
-        self, gripper: str | None = None, item: str | None = None, to: Sequence[float] | None = None
-    ) -> CommandHandle:
-        """Take an item away, as a person would: out of `gripper` (the item it holds) or `item` by name.
-
-        The item goes to `to` [m] or aside onto the floor beyond the environment. The gripper keeps
-        its command, so a closed gripper closes fully. Value: the item's name (None if nothing).
-        """
-        if gripper is not None:
-            self._check_gripper(gripper)
-        if item is not None:
-            self.scene.item(item)
-
-        def fn(eng: Engine) -> str | None:
-            name = item
-            if name is None and gripper is not None:
-                name = eng.grippers[gripper].holding
-            if name is None:
-                return None
-            eng.set_item_pose(name, cast(Vec3, tuple(to)) if to is not None else eng.aside_position(name))
-            return name
-
-        return self._call("take_item", fn)
-
-    def give_item(self, item: str, gripper: str, close: bool = True, timeout: float = 5.0) -> CommandHandle:
-        """Hand `item` into `gripper` (opened first if needed) and hold it there until it is grasped.
-
-        With `close` the person closes the gripper on the item; without, the robot must close
-        its gripper (e.g. a `setting_gripper` motion) within `timeout` [s of simulated time].
-        The command succeeds once the gripper holds the item and fails with "timeout" otherwise.
-        """
-        self.scene.item(item)
-        self._check_gripper(gripper)
-        arm = next(a for a, s in self.description.ARMS.items() if s["gripper"] == gripper)
-        return self.submit(GiveItem(item, gripper, arm, close, timeout), "give_item")
-
-    def move_item(
-        self, item: str, position: Sequence[float], orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)
-    ) -> CommandHandle:
-        """Put `item` at `position` [m] / `orientation` (w, x, y, z), releasing any grasp."""
-        self.scene.item(item)
-        return self._call("move_item", lambda eng: eng.set_item_pose(item, tuple(position), tuple(orientation)))
-
-    def place_obstacle(self, x: float, y: float) -> CommandHandle:
-        """Put a 0.3 x 0.3 x 1 m box on the floor centred at (x, y) [m]; value: its name."""
-
-        def fn(eng: Engine) -> str:
-            free = [n for n in eng.obstacles if n not in eng.obstacles_used]
-            if not free:
-                raise RuntimeError(f"all {len(eng.obstacles)} obstacles are in use")
-            name = free[0]
-            eng.obstacles_used.add(name)
-            eng.place_obstacle(name, x, y)
-            return name
-
-        return self._call("place_obstacle", fn)
-
-    def remove_obstacle(self, name: str) -> CommandHandle:
-        """Take the obstacle `name` away again."""
-
-        def fn(eng: Engine) -> None:
-            if name not in eng.obstacles:
-                raise UnknownNameError("obstacle", name, eng.obstacles)
-            eng.obstacles_used.discard(name)
-            eng.remove_obstacle(name, OBSTACLE_PARKING)
-
-        return self._call("remove_obstacle", fn)
-
-    def set_container_stuck(self, container: str, stuck: bool = True) -> CommandHandle:
-        """Fault: make the drawer or door `container` stuck where it is (or free it again).
-
-        A stuck container does not move however hard it is pulled (it is held by a constraint).
-        """
-        self.environment.container(container)
-
-        def fn(eng: Engine) -> None:
-            eng.furniture.set_stuck(eng.data, container, stuck)
-
-        return self._call("set_container_stuck", fn)
-
-    def push_container(
-        self, container: str, force: Sequence[float], duration: float, point: Sequence[float] | None = None
-    ) -> CommandHandle:
-        """A person's hand pushes or pulls `container` with `force` [N, map frame] for `duration`
-        [s of simulated time], at its handle (default) or at `point` [m, map frame] on it.
-
-        Value: the container's joint position at the end [m or rad]. The container moves only as
-        far as the force overcomes its friction; it keeps moving briefly (damped) afterwards.
-        """
-        self.environment.container(container)
-        return self.submit(ContainerPush(container, force, duration, point), f"push:{container}")
-
     # ------------------------------------------------------------------ conveniences
     def kitchen_base_pose(self, place: str) -> Pose2D:
         """The description's base pose in front of `place` ("cooker #1", "cooker #2")."""
@@ -833,13 +357,6 @@ class World:
 
     def __repr__(self) -> str:
         return f"<World {self.robot} t={self.sim_time.get_value():.2f}s {'running' if self.running else 'closed'}>"
-
-
-def _wait_wall(handle: CommandHandle, timeout: float) -> None:
-    """Wait for `handle` by wall time (for blocking conveniences that must not hang on sim time)."""
-    deadline = time.monotonic() + timeout
-    while not handle.done and time.monotonic() < deadline:
-        handle.wait(0.05)  # wakes on completion or after 0.05 s of the active clock
 
 
 __all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK"]

@@ -1,8 +1,9 @@
-"""The robot numbers location reasoning needs, read from a robot's description module.
+"""The robot numbers location reasoning needs, read from a robot's description.
 
 Location reasoning is robot-agnostic: it asks a `RobotGeometry` how big the base is, where each
 arm reaches comfortably, how the grasp phases are offset and how the arms are tucked away. Every
-number comes from the description module (``pycram.robots.<name>.description``): ``BASE``
+number comes from the robot's validated description (:class:`pycram.world.robot_description.RobotDescription`,
+from ``pycram.robots.<name>.description``): ``BASE``
 (``radius``: circumscribed, ``inscribed_radius``), ``ARMS``, ``ARM_ALIASES``, ``DEFAULT_ARM``,
 ``REACH_POINT_IN_BASE``, ``APPROACH_OFFSETS``, ``ARM_CONFIGURATIONS`` (``park``), optionally
 ``DOOR_PUSH``. Lengths in [m].
@@ -14,6 +15,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, cast
+
+from pycram.world.robot_description import RobotDescription
 
 __all__ = ["RobotGeometry"]
 
@@ -60,8 +63,8 @@ class RobotGeometry:
     top_grasp_clearance: float = 0.0
 
     @classmethod
-    def from_description(cls, d: Any) -> RobotGeometry:
-        """The geometry of the robot described by module `d` (see the module docstring)."""
+    def from_description(cls, d: RobotDescription) -> RobotGeometry:
+        """The geometry of the robot described by `d` (see the module docstring)."""
         tucked: dict[str, float] = {}
         for arm, spec in d.ARMS.items():
             park = d.ARM_CONFIGURATIONS[arm].get("park")
@@ -84,12 +87,12 @@ class RobotGeometry:
                 for a, s in d.ARMS.items()
                 if "carry" in d.ARM_CONFIGURATIONS[a]
             },
-            contact_margin=float(getattr(d, "GRASP_CONTACT_MARGIN", 0.0)),
-            torso_joint=getattr(d, "TORSO", {}).get("joint"),
-            torso_positions={k: float(v) for k, v in getattr(d, "TORSO_POSITIONS", {}).items()},
-            door_push=getattr(d, "DOOR_PUSH", None),
-            fingertip_reach=float(getattr(d, "FINGERTIP_REACH", 0.0)),
-            top_grasp_clearance=float(getattr(d, "TOP_GRASP_CLEARANCE", 0.0)),
+            contact_margin=float(d.GRASP_CONTACT_MARGIN),
+            torso_joint=d.TORSO.get("joint"),
+            torso_positions={k: float(v) for k, v in d.TORSO_POSITIONS.items()},
+            door_push=d.DOOR_PUSH,
+            fingertip_reach=float(d.FINGERTIP_REACH),
+            top_grasp_clearance=float(d.TOP_GRASP_CLEARANCE),
         )
 
     def top_grasp_height(self, bottom: float, wanted: float) -> float:

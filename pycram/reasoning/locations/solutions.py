@@ -19,7 +19,7 @@ class BaseLocation:
     `visible` the fraction of the target the head camera sees (``to_see``); `tool_poses` the
     validated tool poses of the sequence (position [m], orientation (w, x, y, z)), in order;
     `torso` the named torso position the solution needs (None: the torso as it is; the actions
-    carry objects with the torso up afterwards, `pycram.actions.manipulation.CARRY_TORSO`);
+    carry objects with the torso up afterwards, `pycram.actions.pick_up.CARRY_TORSO`);
     `push` the face of a door the hand pushes from there (``'inside'``/``'outside'``; None: not
     a push).
     """

@@ -2,13 +2,13 @@
 
 The same motion vocabulary and resolvers as the simulated robot of the same name (the plan does
 not know which backend runs it), with :mod:`pycram.backends.ros.modules` as process modules. The robot's
-numbers (joint configurations, torso heights, reaching offsets) come from its description in
-:mod:`pycram.robots`; the names of its ROS interfaces from :mod:`pycram.backends.ros.config`.
+numbers (joint configurations, torso heights, reaching offsets) come from its validated
+description (:func:`pycram.world.robot_registry.robot_description`); the names of its ROS
+interfaces from :mod:`pycram.backends.ros.config`.
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
 
 from pycram.backends.ros import modules as rm
@@ -25,6 +25,7 @@ from pycram.robots.common.sim_resolvers import (
 )
 from pycram.robots.common.sim_vocabulary import motion_types
 from pycram.world.belief import BeliefState
+from pycram.world.robot_registry import robot_description
 
 __all__ = ["RosRobot", "make_ros_robot"]
 
@@ -61,7 +62,7 @@ class RosRobot(Robot):
 def make_ros_robot(
     name: str, transport: Transport | None = None, config: RosRobotConfig | None = None, wait_for_state: float = 10.0
 ) -> RosRobot:
-    """The robot ``name`` (``'pr2'``, ``'tiago'``) over ROS, modules online.
+    """The robot ``name`` (a registered robot with a ROS configuration) over ROS, modules online.
 
     ``transport`` defaults to the process's ROS 1 transport (node initialised on first use),
     ``config`` to the robot's default ROS configuration. Waits at most ``wait_for_state`` [s,
@@ -75,7 +76,7 @@ def make_ros_robot(
         from pycram.backends.ros.ros1 import ros1_transport
 
         transport = ros1_transport()
-    description = importlib.import_module(f"pycram.robots.{name}.description")
+    description = robot_description(name)
     state = rm.RosRobotState(transport, config)
     if not state.wait_ready(wait_for_state):
         state.close()

@@ -32,6 +32,13 @@ from typing import Any
 
 from pycram.core.fluent import Fluent
 from pycram.execution.failures import MotionFailure, NavigationFailure
+from pycram.execution.module_support import (
+    cancel_running_handle,
+    check_command,
+    format_pose2d,
+    format_values,
+    seen_objects,
+)
 from pycram.execution.process_module import ProcessModule, ProcessModuleStatus
 from pycram.execution.robot import Robot
 
@@ -80,19 +87,6 @@ class NavigationFailed(SimMotionFailed, NavigationFailure):
     """The base found no collision-free path to its goal (``reason`` ``'no_path'``); a
     :class:`pycram.world.navigation.NavigationFailure`, so plans can catch it without knowing
     the backend. The message says why (goal in collision, no connection, off the map)."""
-
-
-def _fmt(values: Any) -> str:
-    try:
-        return "(" + ", ".join(f"{float(v):.3f}" for v in values) + ")"
-    except TypeError:
-        return repr(values)
-
-
-def _fmt_pose2d(pose: Any) -> str:
-    if pose is None:
-        return "?"
-    return f"(x={pose.x:.3f}, y={pose.y:.3f}, yaw={pose.yaw:.3f})"
 
 
 class SimProcessModule(ProcessModule):
@@ -144,20 +138,6 @@ class SimProcessModule(ProcessModule):
         cancel_running_handle(self, designator)
 
 
-def cancel_running_handle(module: Any, designator: Any) -> None:
-    """The cancel hook of a module that keeps its running command's handle in ``module._handle``
-    (a simulator command, a ROS goal: anything with ``name``, ``done`` and ``cancel()``): cancel
-    it -- unless ``designator`` was evaporated while still queued, when the running command
-    belongs to another caller."""
-    current = module.current
-    if current is None or current.designator is not designator:
-        return
-    handle, module._handle = module._handle, None
-    if handle is not None and not handle.done:
-        logger.info("%s: cancelling %s", module.name, handle.name)
-        handle.cancel()
-
-
 class NavigationModule(SimProcessModule):
     """Drives the base (``'cmd': 'navigate'`` with ``'pose'``: a ``Pose2D`` in the map frame)
     along a collision-free path around the environment and obstacles, re-planning when the
@@ -174,15 +154,15 @@ class NavigationModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "navigate")
+        check_command(self, solution, "navigate")
         pose = solution["pose"]
         distance = math.hypot(pose.x - self.world.base_pose.get_value().x, pose.y - self.world.base_pose.get_value().y)
         try:
             return self._run_command(
                 lambda: self.world.move_base(pose),
-                f"drive to {_fmt_pose2d(pose)}",
+                f"drive to {format_pose2d(pose)}",
                 timeout=30.0 + 4.0 * distance,
-                describe_failure=lambda out: f"(stopped at {_fmt_pose2d(out.value)})",
+                describe_failure=lambda out: f"(stopped at {format_pose2d(out.value)})",
             )
         except SimMotionFailed as exc:
             if exc.reason != "no_path":
@@ -204,7 +184,7 @@ class BaseStopModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "stop_base")
+        check_command(self, solution, "stop_base")
         execution = self.navigation.current
         if execution is not None:
             execution.cancel()  # a non-waited drive: evaporates its task (cancel hook stops it)
@@ -230,12 +210,14 @@ class HeadModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "point_head")
+        check_command(self, solution, "point_head")
         point = tuple(float(v) for v in solution["point"])
         if solution.get("track"):
             self.world.track_point(point)
             return None
-        return self._run_command(lambda: self.world.point_head(point), f"point the head at {_fmt(point)}", timeout=10.0)
+        return self._run_command(
+            lambda: self.world.point_head(point), f"point the head at {format_values(point)}", timeout=10.0
+        )
 
 
 class TorsoModule(SimProcessModule):
@@ -246,7 +228,7 @@ class TorsoModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "set_torso")
+        check_command(self, solution, "set_torso")
         height = float(solution["height"])
         return self._run_command(lambda: self.world.set_torso(height), f"set the torso to {height:.3f} m", timeout=20.0)
 
@@ -269,7 +251,7 @@ class ArmModule(SimProcessModule):
         cmd = solution.get("cmd")
         if cmd == "move_arm":
             positions = tuple(float(v) for v in solution["positions"])
-            what = solution.get("configuration") or _fmt(positions)
+            what = solution.get("configuration") or format_values(positions)
             return self._run_command(
                 lambda: self.world.move_arm(self.arm, positions), f"move the {self.arm} arm to {what}", timeout=30.0
             )
@@ -277,8 +259,8 @@ class ArmModule(SimProcessModule):
             position = tuple(float(v) for v in solution["position"])
             orientation = solution.get("orientation")
             phase = solution.get("phase")
-            what = f"reach with the {self.arm} arm to {_fmt(position)}" + (
-                f" ({phase} of {_fmt(solution['target'])})" if phase else ""
+            what = f"reach with the {self.arm} arm to {format_values(position)}" + (
+                f" ({phase} of {format_values(solution['target'])})" if phase else ""
             )
             return self._run_command(
                 lambda: self.world.reach(
@@ -287,7 +269,7 @@ class ArmModule(SimProcessModule):
                 what,
                 timeout=30.0,
             )
-        _check_cmd(self, solution, "move_arm", "reach")
+        check_command(self, solution, "move_arm", "reach")
 
 
 class GripperModule(SimProcessModule):
@@ -300,7 +282,7 @@ class GripperModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "set_gripper")
+        check_command(self, solution, "set_gripper")
         opening = float(solution["opening"])
         effort = solution.get("effort")
         return self._run_command(
@@ -350,7 +332,7 @@ class SensorModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "subscribe")
+        check_command(self, solution, "subscribe")
         target = solution["fl"]
         if not isinstance(target, Fluent):
             raise TypeError(f"'fl' must be a Fluent, got {target!r}")
@@ -389,34 +371,10 @@ class PerceptionModule(SimProcessModule):
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
-        _check_cmd(self, solution, "perceive")
+        check_command(self, solution, "perceive")
         report = self._run_command(self.world.detect, "detect objects", timeout=10.0)
         update = self.last_update = self.belief.update(report)
         return seen_objects(update, solution.get("object"), report.stamp)
-
-
-def seen_objects(update: Any, wanted: Any, stamp: float) -> list[Any]:
-    """What a ``detecting`` motion returns, on every backend: the believed objects seen in one
-    look (``update``, a :class:`pycram.world.belief.BeliefUpdate`), most visible first,
-    restricted by ``wanted`` when given -- a type or belief name, or an object designator, whose
-    best match is then recorded with ``designator.perceived(obj, timestamp=stamp)`` (``stamp``
-    [s]: the look's time)."""
-    from pycram.designators.object import ObjectDesignator
-
-    seen = sorted(update.seen, key=lambda o: -int(o.properties.get("pixels", 0)))
-    if wanted is None:
-        return seen
-    if isinstance(wanted, ObjectDesignator):
-        matching = [obj for obj in seen if wanted.matches(obj)]
-        if matching:
-            wanted.perceived(matching[0], timestamp=stamp)
-        return matching
-    return [obj for obj in seen if wanted in (obj.name, obj.type)]
-
-
-def _check_cmd(module: ProcessModule, solution: Any, *expected: str) -> None:
-    if not isinstance(solution, dict) or solution.get("cmd") not in expected:
-        raise ValueError(f"{module.name} executes commands {list(expected)}, got solution {solution!r}")
 
 
 def shutdown_modules(robot: Robot) -> None:

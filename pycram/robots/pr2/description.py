@@ -1,7 +1,10 @@
 """PR2 description: names and numbers of the PR2 as used by the simulated world and process modules.
 
 Pure data, no imports: every constant here can be read by resolvers and process modules without
-loading a simulator. Angles in [rad], lengths in [m], velocities in [m/s] / [rad/s], forces in [N].
+loading a simulator. The UPPERCASE names are the keys of
+:class:`pycram.world.robot_description.RobotDescription` (which validates them; read them through
+``pycram.world.robot_registry.robot_description("pr2")``); ``_``-names are helpers. Angles in
+[rad], lengths in [m], velocities in [m/s] / [rad/s], forces in [N].
 The model is `example-robot-data`'s PR2 URDF (loaded from the installed package, never copied).
 """
 
@@ -34,7 +37,7 @@ HEAD = {
     "resolution": (320, 240),  # [px] width, height
 }
 
-ARM_JOINT_SUFFIXES = (
+_ARM_JOINT_SUFFIXES = (
     "shoulder_pan_joint",
     "shoulder_lift_joint",
     "upper_arm_roll_joint",
@@ -48,12 +51,12 @@ ARM_JOINT_SUFFIXES = (
 #: direction, y: finger opening direction) and the gripper mounted on it.
 ARMS = {
     "right": {
-        "joints": tuple("r_" + s for s in ARM_JOINT_SUFFIXES),
+        "joints": tuple("r_" + s for s in _ARM_JOINT_SUFFIXES),
         "tool_link": "r_gripper_tool_frame",
         "gripper": "right",
     },
     "left": {
-        "joints": tuple("l_" + s for s in ARM_JOINT_SUFFIXES),
+        "joints": tuple("l_" + s for s in _ARM_JOINT_SUFFIXES),
         "tool_link": "l_gripper_tool_frame",
         "gripper": "left",
     },
@@ -175,3 +178,35 @@ DOOR_PUSH = {"outside": {"heading": -1.5708, "offset": (0.0, 0.01), "gripper": 1
 FINGERTIP_REACH = 0.015
 #: Clearance [m] of the finger tips above the supporting surface in a top grasp.
 TOP_GRASP_CLEARANCE = 0.003
+
+
+# --- ROS interface: names read by `pycram.backends.ros.config` ---------------------------------------
+
+#: The real PR2's ROS interface names (thesis ch. 4.1, ``control.py``): the keyword arguments of
+#: `pycram.backends.ros.config.RosRobotConfig` (arms and grippers as mappings of their fields);
+#: the fields not given keep that class's defaults. The PR2 publishes each gripper's gap as one
+#: joint (``r_gripper_joint``).
+ROS = {
+    "arms": {
+        "right": {
+            "trajectory_action": "/r_arm_controller/follow_joint_trajectory",
+            "joint_names": ARMS["right"]["joints"],
+            "reach_action": "/r_arm_reach",
+        },
+        "left": {
+            "trajectory_action": "/l_arm_controller/follow_joint_trajectory",
+            "joint_names": ARMS["left"]["joints"],
+            "reach_action": "/l_arm_reach",
+        },
+    },
+    "grippers": {
+        "right": {"action": "/r_gripper_controller/gripper_action", "opening_joints": ("r_gripper_joint",)},
+        "left": {"action": "/l_gripper_controller/gripper_action", "opening_joints": ("l_gripper_joint",)},
+    },
+    "head_action": "/head_traj_controller/point_head_action",
+    "head_pointing_frame": "high_def_frame",
+    "head_pointing_axis": (1.0, 0.0, 0.0),
+    "torso_action": "/torso_controller/position_joint_action",
+    "torso_joint": "torso_lift_joint",
+    "torso_interface": "single_joint_position",
+}

@@ -2,7 +2,8 @@
 
 Two arms and two grippers, each with its own process module (the thesis' ``Pr2ArmL`` /
 ``Pr2ArmR``); requests name them ``'left'`` / ``'right'`` (or the thesis' ``'0'`` / ``'1'``).
-All numbers come from :mod:`pycram.robots.pr2.description`.
+All numbers come from :mod:`pycram.robots.pr2.description`
+(validated by the robot registry).
 
 Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``, ``head``,
 ``torso``, ``arm_left``, ``arm_right``, ``gripper_left``, ``gripper_right``, ``sensors``,
@@ -22,9 +23,12 @@ from pycram.robots.common.sim_resolvers import (
     physical_gripper,
 )
 from pycram.robots.common.sim_vocabulary import motion_types
-from pycram.robots.pr2 import description
+from pycram.world.robot_registry import robot_description
 
 __all__ = ["make_robot"]
+
+#: The validated description (the registry's, shared with the simulated world).
+description = robot_description("pr2")
 
 
 def make_robot(world: Any) -> sm.SimRobot:

@@ -1,6 +1,9 @@
 """TIAGo description (one 7-DoF arm): names and numbers used by the simulated world and process modules.
 
-Pure data, no imports. Angles in [rad], lengths in [m], velocities in [m/s] / [rad/s], forces in [N].
+Pure data, no imports; the UPPERCASE names are the keys of
+:class:`pycram.world.robot_description.RobotDescription` (read them through
+``pycram.world.robot_registry.robot_description("tiago")``). Angles in [rad], lengths in [m],
+velocities in [m/s] / [rad/s], forces in [N].
 The model is `example-robot-data`'s `tiago_no_hand.urdf` (loaded from the installed package) plus
 a simple two-finger parallel gripper of our own on `arm_tool_link`, described in `GRIPPER_MODEL`,
 so that its opening is measured like the PR2's.
@@ -156,3 +159,32 @@ GRASP_CONTACT_MARGIN = 0.005
 FINGERTIP_REACH = 0.04
 #: Clearance [m] of the finger tips above the supporting surface in a top grasp.
 TOP_GRASP_CLEARANCE = 0.003
+
+
+# --- ROS interface: names read by `pycram.backends.ros.config` ---------------------------------------
+
+#: TIAGo's ROS interface names: the keyword arguments of
+#: `pycram.backends.ros.config.RosRobotConfig` (arms and grippers as mappings of their fields);
+#: the fields not given keep that class's defaults. Its gripper's opening is the sum of its two
+#: fingers' positions.
+ROS = {
+    "arms": {
+        "right": {
+            "trajectory_action": "/arm_controller/follow_joint_trajectory",
+            "joint_names": ARMS["right"]["joints"],
+            "reach_action": "/arm_reach",
+        },
+    },
+    "grippers": {
+        "right": {
+            "action": "/gripper_controller/gripper_action",
+            "opening_joints": ("gripper_left_finger_joint", "gripper_right_finger_joint"),
+        },
+    },
+    "head_action": "/head_controller/point_head_action",
+    "head_pointing_frame": "xtion_rgb_optical_frame",
+    "head_pointing_axis": (0.0, 0.0, 1.0),
+    "torso_action": "/torso_controller/follow_joint_trajectory",
+    "torso_joint": "torso_lift_joint",
+    "torso_interface": "joint_trajectory",
+}

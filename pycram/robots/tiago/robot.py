@@ -4,7 +4,7 @@ One arm and one gripper (physically named ``'right'`` in the description). Like 
 robot of the thesis' ch. 4.2.2 discussion, its only arm module serves requests for either arm
 (``'left'``, ``'right'``, ``'0'``, ``'1'``) and its only gripper module requests for either
 gripper, so a plan written for the two-armed PR2 runs unchanged. All numbers come from
-:mod:`pycram.robots.tiago.description`.
+:mod:`pycram.robots.tiago.description` (validated by the robot registry).
 
 Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``, ``head``,
 ``torso``, ``arm_right``, ``gripper_right``, ``sensors``, ``perception``.
@@ -23,9 +23,12 @@ from pycram.robots.common.sim_resolvers import (
     physical_gripper,
 )
 from pycram.robots.common.sim_vocabulary import motion_types
-from pycram.robots.tiago import description
+from pycram.world.robot_registry import robot_description
 
 __all__ = ["make_robot"]
+
+#: The validated description (the registry's, shared with the simulated world).
+description = robot_description("tiago")
 
 
 def make_robot(world: Any) -> sm.SimRobot:

@@ -1,0 +1,118 @@
+"""`pycram demo`: the thesis demo or another scenario, headless, with pictures and the trace."""
+
+from __future__ import annotations
+
+import typer
+
+from pycram.apps.cli.app import (
+    ROBOT_HELP,
+    DbOption,
+    app,
+    check_output_folder,
+    fail,
+    record_flag,
+    trace_errors,
+)
+from pycram.world.robot_registry import DEFAULT_ROBOT
+
+#: `--steal` above this is refused: the plan gives up long before (it retries a few times).
+_MAX_STEALS = 100
+
+
+@app.command("demo")
+def demo_command(
+    robot: str = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP),
+    output: str | None = typer.Option(
+        None,
+        "--output",
+        "-o",
+        help="Folder for pictures (default: the run's "
+        "own, output/demo-ROBOT-RUNID, or output/demo-ROBOT-DATE-TIME when not recorded).",
+    ),
+    item_at: int = typer.Option(
+        1, "--item-at", min=0, max=3, help="Where the item starts: position 1, 2 or 3 (0: no item)."
+    ),
+    steal: int = typer.Option(
+        0,
+        "--steal",
+        min=0,
+        max=_MAX_STEALS,
+        help="How many times the item is taken from the gripper while the robot carries it.",
+    ),
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed (a non-negative integer)."),
+    realtime: bool = typer.Option(False, "--realtime", help="Run at real-time speed instead of as fast as possible."),
+    interactive: bool = typer.Option(False, "--interactive", help="Ask the operator in the terminal."),
+    record: bool | None = typer.Option(
+        None, "--record/--no-record", help="Record the run in the trace database [default: on, or $PYCRAM_RECORD]."
+    ),
+    db: str | None = DbOption,
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No live progress line."),
+    animation: bool = typer.Option(
+        True, "--animation/--no-animation", help="Record the animation run.gif (--no-animation: a faster run)."
+    ),
+    backend: str = typer.Option(
+        "sim",
+        "--backend",
+        help="sim: process modules drive the simulator in-process; ros: over ROS 1 "
+        "(starts roscore and sim-ros-bridge on 127.0.0.1 unless ROS_MASTER_URI is set).",
+    ),
+    scenario: str = typer.Option(
+        "thesis",
+        "--scenario",
+        help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the "
+        "apartment (objects on counters and in a closed drawer); set-table-open: the same, every object "
+        "starting on an open surface.",
+    ),
+    faults: str = typer.Option(
+        "",
+        "--faults",
+        help="set-table only: comma-separated faults drawn from the seed: moved, taken, stuck, obstacle, missed.",
+    ),
+) -> None:
+    """The thesis demo (fetch and place in the simulated kitchen, with recovery from failures),
+    or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
+    if output is not None:
+        check_output_folder(output)
+    scenarios = ("thesis", "set-table", "set-table-open")  # pycram.apps.scenarios.set_table.SCENARIOS (imported lazily)
+    if scenario not in scenarios:
+        fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
+    if scenario.startswith("set-table"):
+        from pycram.apps.scenarios.set_table import main as set_table_main
+
+        code = trace_errors(
+            set_table_main,
+            robot=robot,
+            seed=seed,
+            faults=faults,
+            output=output,
+            db=db,
+            record=record_flag(record),
+            quiet=quiet,
+            animation=animation,
+            in_containers=scenario != "set-table-open",
+        )
+        raise typer.Exit(int(code or 0))
+    if faults:
+        fail("--faults applies to --scenario set-table only (the thesis demo has --steal)", code=2)
+    try:
+        from pycram.apps.demos.kitchen import main as demo_main
+    except ModuleNotFoundError as e:
+        if e.name and e.name.startswith("pycram.apps.demos"):
+            fail("the kitchen demo (pycram.apps.demos.kitchen) is not available in this installation")
+        fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
+    code = trace_errors(
+        demo_main,
+        robot=robot,
+        output=output,
+        item_at=item_at,
+        steal=steal,
+        seed=seed,
+        realtime=realtime,
+        interactive=interactive,
+        db=db,
+        record=record_flag(record),
+        quiet=quiet,
+        animation=animation,
+        backend=backend,
+    )
+    raise typer.Exit(int(code or 0))

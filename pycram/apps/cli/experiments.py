@@ -1,0 +1,184 @@
+"""`pycram experiment`: many runs of a scenario, in parallel, with a report."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import typer
+from rich.markup import escape
+
+from pycram.apps.cli.app import (
+    DbOption,
+    app,
+    check_output_folder,
+    console,
+    err,
+    fail,
+    trace_errors,
+    write_errors,
+)
+from pycram.world.robot_registry import DEFAULT_ROBOT, robot_names
+
+
+@app.command("experiment")
+def experiment_command(
+    scenario: str | None = typer.Option(
+        None,
+        "--scenario",
+        help="Scenario: thesis (default), set-table, set-table-open, or an import path package.module:function.",
+    ),
+    robot: str | None = typer.Option(
+        None,
+        "--robot",
+        help=f"Robots, comma-separated: {','.join(robot_names())} [default: {DEFAULT_ROBOT}].",
+    ),
+    seeds: str | None = typer.Option(None, "--seeds", help="Seeds: a range 1-200, a list 1,5,9 or both (1,5,10-20)."),
+    faults: list[str] | None = typer.Option(
+        None,
+        "--faults",
+        help="A variant: comma-separated faults ('none': no faults, 'all': every fault of the scenario). "
+        "Repeat for several variants, e.g. --faults none --faults all [default: none].",
+    ),
+    workers: int = typer.Option(2, "--workers", "-j", help="Worker processes (with --ray local: Ray's CPUs)."),
+    ray: str | None = typer.Option(
+        None,
+        "--ray",
+        help="Run on Ray: a cluster address (auto, HOST:PORT, ray://HOST:10001) or 'local' to start one here.",
+        metavar="ADDRESS",
+    ),
+    name: str | None = typer.Option(
+        None, "--name", help="Name of the experiment (default: SCENARIO-DATE-TIME); an existing name resumes it."
+    ),
+    resume: str | None = typer.Option(
+        None,
+        "--resume",
+        help="Resume the experiment with this id or name: run only the seeds not finished.",
+        metavar="ID",
+    ),
+    output: Path | None = typer.Option(
+        None, "--output", "-o", help="Folder for the plot and summary (default: output/experiment-NAME)."
+    ),
+    db: str | None = DbOption,
+) -> None:
+    """Run a scenario over many robots, seeds and faults in parallel; report success and times.
+
+    Each run is headless and recorded in the trace database; at the end a table shows the
+    success rate per robot and variant, the failure causes and the simulated and wall time
+    (p50/p95), and a plot is written.
+
+    Ctrl-C stops it: the runs under way finish and are recorded (a second Ctrl-C exits at once);
+    `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when
+    runs were lost (a worker died) or raised an error (a resume runs them again), 2 for bad options.
+    """
+    import contextlib
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        from pycram.apps.experiments.runner import ExperimentInputError, RayUnavailable, prepare_experiment, ray_session
+    except ImportError as e:
+        fail(f"experiments need the 'db' extra (pip install 'pycram[all]'): {e}")
+    if workers < 1:
+        fail(f"--workers must be at least 1, not {workers}", code=2)
+    if output is not None:
+        check_output_folder(str(output))
+    options = dict(scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db)
+    with contextlib.ExitStack() as session:
+        try:
+            if ray is not None:  # check the input, then connect (before an experiment is created)
+                trace_errors(prepare_experiment, check_only=True, **options)
+                session.enter_context(ray_session(ray, workers))
+            prepared = trace_errors(prepare_experiment, command=" ".join(["pycram", *sys.argv[1:]]), **options)
+        except ExperimentInputError as e:
+            fail(str(e), code=2)
+        except RayUnavailable as e:
+            fail(str(e))
+        _run_experiment(prepared, workers, ray, output, db)
+
+
+def _run_experiment(prepared: Any, workers: int, ray: str | None, output: Path | None, db: str | None) -> None:
+    """`pycram experiment` once its input is checked: run with a progress bar, then report."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from pycram.apps.experiments import report, store
+    from pycram.apps.experiments.runner import ExperimentInputError, RayUnavailable, run_experiment
+    from pycram.core.interrupts import StopSignals
+
+    record = prepared.record
+    where = f"Ray ({ray})" if ray else f"{workers} worker processes"
+    total = len(record.keys())
+    verb = "resuming" if prepared.resumed else "experiment"
+    err.print(
+        f"{verb} {record.id} ({escape(record.name)}): scenario {escape(record.scenario)}, "
+        f"robots {escape(','.join(record.robots))}, {len(record.seeds)} seeds, "
+        f"{len(record.variants)} variant(s): {total} runs, {prepared.done_before} recorded before, "
+        f"{len(prepared.todo)} to run on {where}"
+    )
+    counts = {"ok": 0, "failed": 0}
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=err,
+        transient=False,
+    ) as bar:
+        job = bar.add_task("runs", total=len(prepared.todo))
+
+        def progress(key: tuple[str, int, str], result: dict[str, Any] | None) -> None:
+            if result is not None:
+                counts["ok" if result.get("success") else "failed"] += 1
+            bar.update(
+                job,
+                advance=1 if result is not None else 0,
+                description=f"succeeded {counts['ok']}, failed {counts['failed']} · last: {key[0]} seed {key[1]}",
+            )
+
+        with StopSignals() as stop:
+            try:
+                outcome = trace_errors(run_experiment, prepared, workers=workers, ray=ray, stop=stop, progress=progress)
+            except RayUnavailable as e:
+                fail(str(e))
+            except ExperimentInputError as e:
+                fail(str(e), code=2)
+    runs = trace_errors(store.run_records, db, record.id)
+    groups = report.summarize(runs)
+    title = f"experiment {record.id} ({record.name}): {record.scenario}, {len(runs)} of {total} runs"
+    console.print(report.summary_table(groups, title=escape(title)))
+    console.print(report.causes_table(groups))
+    folder = output if output is not None else Path("output") / f"experiment-{record.name}"
+    if groups:
+        plot = write_errors(report.write_plot, groups, folder / "experiment.png", title)
+        console.print(f"wrote {escape(str(plot))}")
+    console.print(
+        f"{outcome.recorded} runs in {outcome.wall_time:.1f} s "
+        f"({60.0 * outcome.recorded / outcome.wall_time if outcome.wall_time > 0 else 0.0:.1f} runs/min); "
+        f"see `pycram runs` for their traces"
+        + ("" if outcome.traced else " (not traced: SQLite is not reachable from the Ray workers)")
+    )
+    if outcome.errors:
+        err.print(f"[red]{len(outcome.errors)} runs were lost:[/red] " + escape("; ".join(outcome.errors[:5])))
+    raised = [r for r in runs if r.status == "error"]
+    if raised:
+        err.print(
+            f"[red]{len(raised)} runs raised an error[/red] (e.g. {escape(raised[0].robot)} seed {raised[0].seed}: "
+            f"{escape(raised[0].error or '')}); `pycram experiment --resume {record.id}` runs them again"
+        )
+    left = total - len(runs)
+    if outcome.interrupted or left:
+        err.print(
+            f"[yellow]{'stopped: ' if outcome.interrupted else ''}{left} runs not finished; "
+            f"resume with `pycram experiment --resume {record.id}`[/yellow]"
+        )
+        raise typer.Exit(stop.exit_code if outcome.interrupted and stop.signum else 1)
+    raise typer.Exit(1 if raised or outcome.errors else 0)

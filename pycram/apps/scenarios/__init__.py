@@ -1,0 +1,9 @@
+"""The scenarios of `pycram demo` and `pycram experiment`, one package per scenario.
+
+Each scenario is split by concept: its data (objects, regions, thresholds), its scene (where the
+objects start), its faults (the simulated world misbehaving), its judge (success from the
+simulator's truth), its driver (running the plan under time limits) and, for `pycram demo`, its
+terminal display; the plan itself is a module of its own that knows nothing of the simulator.
+
+- `pycram.apps.scenarios.set_table`: setting the breakfast table in the apartment (issue 17).
+"""

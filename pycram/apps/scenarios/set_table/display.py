@@ -1,0 +1,131 @@
+"""`pycram demo --scenario set-table` in the terminal: the scenario run with a live progress
+line, then the task tree, each object placed or missing and why, the faults injected and the
+pictures written.
+
+`main` returns the exit code: 0 only when every object is at its place setting and every drawer
+closed; 2 for bad options; else 1.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from pycram.apps.scenarios.set_table.data import OBJECTS
+from pycram.apps.scenarios.set_table.driver import _check, run_scenario
+from pycram.apps.scenarios.set_table.judge import SetTableResult
+from pycram.world.robot_registry import DEFAULT_ROBOT
+
+__all__ = [
+    "main",
+]
+
+
+def _output_folder(robot: str, seed: int, run_id: Any) -> Path:
+    stem = f"set-table-{robot}-{seed}"
+    return Path("output") / (f"{stem}-{run_id}" if run_id is not None else f"{stem}-{time.strftime('%Y%m%d-%H%M%S')}")
+
+
+def main(
+    robot: str = DEFAULT_ROBOT,
+    seed: int = 0,
+    faults: str | frozenset[str] = "",
+    output: str | None = None,
+    db: str | None = None,
+    record: bool = True,
+    quiet: bool = False,
+    animation: bool = True,
+    in_containers: bool = True,
+) -> int:
+    """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
+    tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
+    the task-tree SVG and the timeline of the recorded run. Returns the exit code: 0 only when
+    every object is at its place setting and every drawer closed; 2 for bad options; else 1."""
+    import os
+    from types import SimpleNamespace
+
+    from rich.console import Console
+    from rich.live import Live
+
+    from pycram.apps.demos.kitchen import _log_to_terminal, _stderr_console, _task_tree_display, _write_run_pictures
+    from pycram.apps.scenarios.set_table.plan import current_object, objects_done
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    console = Console()
+    try:
+        kinds = _check(robot, seed, faults)
+    except ValueError as error:
+        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
+        return 2
+    if not quiet:
+        _log_to_terminal()
+    recorder = None
+    if record:
+        from pycram.trace import start_recording
+
+        recorder = start_recording(url=db, plan=f"set table ({robot}, seed {seed})")
+    run_id = recorder.run_id if recorder is not None else None
+    folder = Path(output) if output else _output_folder(robot, seed, run_id)
+    live = None if quiet else Live("", console=_stderr_console(), refresh_per_second=4, transient=False)
+
+    def progress(world: Any, plan: Any, injector: Any) -> None:
+        if live is None:
+            return
+        current = current_object.get_value()
+        live.update(
+            f"objects done: {objects_done.get_value()}/{len(OBJECTS)}  "
+            f"{'bringing the ' + current if current else 'between objects':<22}  "
+            f"faults: {len(injector.injected)}  sim {world.sim_time.get_value():6.1f} s"
+        )
+
+    result: SetTableResult | None = None
+    task = None
+    try:
+        if live is not None:
+            live.start()
+        result, task = run_scenario(
+            robot,
+            seed,
+            kinds,
+            recorder=recorder,
+            output=folder,
+            animation=animation,
+            progress=progress,
+            in_containers=in_containers,
+        )
+    finally:
+        if live is not None:
+            live.stop()
+        if recorder is not None:
+            ok = result is not None and result.success
+            run_id = recorder.finish(
+                "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
+            )
+    view = SimpleNamespace(plan_task=task, run_id=run_id, output=folder, tree_text="")
+    files = [folder / n for n in ("start.png", "end.png", "run.gif") if (folder / n).exists()]
+    if recorder is not None:
+        files += _write_run_pictures(view, recorder)  # type: ignore[arg-type]
+    console.print()
+    console.print(_task_tree_display(view, db))  # type: ignore[arg-type]
+    assert result is not None
+    console.print(
+        f"\nthe plan simulated {result.sim_time:.1f} s; the whole run took {result.wall_time:.1f} s of wall time"
+    )
+    for name, obj in result.objects.items():
+        mark = (
+            "[green]placed[/green]"
+            if obj.placed
+            else f"[red]missing[/red] ({obj.failure or 'not at its place'}: {obj.reason})"
+        )
+        console.print(f"  {name}: {mark}", highlight=False)
+    if result.faults_injected:
+        console.print("faults: " + "; ".join(result.faults_injected), highlight=False)
+    console.print(f"pictures in {folder.resolve()}: " + ", ".join(p.name for p in files))
+    if run_id is not None:
+        console.print(f"recorded as run {run_id} (see `pycram show {run_id}`)")
+    if result.success:
+        console.print("[bold green]SUCCESS[/bold green]: the table is set, every drawer closed")
+        return 0
+    console.print(f"[bold red]FAILURE[/bold red]: {result.summary()}", highlight=False)
+    return 1

@@ -1,0 +1,263 @@
+"""Running the set-table scenario: the world from a seed, the plan in a thread of its own under
+time limits, the faults alongside, then the judge.
+
+`open_world` builds the simulated apartment with the objects of `start_scene` and the robot at
+the start pose; `run_scenario` runs the plan (`plan.set_table`) once, with the faults of
+`FAULTS`, within `SIM_TIME_LIMIT` [s of simulated time] and `WALL_TIME_LIMIT` [s of wall time],
+and judges the outcome with the simulator's truth (`judge`); it never raises for a failure of
+the plan. `run_set_table` and `run_set_table_on_open_surfaces` are the ``set-table`` and
+``set-table-open`` scenarios of `pycram experiment` (headless, JSON-serialisable results).
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from pycram.apps.scenarios.set_table.data import MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
+from pycram.apps.scenarios.set_table.faults import Faults, check_faults
+from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
+from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
+from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
+
+__all__ = [
+    "open_world",
+    "run_scenario",
+    "run_set_table",
+    "run_set_table_on_open_surfaces",
+]
+
+log = logging.getLogger("pycram.demo")
+
+
+class _PlanThread:
+    """The plan in a thread of its own (a task tree root), so the driver can watch time limits."""
+
+    def __init__(self, robot: Any, settings: list[PlaceSetting]) -> None:
+        self.robot, self.settings = robot, settings
+        self.record = PlanRecord()
+        self.task: Any = None
+        self.error: BaseException | None = None
+        self.outcomes: list[SettingOutcome] | None = None
+        self._thread = threading.Thread(target=self._run, name="pycram-set-table", daemon=True)
+
+    def _run(self) -> None:
+        from pycram.apps.scenarios.set_table.plan import set_table
+        from pycram.core.runtime import current_task, end_thread_root, run_subtask
+
+        def whole_plan() -> Any:
+            self.task = current_task()
+            with self.robot:
+                self.outcomes = set_table(self.settings, self.record)
+
+        try:
+            run_subtask("set_table", whole_plan, kind="plan")
+        except BaseException as error:  # evaporated (time limit) or a bug
+            self.error = error
+        finally:
+            end_thread_root(self.error)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def join(self, timeout: float) -> bool:
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def stop(self, timeout: float = 30.0) -> None:
+        if self.task is not None:
+            self.task.evaporate()
+        self._thread.join(timeout)
+
+
+def open_world(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = True,
+) -> tuple[Any, list[Any]]:
+    """The apartment with the scenario's objects at random spots from `seed` (`start_scene`,
+    some inside closed containers with `in_containers`) and `robot` at the start pose
+    (perception misses detections with the ``missed`` fault). Returns the world and the
+    placements."""
+    from pycram.backends.sim import ItemSpec, World
+    from pycram.backends.sim.perception import PerceptionFaults
+    from pycram.environments import load as load_environment
+    from pycram.world.objects import object_type
+
+    placements = start_scene(load_environment("apartment"), seed, objects, in_containers)
+    items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
+    perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
+    world = World(robot, items, environment="apartment", perception_faults=perception)
+    return world, placements
+
+
+def _check(robot: str, seed: int, faults: Any) -> frozenset[str]:
+    from pycram.robots import ROBOT_NAMES
+
+    if robot not in ROBOT_NAMES:
+        raise ValueError(f"unknown robot {robot!r}; valid robots: {', '.join(ROBOT_NAMES)}")
+    if not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"the seed must be an integer >= 0, not {seed!r}")
+    return check_faults(faults)
+
+
+def run_scenario(
+    robot: str,
+    seed: int,
+    faults: Any = frozenset(),
+    *,
+    recorder: Any = None,
+    output: Path | None = None,
+    animation: bool = False,
+    progress: Any = None,
+    objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = True,
+) -> tuple[SetTableResult, Any]:
+    """Run the set-table scenario once; never raises for failures of the plan (they are in the
+    result). With `output`, start.png and end.png are written there (and run.gif with
+    `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
+    faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
+    objects may start inside closed containers (`start_scene`). Returns the
+    result and the plan's task (the root of its task tree, None if it never started)."""
+    from pycram import robots as robot_packages
+
+    kinds = _check(robot, seed, faults)
+    started_wall = time.monotonic()
+    result = SetTableResult(robot, seed, kinds)
+    world, placements = open_world(robot, seed, kinds, objects, in_containers)
+    result.started_in = {p.name: p.container for p in placements if p.container is not None}
+    plan: _PlanThread | None = None
+    injector: Faults | None = None
+    robot_handle = None
+    try:
+        settings = place_settings(world.environment, objects=objects)
+        robot_handle = robot_packages.load(robot, world)
+        if recorder is not None:
+            recorder.set_run_info(robot=robot)
+        camera = "overview"
+        if output is not None:
+            output.mkdir(parents=True, exist_ok=True)
+            world.snapshot(output / "start.png", camera=camera)
+            if animation:
+                world.start_recording(camera, fps=4.0, width=480, height=360, caption=_caption)
+        injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
+        held_at_once = _HeldAtOnce(world)
+        plan = _PlanThread(robot_handle, settings)
+        sim_start = world.sim_time.get_value()
+        injector.start()
+        plan.start()
+        sim_deadline, wall_deadline = sim_start + SIM_TIME_LIMIT, time.monotonic() + WALL_TIME_LIMIT
+        while not plan.join(0.25):
+            if progress is not None:
+                progress(world, plan, injector)
+            if world.sim_time.get_value() > sim_deadline:
+                result.error = f"TimeoutError: the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
+            elif time.monotonic() > wall_deadline:
+                result.error = f"TimeoutError: the plan did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
+            if result.error:
+                log.warning("stopping the plan: %s", result.error)
+                plan.stop()
+                break
+        injector.stop()
+        held_at_once.stop()
+        result.concurrency = {**plan.record.as_dict(), "most_held_at_once": held_at_once.most}
+        result.sim_time = world.sim_time.get_value() - sim_start
+        if plan.error is not None and result.error is None:
+            result.error = f"{type(plan.error).__name__}: {plan.error}"
+        result.faults_injected = list(injector.injected)
+        judge(world, settings, plan.outcomes, result)
+        if output is not None:
+            world.snapshot(output / "end.png", camera=camera)
+            if animation:
+                from pycram.backends.sim.render import write_animation
+
+                frames = world.stop_recording(timeout=300.0)
+                if frames:
+                    write_animation(output / "run.gif", frames, 8.0)
+    finally:
+        if injector is not None:
+            injector.stop()
+        if robot_handle is not None:
+            robot_handle.shutdown()
+        world.close()
+        result.wall_time = time.monotonic() - started_wall
+    return result, plan.task if plan is not None else None
+
+
+def _caption() -> str:
+    from pycram.apps.scenarios.set_table.plan import current_object, objects_done
+
+    current = current_object.get_value()
+    return f"set table: {objects_done.get_value()}/{len(OBJECTS)} done" + (
+        f", bringing the {current}" if current else ""
+    )
+
+
+def run_set_table(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    db_url: str | None = None,
+    pictures: bool = False,
+    objects: tuple[str, ...] = OBJECTS,
+    in_containers: bool = True,
+) -> dict[str, Any]:
+    """Run the set-table scenario once, headless and without animation, for `pycram experiment`.
+
+    `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
+    recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``
+    (``output/set-table-open-ROBOT-SEED`` without `in_containers`); `objects`: the object types
+    to bring (a subset of `OBJECTS`, in that order); `in_containers`: objects may start inside
+    closed containers (`start_scene`). Returns a JSON-serialisable dict: ``success``,
+    ``objects`` (per object: ``placed``, ``failure`` (a failure type's name or None),
+    ``reason``), ``failure_causes``, ``sim_time`` [s], ``wall_time`` [s], ``robot``, ``seed``,
+    ``faults``, ``faults_injected``, ``run_id``, ``started_in`` (object -> the closed container
+    it started in), and ``concurrency``: what the plan's concurrency did (`PlanRecord.as_dict`:
+    objects found while driving, searches ended by a sighting, objects carried together) and
+    ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
+    Raises `ValueError` for an unknown robot or fault name.
+    """
+    import os
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    kinds = _check(robot, seed, faults)
+    recorder = None
+    if db_url is not None:
+        from pycram.trace import start_recording
+
+        recorder = start_recording(url=db_url, plan=f"set table ({robot}, seed {seed})")
+    scenario = "set-table" if in_containers else "set-table-open"
+    output = Path("output") / f"{scenario}-{robot}-{seed}" if pictures else None
+    result: SetTableResult | None = None
+    try:
+        result, _ = run_scenario(
+            robot, seed, kinds, recorder=recorder, output=output, objects=tuple(objects), in_containers=in_containers
+        )
+    finally:
+        run_id = None
+        if recorder is not None:
+            ok = result is not None and result.success
+            run_id = recorder.finish(
+                "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
+            )
+    out = result.as_dict()
+    out["run_id"] = run_id
+    return out
+
+
+def run_set_table_on_open_surfaces(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    db_url: str | None = None,
+    pictures: bool = False,
+) -> dict[str, Any]:
+    """The ``set-table-open`` scenario of `pycram experiment`: `run_set_table` with every object
+    starting on an open surface (the scenes of the same seeds without `START_CONTAINERS`)."""
+    return run_set_table(robot, seed, faults, db_url, pictures, in_containers=False)

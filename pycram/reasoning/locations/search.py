@@ -1,0 +1,178 @@
+"""The bounded search for candidates shared by the location vocabularies.
+
+`CandidateSearch` is the base of the vocabularies (`pycram.reasoning.locations.reach`, ``see``,
+``opening``, ``spots``) that `LocationReasoner` combines: it declares the reasoner's inputs (the
+robot's geometry and the callables that describe the world at resolution time) and walks the
+cells of costmaps cheapest first, validating each candidate with prospection. Guarantees: at most
+`MAX_CANDIDATES` (the reasoner's ``max_candidates``) candidates are checked per designator;
+solutions keep `SPACING` [m] apart; when none passes, `NoSolutionError` says how many were tried
+and what ruled them out (counted by `_Tally`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from pycram.designators.core import NoSolutionError
+from pycram.world.environment import Environment
+
+from .costmap import Costmap
+from .robot_geometry import RobotGeometry
+from .solutions import BaseLocation
+from .targets import KnownObject, Target, as_target
+
+__all__ = ["CandidateSearch", "MAX_CANDIDATES", "SPACING", "FAILED_SPACING", "BASE_CLEARANCE"]
+
+#: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
+#: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
+BASE_CLEARANCE = 0.1
+#: Candidates checked with prospection per designator before giving up.
+MAX_CANDIDATES = 100
+#: Distance [m] between two solutions of one designator (base poses or spots).
+SPACING = 0.1
+#: Cells closer than this [m] to a candidate that failed for the same arm are not checked (the
+#: cells around it: their answer is almost always the same).
+FAILED_SPACING = 0.075
+
+
+class _Tally:
+    """Why candidates failed, for the error message."""
+
+    def __init__(self) -> None:
+        self.tried = 0
+        self.reasons: Counter[str] = Counter()
+        self.details: dict[str, Counter[str]] = {}
+
+    def fail(self, reason: str, detail: str | None = None) -> None:
+        self.reasons[reason] += 1
+        if detail:
+            self.details.setdefault(reason, Counter())[detail] += 1
+
+    def summary(self) -> str:
+        parts = []
+        for reason, n in self.reasons.most_common():
+            if not n:
+                continue
+            detail = self.details.get(reason)
+            more = (
+                f" ({', '.join(f'{k} {v}' for k, v in detail.most_common() if v)})"
+                if detail and any(detail.values())
+                else ""
+            )
+            parts.append(f"{n} {reason}{more}")
+        return f"{self.tried} candidates: " + ", ".join(parts) if parts else f"{self.tried} candidates"
+
+
+class CandidateSearch:
+    """The inputs of location reasoning and the search over ranked candidates (base of the
+    vocabularies; `LocationReasoner` sets the inputs, see its docstring)."""
+
+    #: The robot's numbers (its description).
+    geometry: RobotGeometry
+    #: The environment's description, asked at resolution time.
+    environment: Callable[[], Environment]
+    #: The robot's `Prospection` in the current world, asked at resolution time.
+    prospection: Callable[[], Any]
+    #: The objects believed to be around (`KnownObject`s).
+    known_objects: Callable[[], Sequence[KnownObject]]
+    #: How far each container is believed open [m or rad] (perceived; missing: closed).
+    container_states: Callable[[], Mapping[str, float]]
+    #: Candidates checked with prospection per designator before giving up.
+    max_candidates: int
+    #: The costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
+    last_costmaps: dict[str, Costmap]
+
+    @property
+    def _base_radius(self) -> float:
+        """The base's inscribed radius plus the clearance it keeps [m] (the occupancy inflation)."""
+        return self.geometry.inscribed_radius + BASE_CLEARANCE
+
+    def _fail(self, desig: Any, what: str) -> NoSolutionError:
+        return NoSolutionError(f"Cannot resolve {desig!r}: {what}", designator=desig)
+
+    def _target(self, value: Any) -> Target:
+        return as_target(value, self.environment(), self.known_objects())
+
+    def _empty_costmap(self, maps: dict[str, Costmap], target: Target) -> str:
+        """Why no cell of the costmaps is left: the layer that alone rules out every cell, or
+        the layers that do together."""
+        env = self.environment()
+        where = "(" + ", ".join(f"{v:.1f}" for v in target.position) + ") [m, map]"
+        alone = sorted(
+            {
+                name
+                for m in maps.values()
+                for name, layer in m.layers.items()
+                if name != "occupancy" and bool(np.isinf(layer).all())
+            }
+        )
+        if alone:
+            return (
+                f"{target.describe()} at {where} is outside the environment: no cell of the floor of "
+                f"{env.name} lies within the layer {alone[0]!r} around it"
+            )
+        return (
+            f"every cell of the floor of {env.name} within reach of {target.describe()} at {where} is "
+            f"occupied (layer 'occupancy': furniture and walls inflated by the {self.geometry.name}'s "
+            f"{self._base_radius:.2f} m footprint radius with clearance; {_layer_summary(maps)})"
+        )
+
+    # ------------------------------------------------------------------ the search
+    def _search(
+        self,
+        desig: Any,
+        cells: Iterator[tuple],
+        validate: Callable,
+        kind: str,
+        target: Target,
+        maps: dict[str, Costmap],
+        tally: _Tally | None = None,
+    ) -> Iterator[BaseLocation]:
+        """Walk `cells` (cost, tie, arm, row, col) cheapest first; validate each; yield the valid
+        ones at least `SPACING` apart; after `max_candidates` checks or when the costmap is used
+        up, stop -- with `NoSolutionError` naming what ruled the candidates out if nothing passed
+        (counted in `tally` when given)."""
+        tally = _Tally() if tally is None else tally
+        given: list[BaseLocation] = []
+        failed: list[tuple[str | None, float, float]] = []
+        for cell in cells:
+            if tally.tried >= self.max_candidates:
+                break
+            cost, _, arm, r, c = cell
+            x, y = next(iter(maps.values())).xy(r, c)
+            if any(math.hypot(x - g.x, y - g.y) < SPACING for g in given):
+                continue
+            if any(a == arm and math.hypot(x - fx, y - fy) < FAILED_SPACING for a, fx, fy in failed):
+                continue
+            tally.tried += 1
+            solution, failure = validate(cell)
+            if solution is not None:
+                given.append(solution)
+                yield solution
+            else:
+                failed.append((arm, x, y))
+                tally.fail(*failure)
+        if not given:
+            if tally.tried == 0:
+                raise self._fail(desig, self._empty_costmap(maps, target))
+            raise self._fail(
+                desig, f"no base pose for {kind} {target.describe()} with the {self.geometry.name}: {tally.summary()}"
+            )
+
+
+def _layer_summary(maps: dict[str, Costmap]) -> str:
+    out = []
+    for name, costmap in maps.items():
+        out.append(f"{name}: " + ", ".join(f"{k} forbids {v} cells" for k, v in costmap.ruled_out_by().items()))
+    return "; ".join(out)
+
+
+def _ranked(costmap: Costmap, tie: int, arm: str | None) -> Iterator[tuple]:
+    """The cells of `costmap` cheapest first as (cost, tie, arm, row, column)."""
+    for r, c, cost in costmap.cells():
+        yield cost, tie, arm, r, c
