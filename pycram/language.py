@@ -11,28 +11,12 @@ from typing import Any
 
 from pycram.core.expressions import *  # noqa: F401,F403
 from pycram.core.expressions import __all__ as _expressions_all
-from pycram.core.partial_order import partial_order
-from pycram.core.policy import (
-    Policy,
-    PolicyConditionMet,
-    PolicyInitFailed,
-    PolicyRun,
-    define_policy,
-    timeout_policy,
-    with_policy,
-)
+from pycram.core.partial_order import *  # noqa: F401,F403
+from pycram.core.partial_order import __all__ as _partial_order_all
+from pycram.core.policy import *  # noqa: F401,F403
+from pycram.core.policy import __all__ as _policy_all
 
-__all__ = [
-    *_expressions_all,
-    "partial_order",
-    "Policy",
-    "PolicyRun",
-    "PolicyConditionMet",
-    "PolicyInitFailed",
-    "define_policy",
-    "with_policy",
-    "timeout_policy",
-]
+__all__ = [*_expressions_all, *_partial_order_all, *_policy_all]
 
 
 def __getattr__(name: str) -> Any:

@@ -58,7 +58,7 @@ def test_each_statement_is_one_branch_and_state_is_bound_first() -> None:
     assert module.index("s = _pycram_state") < module.index("def _pycram_par")  # bound before branches
     assert "expression('par')(_pycram_par" in module and "errors=_pycram_errors" in module
     assert "global a" in module and "global b, c" in module
-    assert "macros" not in module.split("import pycram.macros")[0]
+    assert "macros" not in module.split("import pycram.core.macros")[0]
 
 
 def test_thesis_macros_import_is_dropped(tmp_path: Path) -> None:

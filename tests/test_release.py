@@ -93,11 +93,12 @@ def test_ci_type_checks_the_language_core_strictly_before_the_tests():
     assert mypy["files"] == ["pycram"] and mypy["warn_redundant_casts"] is True
     core = next(o for o in mypy["overrides"] if "pycram.runtime" in o["module"])
     for module in (
-        "pycram.fluent",
-        "pycram.runtime.*",
-        "pycram.language",
+        "pycram.core.fluent",
+        "pycram.core.runtime.*",
+        "pycram.core.expressions",
         "pycram.designators.*",
-        "pycram.process_module",
+        "pycram.execution.process_module",
+        "pycram.language",
     ):
         assert module in core["module"]
     # `strict = true` in an override makes every module strict (python/mypy#11401): spelled out.

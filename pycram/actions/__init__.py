@@ -14,6 +14,9 @@ on every robot (PR2: either arm; TIAGo: its one arm). They recover from failures
 grasp or standing pose, perceiving again, searching again) a bounded number of times and then
 raise a typed failure of `pycram.failures`. The plan for an action type can be replaced per
 robot or world by an action resolver of its own (asked before the library's).
+
+May import: core, designators, execution, world, environments and reasoning -- never a robot
+package, never a backend (robot-specific numbers come from the active robot's description).
 """
 
 from pycram.designators.action import ActionDesignator

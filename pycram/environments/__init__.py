@@ -6,6 +6,9 @@
 
 Importing this package is cheap: an environment's module is imported by `load`. Other modules
 read an environment through its `Environment` description, never through its module's constants.
+A new environment is its module plus one line in `_MODULES`.
+
+May import: :mod:`pycram.world` (the `Environment` description) and the standard library.
 """
 
 from __future__ import annotations

@@ -4,7 +4,10 @@ Which robots exist is the robot registry's business (:mod:`pycram.world.robot_re
 ``pycram.robots`` entry points); each robot package holds ``description.py`` (data) and
 ``robot.py`` (``make_robot(world)``). ``load(name, world)`` builds the :class:`pycram.robot.Robot`
 of a simulated world; importing this package stays cheap (the robot modules, which need the
-simulation, are imported by ``load``).
+simulation, are imported by ``load``). :mod:`pycram.robots.common` holds what every robot
+shares.
+
+May import: every layer above (core to backends). Nothing but the apps imports a robot package.
 """
 
 from __future__ import annotations

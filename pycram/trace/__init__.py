@@ -11,6 +11,8 @@ starts, a query runs or a picture is drawn (the `db` extra).
   durations across runs; the process-module executions of a task tree.
 - `pycram.trace.pictures`: task-tree SVG, timeline (Gantt) PNG, `write_run_pictures`.
 - `pycram.trace.db`: URLs (`$PYCRAM_DB_URL`, default SQLite file), schema, `TraceDatabaseError`.
+
+May import: every layer above (core to robots); in practice the core's runtime and events only.
 """
 
 from __future__ import annotations

@@ -74,7 +74,8 @@ def test_pycram_ros_imports_without_rospy():
     import sys
 
     code = (
-        "import sys; import pycram.ros, pycram.backends.ros.transport, pycram.backends.ros.config, pycram.backends.ros.launch; "
+        "import sys; import pycram.ros, pycram.backends.ros.transport, pycram.backends.ros.config, "
+        "pycram.backends.ros.launch; "
         "assert 'rospy' not in sys.modules, 'rospy imported'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

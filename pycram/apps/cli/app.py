@@ -15,6 +15,7 @@ from rich.markup import escape
 
 from pycram.world.robot_registry import robot_names
 
+#: The `pycram` command line; each module of `pycram.apps.cli` registers its commands on it.
 app = typer.Typer(
     name="pycram",
     help="PyCRAM: concurrent, reactive robot plans. Run plans and the kitchen demo; inspect recorded runs.",
@@ -24,7 +25,9 @@ app = typer.Typer(
 )
 #: The help text of every `--robot` option: the registered robots.
 ROBOT_HELP = f"Robot: {' or '.join(robot_names())}."
+#: Standard output of the commands (tables, trees, results).
 console = Console(highlight=False)
+#: Standard error of the commands (errors, warnings, where a run was recorded).
 err = Console(stderr=True, highlight=False)
 
 

@@ -18,6 +18,9 @@ Layout (one concept per module; ``rospy`` is imported only by :mod:`pycram.backe
   hands) reached through the bridge.
 
 Set-up: ``scripts/install_ros.sh`` (Debian's ROS 1 packages + generated messages).
+
+May import: the layers above it (core to actions); never the simulator (:mod:`pycram.backends.sim`)
+and never a robot package. Users import it as :mod:`pycram.ros`.
 """
 
 __all__: list[str] = []

@@ -1,4 +1,4 @@
-"""The simulated world: a MuJoCo environment with a PR2 or TIAGo whose sensors feed fluents.
+"""The simulator backend: a MuJoCo environment with a robot whose sensors feed fluents.
 
 Import this package only when a simulation is wanted: it imports numpy and mujoco (and chooses
 a headless OpenGL backend first when no display is set). Quick start::
@@ -7,6 +7,10 @@ a headless OpenGL backend first when no display is set). Quick start::
     with World("pr2") as world:
         world.drive_to(*world.description.KITCHEN_BASE_POSES["cooker #2"]).wait(30)
         world.snapshot("kitchen.png")
+
+May import: the layers above it (core to actions); never the ROS backend, except that the ROS
+bridge tool (:mod:`pycram.backends.sim.ros_bridge`) uses its message interfaces. Users import it
+as :mod:`pycram.sim`.
 """
 
 from ._gl import configure_gl
