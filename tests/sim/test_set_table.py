@@ -138,6 +138,35 @@ def test_the_demo_command_refuses_an_unknown_scenario_or_fault_naming_the_valid_
     assert result.exit_code == 2 and "set-table only" in result.output
 
 
+def test_the_demo_command_runs_a_scenario_through_its_registered_front_end(tmp_path, monkeypatch):
+    # `pycram demo --scenario NAME` finds the scenario's terminal front end in the experiments'
+    # scenario registry (no list of scenarios in the CLI); set-table-open starts nothing inside.
+    pytest.importorskip("typer")
+    from typer.testing import CliRunner
+
+    from pycram.apps.cli import app
+    from pycram.apps.experiments.scenarios import demo_scenario_names
+    from pycram.apps.scenarios.set_table import display
+
+    assert demo_scenario_names() == ["set-table", "set-table-open"]
+    started = []
+
+    class Stopped(Exception):
+        pass
+
+    def run_scenario(robot, seed, kinds, **options):
+        started.append((robot, seed, options["in_containers"]))
+        raise Stopped
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(display, "run_scenario", run_scenario)
+    for scenario in ("set-table", "set-table-open"):
+        args = ["demo", "--scenario", scenario, "--robot", "tiago", "--seed", "3", "--no-record", "-q"]
+        result = CliRunner().invoke(app, args)
+        assert isinstance(result.exception, Stopped), result.output
+    assert started == [("tiago", 3, True), ("tiago", 3, False)]
+
+
 def _assert_set(out: dict, objects: tuple[str, ...] = OBJECTS) -> None:
     assert json.loads(json.dumps(out)) == out  # JSON-serialisable, as the experiment runner needs
     assert out["success"], out["summary"]

@@ -73,14 +73,14 @@ def demo_command(
     or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
     if output is not None:
         check_output_folder(output)
-    scenarios = ("thesis", "set-table", "set-table-open")  # pycram.apps.scenarios.set_table.SCENARIOS (imported lazily)
+    from pycram.apps.experiments.scenarios import demo_scenario_names, get_scenario
+
+    scenarios = ["thesis", *demo_scenario_names()]  # the thesis demo has options of its own
     if scenario not in scenarios:
         fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
-    if scenario.startswith("set-table"):
-        from pycram.apps.scenarios.set_table import main as set_table_main
-
+    if scenario != "thesis":
         code = trace_errors(
-            set_table_main,
+            get_scenario(scenario).load_demo(),
             robot=robot,
             seed=seed,
             faults=faults,
@@ -89,7 +89,6 @@ def demo_command(
             record=record_flag(record),
             quiet=quiet,
             animation=animation,
-            in_containers=scenario != "set-table-open",
         )
         raise typer.Exit(int(code or 0))
     if faults:

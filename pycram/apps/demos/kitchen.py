@@ -14,7 +14,6 @@ still written, the run is recorded as "interrupted" with the reason, and the exi
 from __future__ import annotations
 
 import contextlib
-import functools
 import logging
 import math
 import os
@@ -26,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from pycram.apps.terminal import log_to_terminal, stderr_console, task_tree_display, write_run_pictures
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 if TYPE_CHECKING:  # imported where used: the ROS backend is optional
@@ -216,7 +216,7 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
             result.run_id = recorder.finish(outcome, reason)
             result.trace_loss = recorder.loss_report()
     if recorder is not None and options.pictures:
-        result.files.extend(_write_run_pictures(result, recorder))
+        result.files.extend(write_run_pictures(result.run_id, result.plan_task, result.output, recorder.url))
     return result
 
 
@@ -418,28 +418,6 @@ def _start_recorder(options: DemoOptions, plan_name: str) -> Any:
     return start_recording(url=options.db, plan=plan_name)
 
 
-def _write_run_pictures(result: DemoResult, recorder: Any) -> list[Path]:
-    """The task-tree SVG and timeline PNG of the recorded run; drawn from the plan's task in
-    memory when the trace database cannot be read (a broken database never fails the demo)."""
-    try:
-        from pycram.trace.db import TraceDatabaseError
-        from pycram.trace.pictures import write_run_pictures, write_task_pictures
-        from pycram.trace.query import RunNotFound
-    except ImportError:
-        return []
-    try:
-        return list(write_run_pictures(result.run_id, result.output, url=recorder.url))
-    except (TraceDatabaseError, RunNotFound) as error:
-        log.warning(
-            "cannot read run %s back from the trace database (%s); drawing the pictures from memory",
-            result.run_id,
-            error,
-        )
-    if result.plan_task is None:
-        return []
-    return list(write_task_pictures(result.plan_task, result.output))
-
-
 def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options: DemoOptions, stop: Any) -> str:
     """Show live progress until the plan ends; stop it on a time limit, a stop signal or Ctrl-C.
 
@@ -525,7 +503,7 @@ class _ProgressLine:
 
         self.run, self.world, self.plan, self.thief = run, world, plan, thief
         self._started = time.monotonic()
-        self._live = Live(self._text(), console=_stderr_console(), refresh_per_second=4, transient=False)
+        self._live = Live(self._text(), console=stderr_console(), refresh_per_second=4, transient=False)
 
     def _text(self) -> str:
         task = self.run.task
@@ -556,56 +534,6 @@ class _ProgressLine:
         self._live.__exit__(*exc)
 
 
-def _task_tree_display(result: DemoResult, url: str | None) -> Any:
-    """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
-    on one line, with the blocking process-module executions when the run was recorded), or as
-    plain text when the trace extra is not installed."""
-    if result.plan_task is None:
-        return "(the plan did not start)"
-    try:
-        from pycram.trace.display import task_tree
-        from pycram.trace.query import records_from_task
-    except ImportError:
-        return result.tree_text
-    records = records_from_task(result.plan_task)
-    if result.run_id is not None:
-        records += _recorded_executions(result.run_id, url, records)
-    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", records)
-    return tree
-
-
-def _recorded_executions(run_id: Any, url: str | None, records: list) -> list:
-    """The recorded process-module executions below the plan's tasks (none if unreadable)."""
-    from pycram.trace import query
-
-    ids = {r.task_id for r in records}
-    try:
-        executions = [x for x in query.executions(run_id, url=url) if x.task_id in ids]
-    except (query.TraceDatabaseError, query.RunNotFound) as error:
-        log.warning("cannot read the process-module executions of run %s: %s", run_id, error)
-        return []
-    return query.execution_nodes(records, executions)
-
-
-@functools.cache
-def _stderr_console() -> Any:
-    """The one rich console of the demo's terminal output (progress line and log records)."""
-    from rich.console import Console
-
-    return Console(stderr=True)
-
-
-def _log_to_terminal() -> None:
-    """Show the demo's INFO records above the live progress line (rich keeps them apart)."""
-    from rich.logging import RichHandler
-
-    demo_log = logging.getLogger("pycram.demo")
-    if not any(isinstance(h, RichHandler) for h in demo_log.handlers):
-        demo_log.addHandler(RichHandler(console=_stderr_console(), show_path=False, markup=False))
-        demo_log.setLevel(logging.INFO)
-        demo_log.propagate = False
-
-
 def main(
     robot: str = DEFAULT_ROBOT,
     output: str | None = None,
@@ -627,7 +555,7 @@ def main(
     from pycram.core.interrupts import StopSignals
 
     if not quiet:
-        _log_to_terminal()
+        log_to_terminal()
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
     options = DemoOptions(
@@ -645,13 +573,13 @@ def main(
         backend=backend,
     )
     try:
-        with StopSignals(on_second=lambda: _stderr_console().show_cursor(True)) as stop:
+        with StopSignals(on_second=lambda: stderr_console().show_cursor(True)) as stop:
             result = run_demo(options, stop)
     except ValueError as error:  # an option out of range: say which, no traceback
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False)
         return 2
     console.print()
-    console.print(_task_tree_display(result, options.db))
+    console.print(task_tree_display(result.plan_task, result.run_id, options.db, result.tree_text))
     console.print(
         f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
         f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s"

@@ -45,6 +45,7 @@ __all__ = [
     "register_scenario",
     "scenario_names",
     "get_scenario",
+    "demo_scenario_names",
     "thesis_scenario",
 ]
 
@@ -75,14 +76,17 @@ class RunInterrupted(KeyboardInterrupt):
 @dataclass(frozen=True)
 class Scenario:
     """A registered scenario: its `name`, the function (`target`: a callable or an import path
-    `"module:function"`), the fault names it knows (`faults`, None when it does not say) and
-    the robots it runs on."""
+    `"module:function"`), the fault names it knows (`faults`, None when it does not say), the
+    robots it runs on, and its terminal front end for `pycram demo --scenario NAME` (`demo`: an
+    import path of ``main(robot, seed, faults, output, db, record, quiet, animation) -> exit
+    code``; None when `pycram demo` does not run it)."""
 
     name: str
     target: ScenarioFunction | str
     faults: tuple[str, ...] | None = None
     robots: tuple[str, ...] = ROBOTS
     description: str = ""
+    demo: str | None = None
 
     def load(self) -> ScenarioFunction:
         """The scenario's function (importing its module for an import path).
@@ -92,6 +96,13 @@ class Scenario:
         if callable(self.target):
             return self.target
         return _import_target(self.target, self.name)
+
+    def load_demo(self) -> Callable[..., Any]:
+        """The scenario's terminal front end (see `demo`); `UnknownScenario` when it has none or
+        its module or function does not exist."""
+        if self.demo is None:
+            raise UnknownScenario(f"scenario {self.name!r} has no terminal front end for `pycram demo`")
+        return _import_target(self.demo, self.name)
 
     @property
     def spec(self) -> str:
@@ -130,14 +141,18 @@ def register_scenario(
     faults: tuple[str, ...] | None = None,
     robots: tuple[str, ...] = ROBOTS,
     description: str = "",
+    demo: str | None = None,
 ) -> Scenario:
     """Register (or replace) the scenario `name`: a callable, or an import path
-    `"module:function"` imported when the scenario is first used. Returns the entry."""
+    `"module:function"` imported when the scenario is first used; `demo`: the import path of its
+    terminal front end for `pycram demo --scenario NAME` (see `Scenario`). Returns the entry."""
     if not name or ":" in name:
         raise ValueError(f"a scenario name must be non-empty and contain no ':', not {name!r}")
     if isinstance(target, str) and ":" not in target:
         raise ValueError(f"a scenario's import path reads 'package.module:function', not {target!r}")
-    entry = Scenario(name, target, tuple(faults) if faults is not None else None, tuple(robots), description)
+    if demo is not None and ":" not in demo:
+        raise ValueError(f"a scenario's demo import path reads 'package.module:function', not {demo!r}")
+    entry = Scenario(name, target, tuple(faults) if faults is not None else None, tuple(robots), description, demo)
     SCENARIOS[name] = entry
     return entry
 
@@ -145,6 +160,12 @@ def register_scenario(
 def scenario_names() -> list[str]:
     """The registered scenario names, sorted."""
     return sorted(SCENARIOS)
+
+
+def demo_scenario_names() -> list[str]:
+    """The registered scenarios `pycram demo --scenario` runs (those with a terminal front end),
+    in the order they were registered."""
+    return [name for name, entry in SCENARIOS.items() if entry.demo is not None]
 
 
 def get_scenario(spec: str) -> Scenario:
@@ -290,10 +311,12 @@ register_scenario(
 register_scenario(
     "set-table",
     "pycram.apps.scenarios.set_table:run_set_table",
+    demo="pycram.apps.scenarios.set_table.display:main",
     description="set the table for breakfast in the apartment, objects on counters and in a drawer (issue 17)",
 )
 register_scenario(
     "set-table-open",
     "pycram.apps.scenarios.set_table:run_set_table_on_open_surfaces",
+    demo="pycram.apps.scenarios.set_table.display:main_on_open_surfaces",
     description="set the table, every object starting on an open surface (none in a closed drawer)",
 )

@@ -17,9 +17,7 @@ from pycram.apps.scenarios.set_table.driver import _check, run_scenario
 from pycram.apps.scenarios.set_table.judge import SetTableResult
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
-__all__ = [
-    "main",
-]
+__all__ = ["main", "main_on_open_surfaces"]
 
 
 def _output_folder(robot: str, seed: int, run_id: Any) -> Path:
@@ -43,13 +41,12 @@ def main(
     the task-tree SVG and the timeline of the recorded run. Returns the exit code: 0 only when
     every object is at its place setting and every drawer closed; 2 for bad options; else 1."""
     import os
-    from types import SimpleNamespace
 
     from rich.console import Console
     from rich.live import Live
 
-    from pycram.apps.demos.kitchen import _log_to_terminal, _stderr_console, _task_tree_display, _write_run_pictures
     from pycram.apps.scenarios.set_table.plan import current_object, objects_done
+    from pycram.apps.terminal import log_to_terminal, stderr_console, task_tree_display, write_run_pictures
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
@@ -59,7 +56,7 @@ def main(
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
         return 2
     if not quiet:
-        _log_to_terminal()
+        log_to_terminal()
     recorder = None
     if record:
         from pycram.trace import start_recording
@@ -67,7 +64,7 @@ def main(
         recorder = start_recording(url=db, plan=f"set table ({robot}, seed {seed})")
     run_id = recorder.run_id if recorder is not None else None
     folder = Path(output) if output else _output_folder(robot, seed, run_id)
-    live = None if quiet else Live("", console=_stderr_console(), refresh_per_second=4, transient=False)
+    live = None if quiet else Live("", console=stderr_console(), refresh_per_second=4, transient=False)
 
     def progress(world: Any, plan: Any, injector: Any) -> None:
         if live is None:
@@ -102,12 +99,11 @@ def main(
             run_id = recorder.finish(
                 "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
             )
-    view = SimpleNamespace(plan_task=task, run_id=run_id, output=folder, tree_text="")
     files = [folder / n for n in ("start.png", "end.png", "run.gif") if (folder / n).exists()]
     if recorder is not None:
-        files += _write_run_pictures(view, recorder)  # type: ignore[arg-type]
+        files += write_run_pictures(run_id, task, folder, recorder.url)
     console.print()
-    console.print(_task_tree_display(view, db))  # type: ignore[arg-type]
+    console.print(task_tree_display(task, run_id, db))
     assert result is not None
     console.print(
         f"\nthe plan simulated {result.sim_time:.1f} s; the whole run took {result.wall_time:.1f} s of wall time"
@@ -129,3 +125,9 @@ def main(
         return 0
     console.print(f"[bold red]FAILURE[/bold red]: {result.summary()}", highlight=False)
     return 1
+
+
+def main_on_open_surfaces(**options: Any) -> int:
+    """`pycram demo --scenario set-table-open`: :func:`main` with every object starting on an open
+    surface (none in a closed container)."""
+    return main(in_containers=False, **options)

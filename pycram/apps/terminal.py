@@ -1,0 +1,91 @@
+"""What the terminal front ends of the demo and the scenarios share (`pycram demo`): one rich
+console on standard error for the live progress line and the log records, the plan's task tree
+as `pycram show` draws it, and the pictures of a recorded run.
+
+Every function here is for people watching a run; none of them changes what a plan does.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+from pathlib import Path
+from typing import Any
+
+__all__ = ["stderr_console", "log_to_terminal", "task_tree_display", "write_run_pictures"]
+
+log = logging.getLogger("pycram.demo")
+
+
+@functools.cache
+def stderr_console() -> Any:
+    """The one rich console of the demo's terminal output (progress line and log records)."""
+    from rich.console import Console
+
+    return Console(stderr=True)
+
+
+def log_to_terminal() -> None:
+    """Show the demo's INFO records above the live progress line (rich keeps them apart)."""
+    from rich.logging import RichHandler
+
+    demo_log = logging.getLogger("pycram.demo")
+    if not any(isinstance(h, RichHandler) for h in demo_log.handlers):
+        demo_log.addHandler(RichHandler(console=stderr_console(), show_path=False, markup=False))
+        demo_log.setLevel(logging.INFO)
+        demo_log.propagate = False
+
+
+def task_tree_display(plan_task: Any, run_id: Any, url: str | None, tree_text: str = "") -> Any:
+    """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
+    on one line, with the blocking process-module executions when the run was recorded as
+    `run_id`), or `tree_text` when the trace extra is not installed."""
+    if plan_task is None:
+        return "(the plan did not start)"
+    try:
+        from pycram.trace.display import task_tree
+        from pycram.trace.query import records_from_task
+    except ImportError:
+        return tree_text
+    records = records_from_task(plan_task)
+    if run_id is not None:
+        records += _recorded_executions(run_id, url, records)
+    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", records)
+    return tree
+
+
+def _recorded_executions(run_id: Any, url: str | None, records: list) -> list:
+    """The recorded process-module executions below the plan's tasks (none if unreadable)."""
+    from pycram.trace import query
+
+    ids = {r.task_id for r in records}
+    try:
+        executions = [x for x in query.executions(run_id, url=url) if x.task_id in ids]
+    except (query.TraceDatabaseError, query.RunNotFound) as error:
+        log.warning("cannot read the process-module executions of run %s: %s", run_id, error)
+        return []
+    return query.execution_nodes(records, executions)
+
+
+def write_run_pictures(run_id: Any, plan_task: Any, output: Path, url: str | None) -> list[Path]:
+    """The task-tree SVG and timeline PNG of the recorded run `run_id`, into `output`; drawn from
+    the plan's task in memory when the trace database cannot be read (a broken database never
+    fails the demo)."""
+    try:
+        from pycram.trace.db import TraceDatabaseError
+        from pycram.trace.pictures import write_run_pictures as write_pictures
+        from pycram.trace.pictures import write_task_pictures
+        from pycram.trace.query import RunNotFound
+    except ImportError:
+        return []
+    try:
+        return list(write_pictures(run_id, output, url=url))
+    except (TraceDatabaseError, RunNotFound) as error:
+        log.warning(
+            "cannot read run %s back from the trace database (%s); drawing the pictures from memory",
+            run_id,
+            error,
+        )
+    if plan_task is None:
+        return []
+    return list(write_task_pictures(plan_task, output))
