@@ -38,9 +38,9 @@ NOT_IK_SEEDS = frozenset({"carry_top"})
 
 
 def load_description(robot: str) -> RobotDescription:
-    """The validated description of `robot` (one of `ROBOTS`; `UnknownNameError` otherwise)."""
-    if robot not in ROBOTS:
-        raise UnknownNameError("robot", robot, ROBOTS)
+    """The validated description of `robot`, a registered robot (`UnknownNameError` otherwise)."""
+    if robot not in robot_names():
+        raise UnknownNameError("robot", robot, robot_names())
     return robot_description(robot)
 
 
