@@ -62,3 +62,76 @@ def test_a_95_percent_interval_covers_the_true_rate_about_95_percent_of_the_time
         covered += low <= true_rate <= high
     assert 0.92 <= covered / trials <= 0.98
     assert Z_95 == pytest.approx(1.96, abs=1e-3)
+
+
+# -- in the report and on the command line ---------------------------------------------------------
+
+
+def _runs(robot: str, variant: str, successes: int, failures: int) -> list:
+    from pycram.apps.experiments.store import RunRecord
+
+    ok = [RunRecord(robot, seed, variant, "done", True, [], 10.0, 1.0) for seed in range(successes)]
+    bad = [RunRecord(robot, 1000 + s, variant, "done", False, ["GraspFailed"], 12.0, 1.0) for s in range(failures)]
+    return ok + bad
+
+
+def test_the_summary_table_shows_each_success_rate_with_its_interval():
+    from rich.console import Console
+
+    from pycram.apps.experiments import report
+
+    groups = report.summarize(_runs("pr2", "", 195, 5) + _runs("tiago", "", 150, 50))
+    console = Console(width=200, record=True)
+    console.print(report.summary_table(groups))
+    text = console.export_text()
+    assert "95 % CI" in text
+    assert "94.3-98.9 %" in text and "68.6-80.5 %" in text, text
+
+
+def test_comparisons_say_which_differences_are_beyond_the_noise():
+    from pycram.apps.experiments import report
+
+    groups = report.summarize(
+        _runs("pr2", "", 22, 2)
+        + _runs("pr2", "taken", 20, 4)
+        + _runs("tiago", "", 12, 12)
+        + _runs("tiago", "taken", 10, 14)
+    )
+    lines = report.comparisons(groups)
+    assert any(line.startswith("pr2: faults taken vs none: 20/24 vs 22/24, -8.3 pp") for line in lines), lines
+    assert all("within the noise" in line for line in lines if "vs none" in line), lines
+    between_robots = [line for line in lines if line.startswith("faults none: pr2 vs tiago")]
+    assert between_robots and "larger than the noise" in between_robots[0], lines
+    reference = report.summarize(_runs("pr2", "", 12, 12))
+    against = report.comparisons(groups, reference=reference)
+    assert against == [
+        "pr2, faults none: this vs reference: 22/24 vs 12/24, " + report.compare_rates(22, 24, 12, 24).describe()
+    ]
+    assert "larger than the noise" in against[0]
+
+
+def test_an_experiment_is_compared_with_an_earlier_one_from_the_database(tmp_path):
+    pytest.importorskip("sqlalchemy")
+    from typer.testing import CliRunner
+
+    from pycram.apps.cli import app
+
+    db = tmp_path / "t.sqlite3"
+    common = ["--scenario", "pycram.testing:scenario_double", "--robot", "pr2", "--seeds", "1-9", "--workers", "1"]
+    common += ["--db", str(db), "--output", str(tmp_path / "out")]
+    first = CliRunner().invoke(app, ["experiment", *common, "--faults", "drop", "--name", "before"])
+    assert first.exit_code == 0, first.output
+    second = CliRunner().invoke(
+        app, ["experiment", *common, "--faults", "none", "--name", "after", "--compare", "before"]
+    )
+    assert second.exit_code == 0, second.output
+    text = " ".join(second.output.split())
+    assert "compared with experiment 1 (before):" in text
+    assert "(no robot and variant in common)" in text  # `none` against `drop`: nothing to pair
+    third = CliRunner().invoke(
+        app, ["experiment", *common, "--faults", "drop", "--name", "again", "--compare", "before"]
+    )
+    text = " ".join(third.output.split())
+    assert "pr2, faults drop: this vs reference: 6/9 vs 6/9, +0.0 pp" in text and "within the noise" in text, text
+    missing = CliRunner().invoke(app, ["experiment", *common, "--compare", "nope"])
+    assert missing.exit_code == 2 and "nope" in missing.output

@@ -61,13 +61,22 @@ def experiment_command(
     output: Path | None = typer.Option(
         None, "--output", "-o", help="Folder for the plot and summary (default: output/experiment-NAME)."
     ),
+    compare: str | None = typer.Option(
+        None,
+        "--compare",
+        help="Compare each robot and variant with the same in this earlier experiment (id or name; e.g. the "
+        "same seeds on other code): is the difference larger than the noise?",
+        metavar="ID",
+    ),
     db: str | None = DbOption,
 ) -> None:
     """Run a scenario over many robots, seeds and faults in parallel; report success and times.
 
     Each run is headless and recorded in the trace database; at the end a table shows the
-    success rate per robot and variant, the failure causes and the simulated and wall time
-    (p50/p95), and a plot is written.
+    success rate per robot and variant with its 95 % confidence interval (Wilson), the failure
+    causes and the simulated and wall time (p50/p95), then which differences between variants,
+    robots and (with --compare) an earlier experiment are larger than the noise; a plot is
+    written.
 
     Ctrl-C stops it: the runs under way finish and are recorded (a second Ctrl-C exits at once);
     `--resume ID` runs the rest. Exit code 0 when every run is recorded, 130 when stopped, 1 when
@@ -84,6 +93,14 @@ def experiment_command(
         fail(f"--workers must be at least 1, not {workers}", code=2)
     if output is not None:
         check_output_folder(str(output))
+    reference = None
+    if compare is not None:
+        from pycram.apps.experiments import store
+
+        try:
+            reference = trace_errors(store.find_experiment, db, compare)
+        except store.ExperimentNotFound as e:
+            fail(str(e), code=2)
     options = dict(scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db)
     with contextlib.ExitStack() as session:
         try:
@@ -95,10 +112,12 @@ def experiment_command(
             fail(str(e), code=2)
         except RayUnavailable as e:
             fail(str(e))
-        _run_experiment(prepared, workers, ray, output, db)
+        _run_experiment(prepared, workers, ray, output, db, reference)
 
 
-def _run_experiment(prepared: Any, workers: int, ray: str | None, output: Path | None, db: str | None) -> None:
+def _run_experiment(
+    prepared: Any, workers: int, ray: str | None, output: Path | None, db: str | None, reference: Any = None
+) -> None:
     """`pycram experiment` once its input is checked: run with a progress bar, then report."""
     from rich.progress import (
         BarColumn,
@@ -156,6 +175,13 @@ def _run_experiment(prepared: Any, workers: int, ray: str | None, output: Path |
     title = f"experiment {record.id} ({record.name}): {record.scenario}, {len(runs)} of {total} runs"
     console.print(report.summary_table(groups, title=escape(title)))
     console.print(report.causes_table(groups))
+    for line in report.comparisons(groups):
+        console.print(escape(line), highlight=False)
+    if reference is not None:
+        theirs = report.summarize(trace_errors(store.run_records, db, reference.id))
+        console.print(f"compared with experiment {reference.id} ({escape(reference.name)}):")
+        for line in report.comparisons(groups, reference=theirs) or ["(no robot and variant in common)"]:
+            console.print("  " + escape(line), highlight=False)
     folder = output if output is not None else Path("output") / f"experiment-{record.name}"
     if groups:
         plot = write_errors(report.write_plot, groups, folder / "experiment.png", title)

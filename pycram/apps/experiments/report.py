@@ -1,8 +1,11 @@
 """What an experiment found: success rates, failure causes and times, as a table and a plot.
 
 `summarize(runs)` groups the recorded runs (`pycram.apps.experiments.store.RunRecord`) by robot and
-variant; `summary_table` renders that as a `rich` table, `write_plot` draws success rate, times
-and failure causes into a PNG (matplotlib, the `db` extra).
+variant; `summary_table` renders that as a `rich` table (each success rate with its 95 %
+confidence interval, Wilson), `comparisons` says which differences between groups -- variants of
+one robot, robots in one variant, or the same group in another experiment -- are larger than the
+noise (:mod:`pycram.apps.experiments.statistics`), `write_plot` draws success rate (with the
+intervals), times and failure causes into a PNG (matplotlib, the `db` extra).
 """
 
 from __future__ import annotations
@@ -14,7 +17,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["GroupSummary", "summarize", "percentile", "variant_label", "summary_table", "causes_table", "write_plot"]
+from pycram.apps.experiments.statistics import compare_rates, wilson_interval
+
+__all__ = [
+    "GroupSummary",
+    "summarize",
+    "percentile",
+    "variant_label",
+    "summary_table",
+    "causes_table",
+    "comparisons",
+    "write_plot",
+]
 
 
 def percentile(values: Iterable[float], p: float) -> float | None:
@@ -50,6 +64,11 @@ class GroupSummary:
         return self.successes / self.runs if self.runs else 0.0
 
     @property
+    def confidence_interval(self) -> tuple[float, float]:
+        """The 95 % confidence interval (Wilson) of the success rate, as fractions."""
+        return wilson_interval(self.successes, self.runs)
+
+    @property
     def real_time_factors(self) -> list[float]:
         """Simulated time / wall time of each run with both."""
         return [s / w for s, w in zip(self.sim_times, self.wall_times) if w and w > 0 and s is not None]
@@ -76,24 +95,26 @@ def _seconds(value: float | None) -> str:
 
 
 def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
-    """A `rich.table.Table`: per robot and variant the runs, success rate, simulated and wall
-    time p50/p95 [s] and the median real-time factor."""
+    """A `rich.table.Table`: per robot and variant the runs, success rate with its 95 %
+    confidence interval (Wilson), simulated and wall time p50/p95 [s] and the median real-time
+    factor."""
     from rich.table import Table
 
     table = Table(title=title or None, header_style="bold")
     table.add_column("robot")
     table.add_column("faults", overflow="fold")
-    for name in ("runs", "success", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
+    for name in ("runs", "success\n95 % CI", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
         table.add_column(name, justify="right", no_wrap=True)
     for g in groups:
         rate = g.success_rate
         style = "green" if rate >= 0.95 else "yellow" if rate >= 0.85 else "red"
         rtf = percentile(g.real_time_factors, 50)
+        low, high = g.confidence_interval
         table.add_row(
             g.robot,
             variant_label(g.variant),
             str(g.runs),
-            f"[{style}]{100 * rate:.1f} %[/{style}] ({g.successes})",
+            f"[{style}]{100 * rate:.1f} %[/{style}] ({g.successes})\n{100 * low:.1f}-{100 * high:.1f} %",
             f"{_seconds(percentile(g.sim_times, 50))} / {_seconds(percentile(g.sim_times, 95))}",
             f"{_seconds(percentile(g.wall_times, 50))} / {_seconds(percentile(g.wall_times, 95))}",
             "–" if rtf is None else f"{rtf:.1f}",
@@ -120,6 +141,43 @@ def causes_table(groups: list[GroupSummary]) -> Any:
     return table
 
 
+def comparisons(groups: list[GroupSummary], reference: list[GroupSummary] | None = None) -> list[str]:
+    """Which differences of success rate are larger than the noise, one line each (difference in
+    percentage points with its 95 % confidence interval, Newcombe's method):
+
+    * with `reference` (the groups of another experiment, e.g. the same seeds on older code):
+      each group against the reference's group of the same robot and variant;
+    * without: each robot's variants against its runs without faults ("none"), and in each
+      variant the robots against each other.
+    """
+    lines: list[str] = []
+
+    def line(what: str, a: GroupSummary, b: GroupSummary) -> None:
+        difference = compare_rates(a.successes, a.runs, b.successes, b.runs)
+        lines.append(f"{what}: {a.successes}/{a.runs} vs {b.successes}/{b.runs}, {difference.describe()}")
+
+    if reference is not None:
+        theirs = {(g.robot, g.variant): g for g in reference}
+        for g in groups:
+            other = theirs.get((g.robot, g.variant))
+            if other is not None and g.runs and other.runs:
+                line(f"{g.robot}, faults {variant_label(g.variant)}: this vs reference", g, other)
+        return lines
+    by_key = {(g.robot, g.variant): g for g in groups if g.runs}
+    for (robot, variant), g in by_key.items():
+        base = by_key.get((robot, ""))
+        if variant and base is not None:
+            line(f"{robot}: faults {variant_label(variant)} vs none", g, base)
+    variants = sorted({variant for _, variant in by_key})
+    robots = list(dict.fromkeys(robot for robot, _ in by_key))
+    for variant in variants:
+        present = [r for r in robots if (r, variant) in by_key]
+        for i, a in enumerate(present):
+            for b in present[i + 1 :]:
+                line(f"faults {variant_label(variant)}: {a} vs {b}", by_key[(a, variant)], by_key[(b, variant)])
+    return lines
+
+
 def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
     """Draw success rate, simulated and wall time (p50 with a bar up to p95) per robot and
     variant, and the failure causes, into the PNG `path` (folders created). Returns `path`."""
@@ -136,6 +194,18 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
     try:
         rates = [100 * g.success_rate for g in groups]
         bars = ax_rate.bar(xs, rates, color=["#3a7" if r >= 95 else "#db3" if r >= 85 else "#c44" for r in rates])
+        intervals = [g.confidence_interval for g in groups]
+        ax_rate.errorbar(
+            xs,
+            rates,
+            yerr=[
+                [r - 100 * low for r, (low, _) in zip(rates, intervals)],
+                [100 * high - r for r, (_, high) in zip(rates, intervals)],
+            ],
+            fmt="none",
+            ecolor="black",
+            capsize=3,
+        )
         for bar, g in zip(bars, groups):
             ax_rate.annotate(
                 f"{g.successes}/{g.runs}",
@@ -147,7 +217,7 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
         ax_rate.set_xticks(xs, labels, fontsize=8)
         ax_rate.set_ylim(0, 105)
         ax_rate.set_ylabel("success rate [%]")
-        ax_rate.set_title("success rate")
+        ax_rate.set_title("success rate (whiskers: 95 % CI, Wilson)")
 
         width = 0.38
         for offset, name, values, colour in (
