@@ -22,6 +22,7 @@ from typing import Any
 
 from pycram.core.runtime import wait_until
 from pycram.core.runtime.evaporation import runtime_code
+from pycram.core.runtime.lockstep import Condition
 from pycram.execution.process_module import ProcessModule
 from pycram.world.robot_registry import robot_names
 
@@ -61,7 +62,7 @@ class ScriptedProcessModule(ProcessModule):
         self._releases = 0
         self._consumed = 0
         self._started = 0
-        self._double_cv = threading.Condition(threading.Lock())
+        self._double_cv = Condition(threading.Lock())
 
     # -- test control -------------------------------------------------------------------------
 

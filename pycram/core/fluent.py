@@ -38,6 +38,7 @@ from typing import Any
 
 from pycram.core.block_forms import BlockForm
 from pycram.core.runtime.evaporation import Evaporated, current_runner, notify_waiters, wait_until
+from pycram.core.runtime.lockstep import Condition
 
 __all__ = ["Fluent", "Behavior", "whenever", "Whenever", "STOP", "ChangeCallback"]
 
@@ -209,7 +210,7 @@ class Fluent:
             with _create_lock:
                 cv = self._cv
                 if cv is None:
-                    cv = self._cv = threading.Condition(threading.Lock())
+                    cv = self._cv = Condition(threading.Lock())
         return cv
 
     def wait_for(self, timeout: float | None = None) -> bool:

@@ -33,6 +33,8 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from inspect import isgenerator, isgeneratorfunction
 from typing import Any
 
+from pycram.core.runtime.lockstep import Condition
+
 __all__ = [
     "Designator",
     "DesignatorError",
@@ -182,7 +184,7 @@ class Designator:
     """
 
     def __init__(self, properties: Any = None, parent: Designator | None = None, **kwargs: Any) -> None:
-        self._mutex = threading.Condition(threading.RLock())
+        self._mutex = Condition(threading.RLock())
         self._resolving: int | None = None  # ident of the thread running _reference
         self._parent: Designator | None = None
         self._successor: Designator | None = None

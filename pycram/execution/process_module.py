@@ -60,6 +60,7 @@ from pycram.core import events
 from pycram.core.fluent import Fluent
 from pycram.core.runtime import Evaporated, current_clock, no_evaporation, wait_until
 from pycram.core.runtime.evaporation import call_plan_code, runtime_code
+from pycram.core.runtime.lockstep import Condition
 from pycram.core.runtime.suspension import on_suspension, retry_after_suspension
 from pycram.designators.core import DesignatorError, callable_name, known_solution
 from pycram.designators.motion import MotionDesignator
@@ -227,7 +228,7 @@ class ProcessModule:
 
     def __init__(self, name: str | None = None) -> None:
         self.name = name or type(self).__name__
-        self._cond = threading.Condition(threading.Lock())
+        self._cond = Condition(threading.Lock())
         self._queue: deque[Execution] = deque()
         self._current: Execution | None = None
         self._offline = False

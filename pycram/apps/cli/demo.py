@@ -50,6 +50,12 @@ def demo_command(
     animation: bool = typer.Option(
         True, "--animation/--no-animation", help="Record the animation run.gif (--no-animation: a faster run)."
     ),
+    stepping: str = typer.Option(
+        "free",
+        "--stepping",
+        help="thesis, sim backend: 'free' (the simulation runs beside the plan, as fast as it can: not "
+        "reproducible) or 'lockstep' (it stands still while plan code runs: the same run from the same seed).",
+    ),
     backend: str = typer.Option(
         "sim",
         "--backend",
@@ -79,6 +85,8 @@ def demo_command(
     if scenario not in scenarios:
         fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
     if scenario != "thesis":
+        if stepping != "free":
+            fail(f"--stepping {stepping} applies to the thesis demo only, not yet to --scenario {scenario}", code=2)
         code = trace_errors(
             get_scenario(scenario).load_demo(),
             robot=robot,
@@ -113,5 +121,6 @@ def demo_command(
         quiet=quiet,
         animation=animation,
         backend=backend,
+        stepping=stepping,
     )
     raise typer.Exit(int(code or 0))

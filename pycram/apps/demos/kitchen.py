@@ -19,13 +19,13 @@ import math
 import os
 import random
 import signal
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from pycram.apps.terminal import log_to_terminal, stderr_console, task_tree_display, write_run_pictures
+from pycram.core.runtime.lockstep import STEPPING_MODES, LockstepClock, PlanThread
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 if TYPE_CHECKING:  # imported where used: the ROS backend is optional
@@ -70,6 +70,7 @@ class DemoOptions:
     animation: bool = True  # record run.gif (False: no animation, a faster run)
     pictures: bool = True  # write start/end snapshots and the run's pictures (False: none, no folder)
     backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
+    stepping: str = "free"  # "lockstep": the simulation stands still while plan code runs (sim only)
 
 
 @dataclass
@@ -92,6 +93,7 @@ class DemoResult:
     tree_text: str = ""  # the plan's task tree as plain text, one line per task
     plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
     trace_loss: str | None = None  # "N trace records could not be written: why", if any were lost
+    final_poses: dict[str, Any] = field(default_factory=dict)  # the robot's base and the items at the end
 
     @property
     def speed_factor(self) -> float:
@@ -123,7 +125,7 @@ class PlanRun:
         self.plan, self.robot, self.facts = plan, robot, facts
         self.task: Any = None
         self.error: BaseException | None = None
-        self._thread = threading.Thread(target=self._run, name="pycram-demo-plan", daemon=True)
+        self._thread = PlanThread(target=self._run, name="pycram-demo-plan", daemon=True)
         self._started_wall = self._ended_wall = 0.0
         self._started_sim = 0.0
 
@@ -188,6 +190,10 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
         raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in robot_names():
         raise ValueError(f"--robot must be {robot_choices()}, not {options.robot!r}")
+    if options.stepping not in STEPPING_MODES:
+        raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {options.stepping!r}")
+    if options.stepping == "lockstep" and options.backend != "sim":
+        raise ValueError("--stepping lockstep needs --backend sim (over ROS the bridge keeps the time)")
     stop = stop if stop is not None else StopSignals()  # never signalled unless entered
     started_wall = time.monotonic()
     recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
@@ -265,7 +271,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
         counter_height = load_environment("thesis-kitchen").surface("cooker #1").height
     else:
-        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime)
+        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime, stepping=options.stepping)
         robot = None
         counter_height = world.environment.surface("cooker #1").height
         camera = FollowView(
@@ -305,6 +311,8 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         run = PlanRun(plan, robot, facts)
         thief.start()
         run.start(world.sim_time.get_value())
+        if isinstance(world.clock, LockstepClock):
+            world.clock.leave()  # this thread only watches (by wall time): the plan runs on
         result.message = _watch(run, world, plan, helper, thief, options, stop)
         thief.stop()
         result.plan_wall_time = run.wall_time
@@ -314,6 +322,7 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         result.failed_grasps = failed_grasps(run.task)
         result.recoveries = recoveries(run.task)
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
+        result.final_poses = {"base": world.base_pose.get_value(), **world.item_poses.get_value()}
         if options.pictures:
             world.snapshot(output / "end.png", camera=camera)
             result.files.append(output / "end.png")
@@ -547,6 +556,7 @@ def main(
     quiet: bool = False,
     animation: bool = True,
     backend: str = "sim",
+    stepping: str = "free",
 ) -> int:
     """Run the demo, print the task tree and a summary; return the process exit code (0: the item
     rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
@@ -571,6 +581,7 @@ def main(
         quiet=quiet,
         animation=animation,
         backend=backend,
+        stepping=stepping,
     )
     try:
         with StopSignals(on_second=lambda: stderr_console().show_cursor(True)) as stop:

@@ -22,6 +22,7 @@ from typing import Any
 
 from pycram.core.fluent import Fluent
 from pycram.core.runtime import sleep
+from pycram.core.runtime.lockstep import PlanThread
 from pycram.execution.process_module import ProcessModule
 from pycram.execution.robot import ResolverSet
 
@@ -161,7 +162,7 @@ class Thief:
         self.gripper, self.count, self.rng = gripper, count, rng
         self.stolen = 0
         self._stop = Fluent(name="thief.stop")
-        self._thread = threading.Thread(target=self._run, name="pycram-demo-thief", daemon=True)
+        self._thread = PlanThread(target=self._run, name="pycram-demo-thief", daemon=True)
 
     def start(self) -> None:
         if self.count > 0:

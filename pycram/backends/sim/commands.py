@@ -18,6 +18,8 @@ import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+from pycram.core.runtime.clock import ManualClock
+from pycram.core.runtime.lockstep import LockstepClock
 from pycram.world.environment import Environment
 from pycram.world.types import Outcome
 
@@ -49,6 +51,7 @@ class CommandQueue:
     _stop: threading.Event
     _active: dict[str, tuple[Controller, CommandHandle]]
     _finished: list[tuple[CommandHandle, Outcome]]
+    clock: ManualClock
 
     def submit(self, ctrl: Controller, name: str) -> CommandHandle:
         """Queue a controller for the simulation thread; returns its handle at once."""
@@ -69,11 +72,18 @@ class CommandQueue:
 
     def _drain_inbox(self) -> None:
         eng = self._engine
+        batch = []
         while True:
             try:
-                kind, ctrl, handle = self._inbox.get_nowait()
+                batch.append(self._inbox.get_nowait())
             except queue.Empty:
-                return
+                break
+        if isinstance(self.clock, LockstepClock):
+            # Lock-step: the commands sent while the simulation stood still all start at one
+            # simulated instant; take them in a canonical order (by command name; a command's
+            # own start and cancel keep their order), not in the order the plan's threads sent them.
+            batch.sort(key=lambda entry: entry[2].name)
+        for kind, ctrl, handle in batch:
             if kind == "cancel":
                 for channel, (_ctrl, h) in list(self._active.items()):
                     if h is handle:

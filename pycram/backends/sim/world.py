@@ -39,6 +39,7 @@ import numpy as np
 
 from pycram.core.fluent import Fluent
 from pycram.core.runtime.clock import ManualClock, current_clock, set_clock
+from pycram.core.runtime.lockstep import STEPPING_MODES, LockstepClock
 from pycram.environments import DEFAULT_ENVIRONMENT
 from pycram.environments import load as load_environment
 from pycram.world.environment import Environment
@@ -123,7 +124,10 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         offscreen_size: tuple[int, int] = (640, 480),
         activate_clock: bool = True,
         perception_faults: PerceptionFaults | None = None,
+        stepping: str = "free",
     ) -> None:
+        if stepping not in STEPPING_MODES:
+            raise ValueError(f"stepping must be one of {', '.join(STEPPING_MODES)}, not {stepping!r}")
         env = load_environment(environment)
         #: Faults of `detect` (none by default); its random generator is seeded from them.
         self.perception_faults = perception_faults or PerceptionFaults()
@@ -145,7 +149,11 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         self.realtime, self.realtime_factor = realtime, realtime_factor
         self._steps_per_tick = max(1, round(control_period / self.scene.model.opt.timestep))
         self._sensor_period = 1.0 / sensor_rate
-        self.clock = ManualClock(0.0)
+        #: "free" or "lockstep" (see `STEPPING_MODES`).
+        self.stepping = stepping
+        self.clock = LockstepClock(0.0) if stepping == "lockstep" else ManualClock(0.0)
+        if isinstance(self.clock, LockstepClock):
+            self.clock.enter()  # the creating thread runs the plan (or waits in PyCRAM for one)
         self._engine = Engine(self.scene, base_pose)  # touched only by the simulation thread from now on
         eng = self._engine
         # --- sensor fluents
@@ -219,6 +227,8 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
 
     def _stop_simulation(self, timeout: float) -> None:
         self._stop.set()
+        if isinstance(self.clock, LockstepClock):
+            self.clock.poke()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
@@ -252,8 +262,13 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         eng = self._engine
         next_sensor = eng.time + self._sensor_period  # the constructor published at eng.time
         wall0, sim0 = time.monotonic(), eng.time
+        lockstep = self.clock if isinstance(self.clock, LockstepClock) else None
         try:
             while not self._stop.is_set():
+                if lockstep is not None and not lockstep.quiet():
+                    # plan code runs: the world stands still (commands wait for the next step)
+                    lockstep.wait_until_quiet(self._stop.is_set)
+                    continue
                 self._drain_inbox()
                 t = eng.time
                 for channel, (ctrl, _handle) in list(self._active.items()):

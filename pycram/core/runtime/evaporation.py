@@ -36,6 +36,7 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 from pycram.core.runtime.clock import current_clock
+from pycram.core.runtime.lockstep import Condition
 
 if TYPE_CHECKING:  # the task module imports this one
     from pycram.core.runtime.task import Task, TaskGroup
@@ -268,7 +269,7 @@ class Runner:
     def sleep_condition(self) -> threading.Condition:
         condition = self._sleep
         if condition is None:
-            condition = self._sleep = threading.Condition(threading.Lock())
+            condition = self._sleep = Condition(threading.Lock())
         return condition
 
 

@@ -47,6 +47,7 @@ from typing import Any, Literal
 import pycram.core.fluent as _fluent
 from pycram.core.runtime import evaporation as _evaporation
 from pycram.core.runtime.evaporation import Evaporated, Runner, current_runner, wait_unsuspendable
+from pycram.core.runtime.lockstep import Condition
 from pycram.core.runtime.task import Task, TaskStatus, current_task, run_subtask, task_scope
 
 __all__ = [
@@ -60,7 +61,7 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-_cv = threading.Condition(threading.Lock())  # guards _counts; notified on every wake-up
+_cv = Condition(threading.Lock())  # guards _counts; notified on every wake-up
 _counts: dict[Task, int] = {}  # task -> how often it is suspended (directly)
 _local = threading.local()  # .hooks: list of (on_suspend, on_wake) of the thread, outermost first
 

@@ -32,6 +32,7 @@ from pycram.core.runtime.evaporation import (
     shielded,
     wait_until,
 )
+from pycram.core.runtime.lockstep import Condition, current_lockstep
 from pycram.core.runtime.workers import submit
 
 _P = ParamSpec("_P")
@@ -527,7 +528,7 @@ class TaskGroup:
         prepare_interrupts()
         self.parent = current_task()
         self.tasks: list[Task] = []
-        self._cv = threading.Condition(threading.Lock())
+        self._cv = Condition(threading.Lock())
         self._running = 0
         self._on_end = on_end
         if detached:  # nobody may wait for it: the branch thread that started it will
@@ -544,10 +545,24 @@ class TaskGroup:
             self._running += 1
         self.tasks.append(task)
         trace = _debugger_trace()
-        submit(lambda: self._thread_main(task, runner, fn, trace))
+        lockstep = current_lockstep()  # the branch counts as running from now on (lock-step time)
+        if lockstep is not None:
+            lockstep.spawned()
+        submit(lambda: self._thread_main(task, runner, fn, trace, lockstep))
         return task
 
-    def _thread_main(self, task: Task, runner: Runner, fn: Callable[[], Any], trace: Any = None) -> None:
+    def _thread_main(
+        self, task: Task, runner: Runner, fn: Callable[[], Any], trace: Any = None, lockstep: Any = None
+    ) -> None:
+        if lockstep is not None:
+            lockstep.adopt()
+        try:
+            self._run_branch(task, runner, fn, trace)
+        finally:
+            if lockstep is not None:
+                lockstep.ended()
+
+    def _run_branch(self, task: Task, runner: Runner, fn: Callable[[], Any], trace: Any) -> None:
         install_runner(runner)
         if trace is not None:
             sys.settrace(trace)  # a debugger's breakpoints work in the branch (see _debugger_trace)

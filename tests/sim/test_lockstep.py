@@ -1,0 +1,125 @@
+"""Lock-step simulation (issue 31, point 1): the world stands still while plan code runs, so
+the same seed gives the same run -- task tree, simulated times and final poses -- however long
+the plan thinks and whatever else the machine does."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import pytest
+
+from pycram.core.runtime.lockstep import LockstepClock, PlanThread
+from pycram.language import par
+from pycram.runtime import sleep
+from pycram.sim import World
+from pycram.trace.fingerprint import fingerprint_lines, run_fingerprint
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+def _simulated_time_while_thinking(stepping: str, seconds: float) -> tuple[float, object]:
+    """Simulated time that passes while the plan computes for `seconds` of wall time (a drive
+    under way), and where the base ends after the drive."""
+    with World("pr2", stepping=stepping) as world:
+        handle = world.drive_to(1.5, 0.6, 0.0)
+        before = world.sim_time.get_value()
+        time.sleep(seconds)  # plan code (IK, costmaps, a loaded machine): wall time, no PyCRAM wait
+        thought = world.sim_time.get_value() - before
+        assert handle.wait(30.0).succeeded
+        sleep(0.5)
+        return thought, world.base_pose.get_value()
+
+
+def test_a_plan_computing_for_a_long_wall_time_loses_no_simulated_time():
+    thought, pose = _simulated_time_while_thinking("lockstep", 0.4)
+    assert thought == 0.0
+    _, quick = _simulated_time_while_thinking("lockstep", 0.0)
+    assert pose == quick  # the same drive, to the bit, however long the plan thought
+    free, _ = _simulated_time_while_thinking("free", 0.4)
+    assert free > 0.5  # beside the plan, the simulation runs on while the plan thinks
+
+
+def test_concurrent_branches_that_compute_hold_the_simulation_until_they_wait():
+    with World("pr2", stepping="lockstep") as world:
+        starts = []
+
+        def branch(seconds: float):
+            def run():
+                deadline = time.monotonic() + seconds
+                while time.monotonic() < deadline:
+                    pass
+                starts.append(world.sim_time.get_value())
+                sleep(0.2)
+                return world.sim_time.get_value()
+
+            return run
+
+        t0 = world.sim_time.get_value()
+        state = par(branch(0.05), branch(0.3))
+        assert state.result is not None
+        assert starts == [t0, t0]  # neither branch's computing let the world run on
+        assert state.result == [pytest.approx(t0 + 0.2, abs=0.011)] * 2
+
+
+def test_a_thread_that_only_watches_leaves_and_a_plan_thread_holds_the_world():
+    with World("pr2", stepping="lockstep") as world:
+        assert isinstance(world.clock, LockstepClock) and world.clock.running == 1  # the creator
+        seen = []
+
+        def plan():
+            deadline = time.monotonic() + 0.2
+            t = world.sim_time.get_value()
+            while time.monotonic() < deadline:
+                pass
+            seen.append(world.sim_time.get_value() - t)
+            sleep(1.0)
+
+        thread = PlanThread(target=plan, daemon=True)
+        thread.start()
+        world.clock.leave()  # this thread only watches, by wall time
+        thread.join(30.0)
+        assert not thread.is_alive() and seen == [0.0]
+        assert world.sim_time.get_value() >= 1.0
+
+
+def test_an_unknown_stepping_is_refused_naming_the_choices():
+    with pytest.raises(ValueError, match="stepping must be one of free, lockstep, not 'fast'"):
+        World("pr2", stepping="fast")
+
+
+@pytest.mark.parametrize("robot", ["pr2", "tiago"])
+def test_the_thesis_demo_with_a_theft_runs_the_same_twice(robot):
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
+
+    def fingerprint():
+        options = DemoOptions(robot=robot, steal=1, seed=3, record=False, quiet=True, animation=False, pictures=False)
+        options.stepping = "lockstep"
+        result = run_demo(options)
+        assert result.exit_code == 0, result.message
+        assert result.failed_grasps == 0 and result.recoveries >= 1
+        return run_fingerprint(result.plan_task, result.final_poses), result
+
+    first, one = fingerprint()
+    second, two = fingerprint()
+    assert first == second, "\n".join(
+        line
+        for line in set(fingerprint_lines(one.plan_task, one.final_poses))
+        ^ set(fingerprint_lines(two.plan_task, two.final_poses))
+    )
+    assert one.sim_time == two.sim_time
+
+
+def test_a_divergence_is_found_and_located_by_the_fingerprint():
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
+
+    options = DemoOptions(record=False, quiet=True, animation=False, pictures=False, stepping="lockstep")
+    result = run_demo(options)
+    poses = dict(result.final_poses)
+    lines = fingerprint_lines(result.plan_task, poses)
+    base = poses["base"]
+    poses["base"] = type(base)(base.x + 2e-6, base.y, base.yaw)  # perturb one pose by 2 um
+    changed = fingerprint_lines(result.plan_task, poses)
+    assert run_fingerprint(result.plan_task, poses) != run_fingerprint(result.plan_task, result.final_poses)
+    differing = [i for i, (a, b) in enumerate(zip(lines, changed)) if a != b]
+    assert len(differing) == 1 and changed[differing[0]].startswith("pose base: ")
