@@ -194,6 +194,7 @@ def test_demo_passes_options_through(monkeypatch, db):
         quiet=True,
         animation=False,
         backend="ros",
+        stepping="free",
     )
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")
@@ -223,6 +224,12 @@ def test_demo_output_that_cannot_be_written_is_one_line_and_exit_2(fake_demo, tm
         lines = result.output.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error: --output"), result.output
         assert expected in lines[0] and "Traceback" not in result.output
+    assert fake_demo == []
+    # where permission bits say yes but nothing can be made (a pseudo file system)
+    result = _invoke("demo", "--no-record", "--output", "/proc/pycram-nope")
+    assert result.exit_code == 2 and "Traceback" not in result.output, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "cannot create a folder in /proc" in lines[0], result.output
     assert fake_demo == []
     assert _invoke("demo", "--output", str(tmp_path / "new" / "folder")).exit_code == 0
     assert not (tmp_path / "new").exists()  # the check creates nothing; the demo does

@@ -6,6 +6,7 @@ from __future__ import annotations
 import datetime as _dt
 import logging
 import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -127,8 +128,9 @@ def record_flag(record: bool | None) -> bool:
 def check_output_folder(output: str) -> None:
     """Refuse (exit code 2, one line) an `--output` folder that cannot be created or written.
 
-    Creates nothing: the folder must be a writable directory, or its nearest existing ancestor
-    must be one (the demo creates the rest).
+    Leaves nothing behind: the folder must be a writable directory, or its nearest existing
+    ancestor must be one in which a folder can really be made (tried with a temporary folder,
+    removed at once: permission bits do not tell, e.g. in /proc or on a read-only file system).
     """
 
     path = Path(output).expanduser()
@@ -141,3 +143,7 @@ def check_output_folder(output: str) -> None:
         fail(f"--output {output}: cannot create the folder, {existing} is not a folder", code=2)
     if not os.access(existing, os.W_OK | os.X_OK):
         fail(f"--output {output}: cannot write to {existing} (permission denied)", code=2)
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".pycram-probe-", dir=existing))
+    except OSError as e:
+        fail(f"--output {output}: cannot create a folder in {existing} ({e.strerror or e})", code=2)
