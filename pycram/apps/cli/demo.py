@@ -53,8 +53,8 @@ def demo_command(
     stepping: str = typer.Option(
         "free",
         "--stepping",
-        help="thesis, sim backend: 'free' (the simulation runs beside the plan, as fast as it can: not "
-        "reproducible) or 'lockstep' (it stands still while plan code runs: the same run from the same seed).",
+        help="'free' (the simulation runs beside the plan, as fast as it can: not reproducible) or "
+        "'lockstep' (it stands still while plan code runs: the same run from the same seed; sim backend).",
     ),
     backend: str = typer.Option(
         "sim",
@@ -85,8 +85,6 @@ def demo_command(
     if scenario not in scenarios:
         fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
     if scenario != "thesis":
-        if stepping != "free":
-            fail(f"--stepping {stepping} applies to the thesis demo only, not yet to --scenario {scenario}", code=2)
         code = trace_errors(
             get_scenario(scenario).load_demo(),
             robot=robot,
@@ -97,6 +95,7 @@ def demo_command(
             record=record_flag(record),
             quiet=quiet,
             animation=animation,
+            stepping=stepping,
         )
         raise typer.Exit(int(code or 0))
     if faults:

@@ -125,7 +125,7 @@ class PlanRun:
         self.plan, self.robot, self.facts = plan, robot, facts
         self.task: Any = None
         self.error: BaseException | None = None
-        self._thread = PlanThread(target=self._run, name="pycram-demo-plan", daemon=True)
+        self._thread = PlanThread(target=self._run, name="pycram-demo-plan", daemon=True, hand_over=True)
         self._started_wall = self._ended_wall = 0.0
         self._started_sim = 0.0
 
@@ -314,6 +314,8 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         if isinstance(world.clock, LockstepClock):
             world.clock.leave()  # this thread only watches (by wall time): the plan runs on
         result.message = _watch(run, world, plan, helper, thief, options, stop)
+        if isinstance(world.clock, LockstepClock):
+            world.clock.adopt()  # the plan ended (or was stopped): the world stands as it left it
         thief.stop()
         result.plan_wall_time = run.wall_time
         result.sim_time = run.sim_time(world.sim_time.get_value())

@@ -78,8 +78,8 @@ class Scenario:
     """A registered scenario: its `name`, the function (`target`: a callable or an import path
     `"module:function"`), the fault names it knows (`faults`, None when it does not say), the
     robots it runs on, and its terminal front end for `pycram demo --scenario NAME` (`demo`: an
-    import path of ``main(robot, seed, faults, output, db, record, quiet, animation) -> exit
-    code``; None when `pycram demo` does not run it)."""
+    import path of ``main(robot, seed, faults, output, db, record, quiet, animation, stepping) ->
+    exit code``; None when `pycram demo` does not run it)."""
 
     name: str
     target: ScenarioFunction | str

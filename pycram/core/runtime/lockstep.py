@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from typing import Any
 
 from pycram.core.runtime.clock import ManualClock, current_clock
 
@@ -142,6 +143,13 @@ class LockstepClock(ManualClock):
             if self._threads.pop(threading.get_ident(), _RUNNING) != _BLOCKED:
                 self._less()
 
+    def hand_over(self) -> None:
+        """The calling thread ends, but the world keeps standing still for whoever `adopt`s its
+        count next (a driver that watched the plan and now judges the world it left)."""
+        with self._quiet:
+            if self._threads.pop(threading.get_ident(), _RUNNING) == _BLOCKED:
+                self._running += 1
+
     def _less(self) -> None:
         self._running -= 1
         if self._running == 0:
@@ -173,7 +181,16 @@ class Condition(threading.Condition):
 class PlanThread(threading.Thread):
     """A `threading.Thread` that is a plan thread of the lock-step clock active when it is
     started (if any), from `start()` to the end of its target -- as a task's thread is: the
-    simulation does not step between its start and its first wait. Otherwise a plain thread."""
+    simulation does not step between its start and its first wait. Otherwise a plain thread.
+
+    With `hand_over`, its end does not let the world run on: the thread that joins it takes its
+    count over with `LockstepClock.adopt()` (the world the plan left is judged as it was left).
+    """
+
+    def __init__(self, *args: Any, hand_over: bool = False, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._hand_over = hand_over
+        self._lockstep: LockstepClock | None = None
 
     def start(self) -> None:
         self._lockstep = current_lockstep()
@@ -189,4 +206,4 @@ class PlanThread(threading.Thread):
             super().run()
         finally:
             if lockstep is not None:
-                lockstep.ended()
+                lockstep.hand_over() if self._hand_over else lockstep.ended()

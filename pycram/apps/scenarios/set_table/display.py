@@ -15,6 +15,7 @@ from typing import Any
 from pycram.apps.scenarios.set_table.data import OBJECTS
 from pycram.apps.scenarios.set_table.driver import _check, run_scenario
 from pycram.apps.scenarios.set_table.judge import SetTableResult
+from pycram.core.runtime.lockstep import STEPPING_MODES
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 __all__ = ["main", "main_on_open_surfaces"]
@@ -35,6 +36,7 @@ def main(
     quiet: bool = False,
     animation: bool = True,
     in_containers: bool = True,
+    stepping: str = "free",
 ) -> int:
     """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
     tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
@@ -52,6 +54,8 @@ def main(
     console = Console()
     try:
         kinds = _check(robot, seed, faults)
+        if stepping not in STEPPING_MODES:
+            raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {stepping!r}")
     except ValueError as error:
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
         return 2
@@ -90,6 +94,7 @@ def main(
             animation=animation,
             progress=progress,
             in_containers=in_containers,
+            stepping=stepping,
         )
     finally:
         if live is not None:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import logging
 import random
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
 from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
 from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
+from pycram.core.runtime.lockstep import LockstepClock, PlanThread
 
 __all__ = [
     "open_world",
@@ -43,7 +43,7 @@ class _PlanThread:
         self.task: Any = None
         self.error: BaseException | None = None
         self.outcomes: list[SettingOutcome] | None = None
-        self._thread = threading.Thread(target=self._run, name="pycram-set-table", daemon=True)
+        self._thread = PlanThread(target=self._run, name="pycram-set-table", daemon=True, hand_over=True)
 
     def _run(self) -> None:
         from pycram.apps.scenarios.set_table.plan import set_table
@@ -80,11 +80,12 @@ def open_world(
     faults: frozenset[str] = frozenset(),
     objects: tuple[str, ...] = OBJECTS,
     in_containers: bool = True,
+    stepping: str = "free",
 ) -> tuple[Any, list[Any]]:
     """The apartment with the scenario's objects at random spots from `seed` (`start_scene`,
     some inside closed containers with `in_containers`) and `robot` at the start pose
-    (perception misses detections with the ``missed`` fault). Returns the world and the
-    placements."""
+    (perception misses detections with the ``missed`` fault), simulated with `stepping` ("free"
+    or "lockstep", see `pycram.sim.World`). Returns the world and the placements."""
     from pycram.backends.sim import ItemSpec, World
     from pycram.backends.sim.perception import PerceptionFaults
     from pycram.environments import load as load_environment
@@ -93,7 +94,7 @@ def open_world(
     placements = start_scene(load_environment("apartment"), seed, objects, in_containers)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
-    world = World(robot, items, environment="apartment", perception_faults=perception)
+    world = World(robot, items, environment="apartment", perception_faults=perception, stepping=stepping)
     return world, placements
 
 
@@ -118,19 +119,21 @@ def run_scenario(
     progress: Any = None,
     objects: tuple[str, ...] = OBJECTS,
     in_containers: bool = True,
+    stepping: str = "free",
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
     `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
     faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
-    objects may start inside closed containers (`start_scene`). Returns the
-    result and the plan's task (the root of its task tree, None if it never started)."""
+    objects may start inside closed containers (`start_scene`); `stepping`: "lockstep" for a
+    run that depends on the seed alone (see `pycram.sim.World`). Returns the result and the
+    plan's task (the root of its task tree, None if it never started)."""
     from pycram import robots as robot_packages
 
     kinds = _check(robot, seed, faults)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
-    world, placements = open_world(robot, seed, kinds, objects, in_containers)
+    world, placements = open_world(robot, seed, kinds, objects, in_containers, stepping)
     result.started_in = {p.name: p.container for p in placements if p.container is not None}
     plan: _PlanThread | None = None
     injector: Faults | None = None
@@ -152,6 +155,8 @@ def run_scenario(
         sim_start = world.sim_time.get_value()
         injector.start()
         plan.start()
+        if isinstance(world.clock, LockstepClock):
+            world.clock.leave()  # this thread only watches (by wall time): the plan runs on
         sim_deadline, wall_deadline = sim_start + SIM_TIME_LIMIT, time.monotonic() + WALL_TIME_LIMIT
         while not plan.join(0.25):
             if progress is not None:
@@ -164,6 +169,8 @@ def run_scenario(
                 log.warning("stopping the plan: %s", result.error)
                 plan.stop()
                 break
+        if isinstance(world.clock, LockstepClock):
+            world.clock.adopt()  # the plan ended (or was stopped): the world stands as it left it
         injector.stop()
         held_at_once.stop()
         result.concurrency = {**plan.record.as_dict(), "most_held_at_once": held_at_once.most}
@@ -172,6 +179,7 @@ def run_scenario(
             result.error = f"{type(plan.error).__name__}: {plan.error}"
         result.faults_injected = list(injector.injected)
         judge(world, settings, plan.outcomes, result)
+        result.final_poses = {"base": world.base_pose.get_value(), **world.item_poses.get_value()}
         if output is not None:
             world.snapshot(output / "end.png", camera=camera)
             if animation:

@@ -16,6 +16,7 @@ from typing import Any
 
 from pycram.apps.scenarios.set_table.data import FAULTS, START_REGIONS, WALL_TIME_LIMIT
 from pycram.apps.scenarios.set_table.plan import PlaceSetting
+from pycram.core.runtime.lockstep import PlanThread
 
 __all__ = [
     "check_faults",
@@ -76,7 +77,7 @@ class Faults:
             self.world.set_container_stuck(self.stuck_drawer, True).wait(10.0)
         for kind, job in jobs.items():
             if kind in self.kinds:
-                thread = threading.Thread(target=self._guard(job), name=f"pycram-fault-{kind}", daemon=True)
+                thread = PlanThread(target=self._guard(job), name=f"pycram-fault-{kind}", daemon=True)
                 self._threads.append(thread)
                 thread.start()
 

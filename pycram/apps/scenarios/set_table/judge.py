@@ -66,6 +66,8 @@ class SetTableResult:
     concurrency: dict[str, Any] = field(default_factory=dict)
     #: Object -> the closed container it started in (the others started on open surfaces).
     started_in: dict[str, str] = field(default_factory=dict)
+    #: The robot's base and every object at the end (the simulator's truth; for fingerprints).
+    final_poses: dict[str, Any] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
