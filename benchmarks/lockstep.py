@@ -1,0 +1,109 @@
+"""The price of lock-step (issue 31): simulated time / wall time of whole runs, free-running and
+in lock-step, each beside the speed of stepping the same scene's physics alone.
+
+For each robot, in one process:
+- **physics alone**: `mj_step` on a copy of the scene's model and data, for `--physics`
+  seconds of simulated time, nothing else running (the ceiling of any run);
+- **thesis demo** (a theft, seed 3; no recording, no pictures): free and lock-step;
+- **set-table** (seed 7; no faults, no pictures): free and lock-step.
+Each run prints its simulated time, its wall time, the speed (sim / wall) and that speed as a
+share of physics alone; lock-step runs also print their fingerprint, which repeats run after run
+(free-running ones differ). The target of issue 31: a set-table run at >= 70 % of physics
+alone in lock-step.
+
+    MUJOCO_GL=egl .venv/bin/python benchmarks/lockstep.py [--robots pr2,tiago] [--repeat 2]
+        [--physics 30] [--skip-set-table]
+
+Numbers depend on the machine's load; run it on an otherwise idle machine for the record.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+def physics_alone(robot: str, environment: str, seconds: float) -> float:
+    """Simulated seconds per wall second of bare `mj_step` on a copy of the scene."""
+    import mujoco
+
+    from pycram.backends.sim.scene import build_scene
+
+    scene = build_scene(robot=robot, environment=environment)
+    model = scene.model
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    steps = int(seconds / model.opt.timestep)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    return steps * model.opt.timestep / (time.perf_counter() - t0)
+
+
+def thesis(robot: str, stepping: str) -> tuple[float, float, str]:
+    from pycram.apps.demos.kitchen import DemoOptions, run_demo
+    from pycram.trace.fingerprint import run_fingerprint
+
+    options = DemoOptions(robot=robot, steal=1, seed=3, record=False, quiet=True, animation=False, pictures=False)
+    options.stepping = stepping
+    t0 = time.perf_counter()
+    result = run_demo(options)
+    wall = time.perf_counter() - t0
+    return result.sim_time, wall, run_fingerprint(result.plan_task, result.final_poses)[:12]
+
+
+def set_table(robot: str, stepping: str) -> tuple[float, float, str]:
+    from pycram.apps.scenarios.set_table.driver import run_scenario
+    from pycram.trace.fingerprint import run_fingerprint
+
+    t0 = time.perf_counter()
+    result, task = run_scenario(robot, 7, frozenset(), stepping=stepping)
+    wall = time.perf_counter() - t0
+    return result.sim_time, wall, run_fingerprint(task, result.final_poses)[:12]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robots", default="pr2,tiago")
+    parser.add_argument("--repeat", type=int, default=2, help="runs per scenario and stepping")
+    parser.add_argument("--physics", type=float, default=30.0, help="simulated seconds of physics alone")
+    parser.add_argument("--skip-set-table", action="store_true")
+    args = parser.parse_args()
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="lock-step vs free-running (sim / wall: x real time; share: of physics alone)")
+    for column in ("robot", "run", "stepping", "sim [s]", "wall [s]", "x real time", "share", "fingerprint"):
+        table.add_column(column, justify="right" if column not in ("robot", "run", "stepping") else "left")
+    for robot in args.robots.split(","):
+        cases = [("thesis demo", "thesis-kitchen", thesis)]
+        if not args.skip_set_table:
+            cases.append(("set-table", "apartment", set_table))
+        for name, environment, run in cases:
+            ceiling = physics_alone(robot, environment, args.physics)
+            table.add_row(robot, name, "physics alone", "", "", f"{ceiling:.1f}", "100 %", "")
+            for stepping in ("free", "lockstep"):
+                for _ in range(args.repeat):
+                    sim, wall, fingerprint = run(robot, stepping)
+                    speed = sim / wall if wall > 0 else 0.0
+                    table.add_row(
+                        robot,
+                        name,
+                        stepping,
+                        f"{sim:.2f}",
+                        f"{wall:.1f}",
+                        f"{speed:.1f}",
+                        f"{100 * speed / ceiling:.0f} %",
+                        fingerprint,
+                    )
+    Console(width=140).print(table)
+
+
+if __name__ == "__main__":
+    main()
