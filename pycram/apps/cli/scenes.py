@@ -59,7 +59,9 @@ def scene_command(
 
     types = [t.strip() for t in objects.split(",") if t.strip()]
     try:
-        world = World(robot, environment=env, seed=seed, objects=types or None, offscreen_size=VIEW_SIZE)
+        world = World(
+            robot, environment=env, seed=seed, objects=types or None, offscreen_size=VIEW_SIZE, stepping="lockstep"
+        )
     except (KeyError, PlacementError) as e:
         fail(str(e).strip("'\""))
     if costmap:
