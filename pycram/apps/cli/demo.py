@@ -84,19 +84,19 @@ def demo_command(
     scenarios = ["thesis", *demo_scenario_names()]  # the thesis demo has options of its own
     if scenario not in scenarios:
         fail(f"--scenario: unknown scenario {scenario!r}; valid scenarios: {', '.join(scenarios)}", code=2)
+    # the options every scenario's front end takes (the thesis demo has more of its own)
+    common = dict(
+        robot=robot,
+        seed=seed,
+        output=output,
+        db=db,
+        record=record_flag(record),
+        quiet=quiet,
+        animation=animation,
+        stepping=stepping,
+    )
     if scenario != "thesis":
-        code = trace_errors(
-            get_scenario(scenario).load_demo(),
-            robot=robot,
-            seed=seed,
-            faults=faults,
-            output=output,
-            db=db,
-            record=record_flag(record),
-            quiet=quiet,
-            animation=animation,
-            stepping=stepping,
-        )
+        code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
         raise typer.Exit(int(code or 0))
     if faults:
         fail("--faults applies to --scenario set-table only (the thesis demo has --steal)", code=2)
@@ -108,18 +108,11 @@ def demo_command(
         fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
     code = trace_errors(
         demo_main,
-        robot=robot,
-        output=output,
         item_at=item_at,
         steal=steal,
-        seed=seed,
         realtime=realtime,
         interactive=interactive,
-        db=db,
-        record=record_flag(record),
-        quiet=quiet,
-        animation=animation,
         backend=backend,
-        stepping=stepping,
+        **common,
     )
     raise typer.Exit(int(code or 0))
