@@ -787,6 +787,30 @@ def measure_pycram(cfg: argparse.Namespace) -> dict[str, Any]:
     return r
 
 
+def measure_turns(cfg: argparse.Namespace) -> dict[str, Any]:
+    """`seq`, `par` and wake latency with a `LockstepClock` active and the measuring thread a
+    plan thread: plan threads take turns, one at a time in task order (what a lock-step
+    simulation does, issue 31), instead of running side by side."""
+    from pycram.core.runtime.clock import current_clock, set_clock
+    from pycram.core.runtime.lockstep import LockstepClock
+
+    clock = LockstepClock()
+    previous = current_clock()
+    set_clock(clock)
+    clock.enter()
+    try:
+        r: dict[str, Any] = {}
+        r["seq"], _ = median_of(pycram_seq, cfg.repeat, warmup=3)
+        r["par"], _ = median_of(pycram_par, cfg.repeat, warmup=3)
+        clock.leave()  # the waker is no plan thread: it waits for the waiter with plain primitives
+        r["wake_fluent"] = pycram_wake(cfg.wake_samples, network=False)
+    finally:
+        clock.leave()
+        set_clock(previous)
+        shutdown_idle_workers()
+    return r
+
+
 def measure_floor(cfg: argparse.Namespace) -> dict[str, Any]:
     r: dict[str, Any] = {}
     floor_wake(200)
@@ -906,6 +930,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer repetitions (smoke run)")
     parser.add_argument("--record", action="store_true", help="also measure PyCRAM with recording on")
     parser.add_argument("--db", default=None, help="recording URL (default: temporary SQLite file)")
+    parser.add_argument(
+        "--turns",
+        action="store_true",
+        help="also measure seq, par and wake with lock-step turns (one thread at a time)",
+    )
     cfg = parser.parse_args(argv)
     cfg.wake_samples = 300 if cfg.quick else 3000
     cfg.pytrees_wake_samples = 100 if cfg.quick else 500
@@ -950,6 +979,23 @@ def main(argv: list[str] | None = None) -> int:
                     pc["import_cli"] > TARGETS["import"],
                 )
             )
+    if cfg.turns:
+        gc.collect()
+        turns = measure_turns(cfg)
+        table = Table(title="lock-step turns: one plan thread at a time (LockstepClock, no simulation)")
+        for column in ("figure", "turns", "threads side by side", "target"):
+            table.add_column(column, justify="left" if column == "figure" else "right")
+        table.add_row("seq of 1,000 no-op steps", fmt_time(turns["seq"]), fmt_time(pc["seq"]), fmt_time(TARGETS["seq"]))
+        table.add_row(
+            "par of 100 no-op branches", fmt_time(turns["par"]), fmt_time(pc["par"]), fmt_time(TARGETS["par"])
+        )
+        table.add_row(
+            "wake latency p50 (from a thread outside the plan)",
+            fmt_time(pct(turns["wake_fluent"], 50)),
+            fmt_time(pct(pc["wake_fluent"], 50)),
+            fmt_time(TARGETS["wake"]),
+        )
+        console.print(table)
     console.print(
         "Evaporation is timed from the winner's last statement to the loser's status becoming "
         "EVAPORATED (probe fluent pulsed inside Task._end). For the busy loser the pursue thread, "

@@ -5,14 +5,17 @@ For each robot, in one process:
 - **physics alone**: `mj_step` on a copy of the scene's model and data, for `--physics`
   seconds of simulated time, nothing else running (the ceiling of any run);
 - **thesis demo** (a theft, seed 3; no recording, no pictures): free and lock-step;
-- **set-table** (seed 7; no faults, no pictures): free and lock-step.
+- **set-table** (seed 7; no faults, no pictures): free and lock-step;
+- **experiment throughput** (`--throughput N`): the thesis scenario with a theft on seeds 1-N,
+  in lock-step, with 1 and then 2 local worker processes: runs per minute of wall time, and
+  whether every seed's result (simulated time, success) is the same with 1 and with 2 workers.
 Each run prints its simulated time, its wall time, the speed (sim / wall) and that speed as a
 share of physics alone; lock-step runs also print their fingerprint, which repeats run after run
 (free-running ones differ). The target of issue 31: a set-table run at >= 70 % of physics
 alone in lock-step.
 
     MUJOCO_GL=egl .venv/bin/python benchmarks/lockstep.py [--robots pr2,tiago] [--repeat 2]
-        [--physics 30] [--skip-set-table]
+        [--physics 30] [--skip-set-table] [--throughput 8]
 
 Numbers depend on the machine's load; run it on an otherwise idle machine for the record.
 """
@@ -68,12 +71,35 @@ def set_table(robot: str, stepping: str) -> tuple[float, float, str]:
     return result.sim_time, wall, run_fingerprint(task, result.final_poses)[:12]
 
 
+def throughput(seeds: int, workers: int) -> tuple[float, dict[int, tuple[float, bool]]]:
+    """Runs per minute of wall time of the thesis scenario (a theft, lock-step) on seeds
+    1..`seeds` with `workers` local processes, and each seed's (simulated time, success)."""
+    import tempfile
+
+    from pycram.apps.experiments.runner import prepare_experiment, run_experiment
+
+    with tempfile.TemporaryDirectory() as folder:
+        db = str(Path(folder) / "throughput.sqlite3")
+        prepared = prepare_experiment(scenario="thesis", seeds=f"1-{seeds}", faults=["steal"], db=db)
+        results: dict[int, tuple[float, bool]] = {}
+
+        def finished(key, result):
+            if result is not None:
+                results[key[1]] = (round(float(result["sim_time"]), 6), bool(result["success"]))
+
+        t0 = time.perf_counter()
+        run_experiment(prepared, workers=workers, progress=finished)
+        wall = time.perf_counter() - t0
+    return 60.0 * len(results) / wall, results
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", default="pr2,tiago")
     parser.add_argument("--repeat", type=int, default=2, help="runs per scenario and stepping")
     parser.add_argument("--physics", type=float, default=30.0, help="simulated seconds of physics alone")
     parser.add_argument("--skip-set-table", action="store_true")
+    parser.add_argument("--throughput", type=int, default=0, help="seeds of the experiment throughput (0: skip)")
     args = parser.parse_args()
     from rich.console import Console
     from rich.table import Table
@@ -102,7 +128,21 @@ def main() -> None:
                         f"{100 * speed / ceiling:.0f} %",
                         fingerprint,
                     )
-    Console(width=140).print(table)
+    console = Console(width=140)
+    console.print(table)
+    if args.throughput:
+        per_minute = {}
+        for workers in (1, 2):
+            per_minute[workers] = throughput(args.throughput, workers)
+            console.print(
+                f"experiment throughput, thesis with a theft, seeds 1-{args.throughput}, lock-step, "
+                f"{workers} worker(s): {per_minute[workers][0]:.1f} runs/min"
+            )
+        same = per_minute[1][1] == per_minute[2][1]
+        console.print(
+            f"the same results with 1 and 2 workers: {'yes' if same else 'NO'} "
+            f"({len(per_minute[1][1])} seeds; speed-up {per_minute[2][0] / per_minute[1][0]:.2f}x)"
+        )
 
 
 if __name__ == "__main__":

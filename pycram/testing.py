@@ -177,8 +177,10 @@ def scenario_double(
     faults: frozenset[str] = frozenset(),
     db_url: str | None = None,
     pictures: bool = False,
+    stepping: str = "lockstep",
 ) -> dict[str, Any]:
-    """A scripted experiment scenario (no simulation): the result of a `pycram experiment` run.
+    """A scripted experiment scenario (no simulation): the result of a `pycram experiment` run
+    (`stepping` is only passed back in the result).
 
     Succeeds unless `"drop"` is among `faults` and the seed is divisible by 3 (then the cause is
     `ObjectSlipped`); `sim_time` is 10 + seed % 7 [s] (twice that with `"slow"`). Knows the
@@ -221,6 +223,7 @@ def scenario_double(
         "robot": robot,
         "seed": seed,
         "faults": sorted(faults),
+        "stepping": stepping,
         "success": not failed,
         "objects": {"cup": {"placed": not failed, "failure": "ObjectSlipped" if failed else None, "reason": None}},
         "failure_causes": ["ObjectSlipped"] if failed else [],

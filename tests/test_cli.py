@@ -194,7 +194,7 @@ def test_demo_passes_options_through(monkeypatch, db):
         quiet=True,
         animation=False,
         backend="ros",
-        stepping="free",
+        stepping=None,  # the backend's own: lock-step in the simulator, the bridge's time over ROS
     )
     monkeypatch.setenv("PYCRAM_RECORD", "0")
     _invoke("demo")

@@ -300,3 +300,32 @@ def test_a_scenario_registered_in_the_driver_runs_in_the_workers(tmp_path):
         assert _rows(db, "pycram_experiments")[0]["scenario"] == "double"
     finally:
         SCENARIOS.pop("double", None)
+
+
+def test_the_stepping_is_recorded_passed_to_every_run_and_kept_on_resume(tmp_path):
+    """Runs simulate in lock-step unless `--stepping free` is asked for; the experiment keeps
+    its stepping, and a resume asking for another is refused (exit 2, one line)."""
+    db = tmp_path / "t.sqlite3"
+    common = ["--db", str(db), "--output", str(tmp_path / "out"), "--workers", "1"]
+    for name, extra, expected in (("a", [], "lockstep"), ("b", ["--stepping", "free"], "free")):
+        result = runner.invoke(
+            app, ["experiment", "--scenario", DOUBLE, "--seeds", "1-2", "--name", name, *extra, *common]
+        )
+        assert result.exit_code == 0, result.output
+        experiment = next(r for r in _rows(db, "pycram_experiments") if r["name"] == name)
+        assert json.loads(experiment["info"]) == {"stepping": expected}
+        runs = [r for r in _rows(db, "pycram_experiment_runs") if r["experiment_id"] == experiment["id"]]
+        assert [json.loads(r["result"])["stepping"] for r in runs] == [expected, expected]
+    refused = runner.invoke(app, ["experiment", "--resume", "b", "--stepping", "lockstep", *common])
+    assert refused.exit_code == 2
+    assert "was recorded with --stepping free, not lockstep" in " ".join(refused.output.split())
+    bad = runner.invoke(app, ["experiment", "--scenario", DOUBLE, "--seeds", "1", "--stepping", "fast", *common])
+    assert bad.exit_code == 2 and "--stepping must be free or lockstep, not 'fast'" in " ".join(bad.output.split())
+
+
+def test_a_scenario_without_a_stepping_argument_runs_only_in_the_default_stepping():
+    from pycram.apps.experiments.runner import execute_run
+
+    spec = "pycram.apps.experiments.scenarios:_thesis_options"  # takes (seed, faults): no stepping
+    result = execute_run(spec, "pr2", 1, "", None, record=False, stepping="free")
+    assert result["failure_causes"] == ["ValueError"] and "takes no 'stepping' argument" in result["error"]

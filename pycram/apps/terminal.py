@@ -12,7 +12,17 @@ import logging
 from pathlib import Path
 from typing import Any
 
-__all__ = ["stderr_console", "log_to_terminal", "task_tree_display", "write_run_pictures"]
+__all__ = [
+    "STOP_PICTURE_SIZE",
+    "stderr_console",
+    "log_to_terminal",
+    "task_tree_display",
+    "write_run_pictures",
+    "write_stop_pictures",
+]
+
+#: The offscreen size [px] a world needs for `write_stop_pictures` (the scene picture's views).
+STOP_PICTURE_SIZE = (1200, 900)
 
 log = logging.getLogger("pycram.demo")
 
@@ -89,3 +99,39 @@ def write_run_pictures(run_id: Any, plan_task: Any, output: Path, url: str | Non
     if plan_task is None:
         return []
     return list(write_task_pictures(plan_task, output))
+
+
+def write_stop_pictures(world: Any, belief: Any, plan_task: Any, folder: Path, title: str) -> list[Path]:
+    """What a run looked like where it was stopped (`pycram demo --until T`), into `folder`:
+    ``scene.png`` (the labelled scene: plan and overview, `write_scene_picture`), ``belief.png``
+    (what the robot believed beside what was, `write_belief_picture`), ``task-tree.txt`` (the
+    task tree so far as text: tasks still running have no end time), ``task-tree.svg`` and
+    ``timeline.png``. `world` is a simulated world standing still (`World.hold_at`) built with an
+    offscreen size of at least `STOP_PICTURE_SIZE`; `belief` the robot's belief (None: no
+    belief picture). A picture that cannot be drawn is logged and left out; returns the paths
+    written."""
+    from pycram.apps.demos.belief_picture import write_belief_picture
+    from pycram.apps.demos.scene_picture import write_scene_picture
+    from pycram.core.runtime import format_task_tree
+
+    folder.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    if plan_task is not None:  # first: the tree as it stands, before anything else can change it
+        tree = folder / "task-tree.txt"
+        tree.write_text(format_task_tree(plan_task) + "\n", encoding="utf-8")
+        written.append(tree)
+    steps: list[tuple[str, Any]] = [("scene.png", lambda path: write_scene_picture(world, path, title=title))]
+    if belief is not None:
+        steps.append(("belief.png", lambda path: write_belief_picture(world, belief, path, title=f"{title}: belief")))
+    for name, draw in steps:
+        try:
+            written.append(draw(folder / name))
+        except Exception as error:  # noqa: BLE001 - a picture never fails the run
+            log.warning("cannot draw %s: %s: %s", name, type(error).__name__, error)
+    if plan_task is not None:
+        try:
+            from pycram.trace.pictures import write_task_pictures
+        except ImportError:
+            return written
+        written.extend(write_task_pictures(plan_task, folder, title=title))
+    return written

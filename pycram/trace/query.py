@@ -61,6 +61,7 @@ __all__ = [
     "RunNotFound",
     "runs",
     "get_run",
+    "find_run",
     "tasks",
     "task_tree",
     "failed_tasks",
@@ -328,6 +329,27 @@ def get_run(run_id: int | None = None, url: str | None = None) -> RunInfo:
         newest = db.rows(sa.select(sa.func.min(runs_table.c.id), sa.func.max(runs_table.c.id)))
         known = f"runs {newest[0][0]}..{newest[0][1]} exist" if newest and newest[0][0] is not None else "no runs exist"
         raise RunNotFound(f"no run {run_id} in this database ({known})")
+    return _run_info(found[0])
+
+
+def find_run(run: str | int | None, url: str | None = None) -> RunInfo:
+    """The run named by `run`: its id (an int or a string of digits), its uuid or a unique
+    prefix of at least 4 characters of it, or the newest run when None. Raises `RunNotFound`
+    (also for a prefix that several runs share)."""
+    if run is None or isinstance(run, int):
+        return get_run(run, url)
+    text = str(run).strip()
+    if text.isdigit():
+        return get_run(int(text), url)
+    if len(text) < 4:
+        raise RunNotFound(f"no run {text!r}: give a run id or (a prefix of at least 4 characters of) a uuid")
+    db = _Reading(url)
+    stmt = sa.select(*db.columns(runs_table, RunInfo)).where(runs_table.c.uuid.like(f"{text}%")).limit(2)
+    found = db.rows(stmt)
+    if not found:
+        raise RunNotFound(f"no run with uuid {text!r} in this database")
+    if len(found) > 1:
+        raise RunNotFound(f"several runs have a uuid starting with {text!r}: give more of it")
     return _run_info(found[0])
 
 

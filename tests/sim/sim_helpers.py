@@ -80,8 +80,14 @@ class _Trigger(Fluent):
 def wait_wall(predicate: Callable[[], bool], fluents: Iterable[Fluent], timeout: float = 60.0) -> bool:
     """Wait until `predicate()` holds, re-checked whenever one of `fluents` is published, for at
     most `timeout` [s of wall time] (independent of whichever PyCRAM clock is active)."""
+    from pycram.core.runtime.lockstep import current_lockstep
+
     trigger = _Trigger(predicate, fluents)
-    return trigger.event.wait(timeout)
+    lockstep = current_lockstep()
+    if lockstep is None:
+        return trigger.event.wait(timeout)
+    with lockstep.watching():  # a lock-step world runs on while this thread waits by wall time
+        return trigger.event.wait(timeout)
 
 
 class ViewMonitor(Controller):

@@ -62,6 +62,37 @@ def test_concurrent_branches_that_compute_hold_the_simulation_until_they_wait():
         assert state.result == [pytest.approx(t0 + 0.2, abs=0.011)] * 2
 
 
+def test_branches_take_turns_one_at_a_time_in_task_order():
+    # three branches compute for different wall times between waits on simulated time: with
+    # turns, no two ever run at once, and at each instant they run in the order they were
+    # started -- never in the order the operating system happened to schedule them
+    with World("pr2") as world:
+        log, running, overlaps = [], [0], []
+
+        def branch(i: int):
+            def run():
+                for step in range(3):
+                    running[0] += 1
+                    if running[0] > 1:
+                        overlaps.append((i, step))
+                    log.append((i, step, world.sim_time.get_value()))
+                    deadline = time.monotonic() + 0.004 * (3 - i)  # the first computes longest
+                    while time.monotonic() < deadline:
+                        pass
+                    running[0] -= 1
+                    sleep(0.05)
+
+            return run
+
+        t0 = world.sim_time.get_value()
+        par(branch(0), branch(1), branch(2))
+        assert overlaps == []
+        assert [(i, step) for i, step, _ in log] == [(i, step) for step in range(3) for i in range(3)]
+        assert [t for *_, t in log] == [
+            pytest.approx(t0 + 0.05 * step, abs=0.011) for step in range(3) for _ in range(3)
+        ]
+
+
 def test_a_thread_that_only_watches_leaves_and_a_plan_thread_holds_the_world():
     with World("pr2", stepping="lockstep") as world:
         assert isinstance(world.clock, LockstepClock) and world.clock.running == 1  # the creator
@@ -156,3 +187,55 @@ def test_pycram_scene_writes_the_same_picture_for_the_same_arguments(tmp_path):
         assert result.exit_code == 0, result.output
         pictures.append((tmp_path / name).read_bytes())
     assert len(pictures[0]) > 10_000 and pictures[0] == pictures[1]
+
+
+def _random_transport(seed: int) -> tuple[list[str], bool]:
+    """Transport the cup of a random apartment scene (`seed`: where it and two other objects
+    start, on open surfaces) to the table or, from the table, to the counter; returns the
+    fingerprint lines of the transport's task tree and the final poses, and whether it worked."""
+    from action_helpers import run_as_task
+
+    from pycram import robots
+    from pycram.actions import ParkArms, Transport
+    from pycram.designator import ObjectDesignator, perform
+
+    surfaces = ["counter", "cabinet top", "table", "cooker #1", "cooker #2"]
+    with World("pr2", environment="apartment", objects=["cup", "bowl", "milk"], seed=seed, supports=surfaces) as world:
+        target = "counter" if world.placements[0].support == "table" else "table"
+        with robots.load("pr2", world):
+            perform(ParkArms())
+            try:
+                _, task = run_as_task(lambda: perform(Transport(ObjectDesignator(type="cup"), target)))
+                worked = True
+            except Exception as error:  # a failed transport must fail the same way twice
+                task, worked = getattr(error, "task", None), False
+            poses = {**world.item_poses.get_value(), "base": world.base_pose.get_value()}
+            return fingerprint_lines(task, poses), worked
+
+
+def test_a_random_transport_runs_the_same_twice():
+    first, worked = _random_transport(5)
+    second, _ = _random_transport(5)
+    assert worked
+    assert first == second, "\n".join(sorted(set(first) ^ set(second)))
+
+
+def test_python_hash_randomisation_does_not_change_a_run():
+    # two processes with different string hashes (set and dict orders of strings differ): the
+    # thesis demo with a theft gives the same fingerprint in both
+    import subprocess
+    import sys
+
+    script = (
+        "from pycram.apps.demos.kitchen import DemoOptions, run_demo\n"
+        "from pycram.trace.fingerprint import run_fingerprint\n"
+        "r = run_demo(DemoOptions(steal=1, seed=2, record=False, quiet=True, animation=False, pictures=False))\n"
+        "print(r.exit_code, run_fingerprint(r.plan_task, r.final_poses))\n"
+    )
+    outputs = []
+    for hash_seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": hash_seed, "MUJOCO_GL": "egl"}
+        done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+        outputs.append(done.stdout.strip().splitlines()[-1])
+    assert outputs[0].startswith("0 ") and outputs[0] == outputs[1]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import typer
 
 from pycram.apps.cli.app import (
@@ -50,11 +52,12 @@ def demo_command(
     animation: bool = typer.Option(
         True, "--animation/--no-animation", help="Record the animation run.gif (--no-animation: a faster run)."
     ),
-    stepping: str = typer.Option(
-        "free",
+    stepping: str | None = typer.Option(
+        None,
         "--stepping",
-        help="'free' (the simulation runs beside the plan, as fast as it can: not reproducible) or "
-        "'lockstep' (it stands still while plan code runs: the same run from the same seed; sim backend).",
+        help="sim backend: 'lockstep' (the default: the simulation stands still while plan code runs, so the "
+        "same seed gives the same run) or 'free' (it runs beside the plan as fast as it can, so what the plan "
+        "computes costs simulated time: not reproducible).",
     ),
     backend: str = typer.Option(
         "sim",
@@ -74,9 +77,25 @@ def demo_command(
         "--faults",
         help="set-table only: comma-separated faults drawn from the seed: moved, taken, stuck, obstacle, missed.",
     ),
+    until: float | None = typer.Option(
+        None,
+        "--until",
+        metavar="T",
+        help="Stop the run at simulated time T [s] (sim backend): write the scene and belief pictures and the "
+        "task tree of that moment into the output folder (until-T.Ts), stop the plan there; exit code 0 "
+        "once they are written (a plan that ends before T: its usual exit code).",
+    ),
 ) -> None:
     """The thesis demo (fetch and place in the simulated kitchen, with recovery from failures),
-    or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting)."""
+    or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting).
+
+    Exit code: 0 on success (or, with --until, once the pictures of that moment are written);
+    1 when the plan failed; 2 for bad options; 130 / 143 when stopped by SIGINT / SIGTERM.
+    A recorded run can be run again with `pycram replay RUN`."""
+    if until is not None and (not math.isfinite(until) or until < 0):
+        fail(f"--until must be a simulated time >= 0 [s], not {until}", code=2)
+    if until is not None and backend != "sim":
+        fail("--until applies to --backend sim only", code=2)
     if output is not None:
         check_output_folder(output)
     from pycram.apps.experiments.scenarios import demo_scenario_names, get_scenario
@@ -95,6 +114,8 @@ def demo_command(
         animation=animation,
         stepping=stepping,
     )
+    if until is not None:
+        common["until"] = until
     if scenario != "thesis":
         code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
         raise typer.Exit(int(code or 0))

@@ -68,6 +68,13 @@ def experiment_command(
         "same seeds on other code): is the difference larger than the noise?",
         metavar="ID",
     ),
+    stepping: str | None = typer.Option(
+        None,
+        "--stepping",
+        help="'lockstep' (the default: each run's simulation stands still while its plan computes, so a "
+        "seed gives the same run on any machine and load) or 'free' (the simulation runs beside the plan: "
+        "not reproducible). A resumed experiment keeps its own.",
+    ),
     db: str | None = DbOption,
 ) -> None:
     """Run a scenario over many robots, seeds and faults in parallel; report success and times.
@@ -101,7 +108,9 @@ def experiment_command(
             reference = trace_errors(store.find_experiment, db, compare)
         except store.ExperimentNotFound as e:
             fail(str(e), code=2)
-    options = dict(scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db)
+    options = dict(
+        scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db, stepping=stepping
+    )
     with contextlib.ExitStack() as session:
         try:
             if ray is not None:  # check the input, then connect (before an experiment is created)

@@ -25,7 +25,12 @@ def sim_ros_bridge_command(
         "--realtime",
         help="Simulate at real-time speed (default: as fast as possible; /clock carries the simulation time).",
     ),
-    publish_rate: float = typer.Option(50.0, "--publish-rate", min=1.0, help="Sensor topics per second [Hz, wall]."),
+    publish_rate: float = typer.Option(
+        50.0,
+        "--publish-rate",
+        min=1.0,
+        help="Sensor topics and /clock per second of simulated time [Hz of simulated time].",
+    ),
     host: str = typer.Option(
         "127.0.0.1",
         "--host",

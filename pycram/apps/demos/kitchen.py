@@ -9,6 +9,11 @@ run's own output folder, and returns 0 only when the item rests on cooker #1.
 SIGINT (Ctrl-C) and SIGTERM stop the plan (the robot stops), the pictures of what happened are
 still written, the run is recorded as "interrupted" with the reason, and the exit code is 130 /
 143; a second signal while stopping exits at once (`pycram.core.interrupts.StopSignals`).
+
+A recorded run stores what it needs to run again and its fingerprint (`pycram.apps.replay`:
+`pycram replay RUN`). With `until` (`pycram demo --until T`), the world stops at simulated time
+T, the scene and belief pictures and the task tree so far are written (`write_stop_pictures`),
+and the plan is stopped there.
 """
 
 from __future__ import annotations
@@ -24,8 +29,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pycram.apps.terminal import log_to_terminal, stderr_console, task_tree_display, write_run_pictures
-from pycram.core.runtime.lockstep import STEPPING_MODES, LockstepClock, PlanThread
+from pycram.apps.terminal import (
+    STOP_PICTURE_SIZE,
+    log_to_terminal,
+    stderr_console,
+    task_tree_display,
+    write_run_pictures,
+    write_stop_pictures,
+)
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES, LockstepClock, PlanThread
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 if TYPE_CHECKING:  # imported where used: the ROS backend is optional
@@ -70,7 +82,10 @@ class DemoOptions:
     animation: bool = True  # record run.gif (False: no animation, a faster run)
     pictures: bool = True  # write start/end snapshots and the run's pictures (False: none, no folder)
     backend: str = "sim"  # "sim": process modules call the simulator; "ros": over ROS 1 (pycram.ros)
-    stepping: str = "free"  # "lockstep": the simulation stands still while plan code runs (sim only)
+    # sim only: "lockstep" (default) stands the simulation still while plan code runs; "free" does not
+    stepping: str | None = None
+    # sim only: stop the run at this simulated time [s], writing the pictures and the task tree so far
+    until: float | None = None
 
 
 @dataclass
@@ -94,6 +109,12 @@ class DemoResult:
     plan_task: Any = None  # the plan's task (`pycram.runtime.Task`), root of its task tree
     trace_loss: str | None = None  # "N trace records could not be written: why", if any were lost
     final_poses: dict[str, Any] = field(default_factory=dict)  # the robot's base and the items at the end
+    #: The world's state every simulated second (`pycram.sim.World.trajectory`; empty over ROS).
+    trajectory: list[Any] = field(default_factory=list)
+    #: With `DemoOptions.until`: the simulated time [s] the run was stopped at (None: it was not),
+    #: and the folder the pictures and the task tree of that moment went to.
+    stopped_at: float | None = None
+    stop_folder: Path | None = None
 
     @property
     def speed_factor(self) -> float:
@@ -190,10 +211,14 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
         raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in robot_names():
         raise ValueError(f"--robot must be {robot_choices()}, not {options.robot!r}")
-    if options.stepping not in STEPPING_MODES:
+    if options.stepping is not None and options.stepping not in STEPPING_MODES:
         raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {options.stepping!r}")
-    if options.stepping == "lockstep" and options.backend != "sim":
-        raise ValueError("--stepping lockstep needs --backend sim (over ROS the bridge keeps the time)")
+    if options.stepping is not None and options.backend != "sim":
+        raise ValueError("--stepping applies to --backend sim only (over ROS the bridge keeps the time)")
+    if options.until is not None and (not math.isfinite(options.until) or options.until < 0):
+        raise ValueError(f"--until must be a simulated time >= 0 [s], not {options.until}")
+    if options.until is not None and options.backend != "sim":
+        raise ValueError("--until applies to --backend sim only")
     stop = stop if stop is not None else StopSignals()  # never signalled unless entered
     started_wall = time.monotonic()
     recorder = _start_recorder(options, plan_name="kitchen demo (fetch and place)")
@@ -217,13 +242,41 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
         if recorder is not None:
             outcome = "succeeded" if result.exit_code == 0 else "interrupted" if result.interrupted else "failed"
             reason = result.message if result.exit_code != 0 else None
+            if result.stopped_at is not None:
+                outcome, reason = "interrupted", result.message
             if error is not None and not isinstance(error, KeyboardInterrupt):
                 reason = f"{type(error).__name__}: {error}"
+            if error is None:
+                _record_replay_info(recorder, options, result)
             result.run_id = recorder.finish(outcome, reason)
             result.trace_loss = recorder.loss_report()
     if recorder is not None and options.pictures:
         result.files.extend(write_run_pictures(result.run_id, result.plan_task, result.output, recorder.url))
     return result
+
+
+def _record_replay_info(recorder: Any, options: DemoOptions, result: DemoResult) -> None:
+    """Store in the run's info what `pycram replay` needs to run it again, and -- for a run that
+    ended by itself, not stopped by a signal or `until` -- its fingerprint."""
+    from pycram.trace.fingerprint import recording_info
+
+    replay_options: dict[str, Any] = {"item_at": options.item_at, "steal": options.steal, "pictures": options.pictures}
+    if options.interactive:
+        replay_options["interactive"] = True
+    if options.until is not None:
+        replay_options["until"] = options.until
+    finished = not result.interrupted and result.stopped_at is None and result.plan_task is not None
+    info = recording_info(
+        "thesis",
+        options.robot,
+        "thesis-kitchen",
+        options.seed,
+        options.stepping or DEFAULT_STEPPING,
+        replay_options,
+        backend=options.backend,
+        fingerprint=(result.plan_task, result.final_poses, result.trajectory) if finished else None,
+    )
+    recorder.set_run_info(**info)
 
 
 def _mark_interrupted(result: DemoResult, stop: Any) -> None:
@@ -271,7 +324,14 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         world, robot = open_ros_world(options.robot, options.item_at, realtime=options.realtime)
         counter_height = load_environment("thesis-kitchen").surface("cooker #1").height
     else:
-        world = World(options.robot, items, base_pose=START_POSE, realtime=options.realtime, stepping=options.stepping)
+        world = World(
+            options.robot,
+            items,
+            base_pose=START_POSE,
+            realtime=options.realtime,
+            stepping=options.stepping or DEFAULT_STEPPING,
+            **_picture_size(options),
+        )
         robot = None
         counter_height = world.environment.surface("cooker #1").height
         camera = FollowView(
@@ -309,11 +369,25 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
                 camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1], caption=story.caption
             )
         run = PlanRun(plan, robot, facts)
+        if options.until is not None and isinstance(world, World):  # (--until is refused over ROS)
+            world.hold_at(options.until)
         thief.start()
         run.start(world.sim_time.get_value())
         if isinstance(world.clock, LockstepClock):
             world.clock.leave()  # this thread only watches (by wall time): the plan runs on
         result.message = _watch(run, world, plan, helper, thief, options, stop)
+        if result.message == _HELD:  # --until: the world stands at T; look, then stop the plan there
+            result.stopped_at = world.sim_time.get_value()
+            result.stop_folder = output / f"until-{result.stopped_at:.1f}s"
+            title = f"thesis demo · {options.robot} · seed {options.seed} · t={result.stopped_at:.2f} s"
+            result.files.extend(write_stop_pictures(world, robot.belief, run.task, result.stop_folder, title))
+            if isinstance(world.clock, LockstepClock):
+                world.clock.leave()  # its waits for the pictures made it a plan thread: watch again
+            result.message = (
+                f"stopped at t={result.stopped_at:.2f} s of simulated time (--until {options.until:g}); "
+                f"the scene, the belief and the task tree of that moment are in {result.stop_folder}"
+            )
+            run.stop()  # evaporated while the world stands still: no task ends after T
         if isinstance(world.clock, LockstepClock):
             world.clock.adopt()  # the plan ended (or was stopped): the world stands as it left it
         thief.stop()
@@ -325,12 +399,15 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
         result.recoveries = recoveries(run.task)
         result.item_on_cooker_1 = _item_on_cooker_1(world, ITEM_NAME, counter_height) if items else False
         result.final_poses = {"base": world.base_pose.get_value(), **world.item_poses.get_value()}
+        result.trajectory = world.trajectory() if hasattr(world, "trajectory") else []
         if options.pictures:
             world.snapshot(output / "end.png", camera=camera)
             result.files.append(output / "end.png")
         # the recorder may lag behind on a busy machine: let it finish rather than lose the end
         frames = world.stop_recording(timeout=RENDER_CATCH_UP) if options.animation and options.pictures else []
-        if result.item_on_cooker_1:
+        if result.stopped_at is not None:
+            result.exit_code = 0  # stopped where asked: the pictures of that moment are written
+        elif result.item_on_cooker_1:
             result.exit_code, result.message = 0, "the item rests on cooker #1"
         elif not result.message:
             result.message = _failure_message(run)
@@ -343,6 +420,11 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
     result.captions = list(getattr(frames, "captions", []))
     if frames:  # encoded after the simulation stopped, so the two do not compete for the CPU
         result.files.append(write_animation(output / "run.gif", frames, ANIMATION_SPEED_UP * ANIMATION_FPS))
+
+
+def _picture_size(options: DemoOptions) -> dict[str, Any]:
+    """The world's offscreen size: large enough for the pictures of `--until`, else the default."""
+    return {"offscreen_size": STOP_PICTURE_SIZE} if options.until is not None else {}
 
 
 def _gripper_mapper(world: Any):
@@ -437,6 +519,7 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
     `WALL_TIME_LIMIT` of wall time, whichever comes first: the demo never hangs.
     """
     limited = not options.interactive
+    held = getattr(world, "held", None)  # with --until: set once the world stands at that time
     sim_deadline = world.sim_time.get_value() + SIM_TIME_LIMIT
     wall_deadline = time.monotonic() + WALL_TIME_LIMIT
     progress = None if options.quiet else _ProgressLine(run, world, plan, thief)
@@ -450,6 +533,8 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
             while not run.join(0.25):
                 if progress is not None:
                     progress.refresh()
+                if held is not None and held.is_set():
+                    return _HELD  # the plan is left as it is, for pictures of this moment
                 if stop.requested:
                     reason = stop.reason
                 elif limited and world.sim_time.get_value() > sim_deadline:
@@ -467,6 +552,10 @@ def _watch(run: PlanRun, world: Any, plan: Any, helper: Any, thief: Any, options
             log.warning("stopping the plan: %s", reason)
             run.stop()
     return reason
+
+
+#: What `_watch` returns when the world holds at `DemoOptions.until`.
+_HELD = "held at --until"
 
 
 class _Story:
@@ -558,10 +647,12 @@ def main(
     quiet: bool = False,
     animation: bool = True,
     backend: str = "sim",
-    stepping: str = "free",
+    stepping: str | None = None,
+    until: float | None = None,
 ) -> int:
     """Run the demo, print the task tree and a summary; return the process exit code (0: the item
-    rests on cooker #1; 130 / 143: stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
+    rests on cooker #1, or the run was stopped at `until` and its pictures written; 130 / 143:
+    stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
     from rich.console import Console
 
     from pycram.core.interrupts import StopSignals
@@ -584,6 +675,7 @@ def main(
         animation=animation,
         backend=backend,
         stepping=stepping,
+        until=until,
     )
     try:
         with StopSignals(on_second=lambda: stderr_console().show_cursor(True)) as stop:
@@ -603,6 +695,9 @@ def main(
         console.print(f"recorded as run {result.run_id} (see `pycram show {result.run_id}`)")
     if result.trace_loss:
         console.print(f"[yellow]trace of run {result.run_id} incomplete: {result.trace_loss}[/yellow]", highlight=False)
+    if result.stopped_at is not None:
+        console.print(f"[bold yellow]STOPPED[/bold yellow]: {result.message}", highlight=False)
+        return result.exit_code
     colour = "green" if result.exit_code == 0 else "yellow" if result.interrupted else "red"
     verdict = "SUCCESS" if result.exit_code == 0 else "INTERRUPTED" if result.interrupted else "FAILURE"
     console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import inspect
 import json
 import logging
 import os
@@ -42,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from pycram.apps.experiments.scenarios import RunInterrupted, Scenario, UnknownScenario, get_scenario
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 log = logging.getLogger(__name__)
@@ -144,6 +146,12 @@ class PreparedExperiment:
     done_before: int  # runs recorded before this invocation
     resumed: bool
 
+    @property
+    def stepping(self) -> str:
+        """How the runs' simulations keep time with their plans (the record's; the default when
+        only checked)."""
+        return self.record.stepping if self.record is not None else DEFAULT_STEPPING
+
 
 @dataclass
 class ExperimentOutcome:
@@ -173,13 +181,16 @@ def prepare_experiment(
     db: str | None = None,
     command: str | None = None,
     check_only: bool = False,
+    stepping: str | None = None,
 ) -> PreparedExperiment:
     """Check the input and create the experiment in the database, or find the one to resume.
 
     `resume` (an id or name) continues a recorded experiment: the options given must match it
     (those left out are taken from it). A `name` that is recorded already resumes that
     experiment when the options match. With `check_only`, only checks: nothing is created and
-    the result's `record` is the experiment to resume or None. Raises `ExperimentInputError` for bad input,
+    the result's `record` is the experiment to resume or None. `stepping` ("lockstep", the default
+    for a new experiment, or "free") is how its simulations keep time with the plans; a resumed
+    experiment keeps its own. Raises `ExperimentInputError` for bad input,
     `pycram.trace.db.TraceDatabaseError` when the database cannot be used.
     """
     from pycram.apps.experiments import store
@@ -195,6 +206,8 @@ def prepare_experiment(
             existing = store.find_experiment(db, name)
         except store.ExperimentNotFound:
             existing = None
+    if stepping is not None and stepping not in STEPPING_MODES:
+        raise ExperimentInputError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {stepping!r}")
     spec = scenario if scenario is not None else existing.scenario if existing is not None else "thesis"
     try:
         entry = get_scenario(spec)
@@ -224,6 +237,11 @@ def prepare_experiment(
         variants = [tuple(v) for v in existing.variants]
     else:
         variants = parse_variants([], known)
+    if existing is not None and stepping is not None and stepping != existing.stepping:
+        raise ExperimentInputError(
+            f"experiment {existing.id} ({existing.name}) was recorded with --stepping {existing.stepping}, not "
+            f"{stepping} (leave --stepping out to resume it, or choose another --name)"
+        )
     if existing is not None:
         given = (entry.name, robot_list, seed_list, variants)
         stored = (existing.scenario, list(existing.robots), list(existing.seeds), [tuple(v) for v in existing.variants])
@@ -239,7 +257,14 @@ def prepare_experiment(
         return PreparedExperiment(None, entry, db, [], 0, False)
     else:
         record = store.create_experiment(
-            db, name or _default_name(entry.name), entry.name, robot_list, seed_list, variants, command
+            db,
+            name or _default_name(entry.name),
+            entry.name,
+            robot_list,
+            seed_list,
+            variants,
+            command,
+            stepping or DEFAULT_STEPPING,
         )
     done = store.finished_keys(db, record.id)
     todo = [key for key in record.keys() if key not in done]
@@ -254,9 +279,18 @@ def _variants_text(variants: Iterable[Iterable[str]]) -> str:
 
 
 def execute_run(
-    scenario: str, robot: str, seed: int, variant: str, db: str | None, record: bool = True
+    scenario: str,
+    robot: str,
+    seed: int,
+    variant: str,
+    db: str | None,
+    record: bool = True,
+    stepping: str = DEFAULT_STEPPING,
 ) -> dict[str, Any]:
     """Run the scenario named `scenario` once and return its result (JSON-serialisable).
+
+    `stepping` is passed on to a scenario that takes it (every built-in one does); one that does
+    not is run as it is, and refused (an error result) unless `stepping` is the default.
 
     Runs in a worker: the scenario is looked up by name or import path. An exception of the
     scenario becomes a result with `error` set and its type as the failure cause;
@@ -270,7 +304,12 @@ def execute_run(
     started = time.monotonic()
     try:
         function = get_scenario(scenario).load()
-        result = dict(function(robot, seed, faults, db_url=db, pictures=False))
+        if _takes_stepping(function):
+            result = dict(function(robot, seed, faults, db_url=db, pictures=False, stepping=stepping))
+        elif stepping == DEFAULT_STEPPING:
+            result = dict(function(robot, seed, faults, db_url=db, pictures=False))
+        else:
+            raise ValueError(f"scenario {scenario} takes no 'stepping' argument: it cannot run with {stepping!r}")
     except KeyboardInterrupt:
         raise
     except Exception as e:
@@ -294,6 +333,15 @@ def execute_run(
     result["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     clean: dict[str, Any] = json.loads(json.dumps(result, default=str))
     return clean
+
+
+def _takes_stepping(function: Any) -> bool:
+    """Whether a scenario function takes a `stepping` keyword."""
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "stepping" or p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters)
 
 
 def _worker_init() -> None:
@@ -373,7 +421,9 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
     futures: dict[Any, RunKey] = {}
     try:
         for key in prepared.todo:
-            future = pool.submit(execute_run, prepared.scenario.spec, key[0], key[1], key[2], prepared.db, True)
+            future = pool.submit(
+                execute_run, prepared.scenario.spec, key[0], key[1], key[2], prepared.db, True, prepared.stepping
+            )
             futures[future] = key
         pending = set(futures)
         stopping = False
@@ -487,7 +537,7 @@ def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: 
     task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
     refs: dict[Any, RunKey] = {}
     for key in prepared.todo:
-        refs[task.remote(prepared.scenario.spec, key[0], key[1], key[2], prepared.db, record)] = key
+        refs[task.remote(prepared.scenario.spec, key[0], key[1], key[2], prepared.db, record, prepared.stepping)] = key
     cancelled = False
     while refs:
         ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.25, fetch_local=True)

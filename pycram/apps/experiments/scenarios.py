@@ -4,7 +4,7 @@ A *scenario* is a function that runs one headless episode for a robot and a seed
 its result as a JSON-serialisable dict:
 
     scenario(robot: str, seed: int, faults: frozenset[str] = frozenset(),
-             db_url: str | None = None, pictures: bool = False) -> dict
+             db_url: str | None = None, pictures: bool = False, stepping: str = "lockstep") -> dict
 
 with at least `success` (bool), `failure_causes` (list of failure type names, empty on
 success), `sim_time` and `wall_time` [s], `robot`, `seed` and `faults`; optionally `objects`
@@ -30,6 +30,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 from pycram.world.robot_registry import robot_names
 
 log = logging.getLogger(__name__)
@@ -220,9 +221,10 @@ def thesis_scenario(
     faults: frozenset[str] = frozenset(),
     db_url: str | None = None,
     pictures: bool = False,
+    stepping: str = DEFAULT_STEPPING,
 ) -> dict[str, Any]:
     """The thesis demo (fetch and place in the kitchen) as a scenario: headless, no animation,
-    pictures only with `pictures` (into `output/demo-ROBOT-RUNID`).
+    pictures only with `pictures` (into `output/demo-ROBOT-RUNID`), simulated with `stepping`.
 
     `faults` is a subset of `THESIS_FAULTS`; the seed chooses where the misplaced item is and
     how often it is stolen, and drives the thief's timing. The run is recorded into `db_url`
@@ -261,6 +263,7 @@ def thesis_scenario(
             quiet=True,
             animation=False,
             pictures=pictures,
+            stepping=stepping,
         )
     )
     if result.interrupted:
@@ -272,6 +275,7 @@ def thesis_scenario(
         "robot": robot,
         "seed": seed,
         "faults": sorted(faults),
+        "stepping": stepping,
         "success": success,
         "objects": {
             ITEM_NAME: {

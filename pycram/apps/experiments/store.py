@@ -68,6 +68,9 @@ class ExperimentRecord:
     variants: tuple[tuple[str, ...], ...]
     status: str | None = None
     created_at: _dt.datetime | None = None
+    #: How its simulations kept time with the plans ("lockstep" or "free"); experiments recorded
+    #: before PyCRAM stored it ran free.
+    stepping: str = "free"
 
     def keys(self) -> list[tuple[str, int, str]]:
         """Every run of the experiment as (robot, seed, variant key), in the order they run:
@@ -115,7 +118,16 @@ def _experiment_from_row(row: Any) -> ExperimentRecord:
         variants=tuple(tuple(v) for v in json.loads(row.variants)),
         status=row.status,
         created_at=row.created_at,
+        stepping=_info(row.info).get("stepping", "free"),
     )
+
+
+def _info(text: str | None) -> dict[str, Any]:
+    try:
+        info = json.loads(text) if text else {}
+    except ValueError:
+        return {}
+    return info if isinstance(info, dict) else {}
 
 
 def find_experiment(url: str | None, ref: str | int) -> ExperimentRecord:
@@ -147,8 +159,10 @@ def create_experiment(
     seeds: list[int],
     variants: list[tuple[str, ...]],
     command: str | None = None,
+    stepping: str = "lockstep",
 ) -> ExperimentRecord:
-    """Record a new experiment; raises `TraceDatabaseError` (also when the name is taken)."""
+    """Record a new experiment whose runs simulate with `stepping`; raises `TraceDatabaseError`
+    (also when the name is taken)."""
     engine = _engine(url)
     values = {
         "name": name,
@@ -161,6 +175,7 @@ def create_experiment(
         "status": "running",
         "host": socket.gethostname(),
         "command": command if command is not None else " ".join(sys.argv),
+        "info": json.dumps({"stepping": stepping}),
     }
     try:
         with engine.begin() as conn:

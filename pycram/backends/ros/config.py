@@ -23,6 +23,7 @@ base pose            ``pose_topic`` (``/amcl_pose``)             geometry_msgs/P
 joints, grippers     ``joint_states_topic``                      sensor_msgs/JointState
 detections           ``detections_topic``                        pycram_msgs/DetectedItems
 simulation time      ``/clock``                                  rosgraph_msgs/Clock
+sensor instant taken ``sensor_ack_topic`` (simulator only)       rosgraph_msgs/Clock
 ===================  ==========================================  ===============================
 
 A gripper's opening [m] is the sum of the positions of its ``opening_joints`` in the joint
@@ -86,6 +87,9 @@ class RosRobotConfig:
     environment: str = "thesis-kitchen"
     #: simulator-only services and topics of the bridge (item states, the environment's hands)
     sim_namespace: str = "/pycram_sim"
+    #: simulator only: where PyCRAM's ROS robot acknowledges each sensor instant it took in
+    #: (``rosgraph_msgs/Clock``: the stamp), so that the bridge's simulation keeps step with it
+    sensor_ack_topic: str = "/pycram_sim/sensor_ack"
     extra: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -4,6 +4,9 @@ Used by ``pycram demo --backend ros`` (when no ``ROS_MASTER_URI`` is given), the
 benchmark. Nothing here imports rospy: the processes are plain ``roscore`` and
 ``python -m pycram sim-ros-bridge``.
 
+The master is started with ``/use_sim_time`` set (:class:`RosMaster`): the nodes on it read
+their time from the bridge's ``/clock``, i.e. simulated time.
+
 Guarantees: every process is started in a session of its own, bound to 127.0.0.1
 (``ROS_IP``/``ROS_HOSTNAME``), logs into a temporary folder, and :meth:`stop` ends it (SIGINT,
 then SIGKILL after a bound) -- also the children roscore starts. Readiness is awaited with a
@@ -82,9 +85,16 @@ def _stop_process(process: subprocess.Popen, timeout: float = 10.0) -> None:
 
 
 class RosMaster:
-    """``roscore`` on ``127.0.0.1:port`` (a free port by default). ``uri`` is its address."""
+    """``roscore`` on ``127.0.0.1:port`` (a free port by default). ``uri`` is its address.
 
-    def __init__(self, port: int | None = None, startup_timeout: float = 20.0) -> None:
+    With ``use_sim_time`` (the default: this master serves a simulated robot) the parameter
+    ``/use_sim_time`` is set to true as soon as the master answers -- before the constructor
+    returns, so before any node of the launcher's user starts: every ROS node on this master
+    then takes its time from ``/clock``, which ``pycram sim-ros-bridge`` publishes (simulated
+    time). rospy reads the parameter once, when its node is initialised.
+    """
+
+    def __init__(self, port: int | None = None, startup_timeout: float = 20.0, use_sim_time: bool = True) -> None:
         if shutil.which("roscore") is None:
             raise RuntimeError("roscore not found: run scripts/install_ros.sh (Debian package ros-core)")
         self.port = port or free_port()
@@ -101,9 +111,19 @@ class RosMaster:
         )
         try:
             self._wait_ready(startup_timeout)
+            if use_sim_time:
+                self.set_param("/use_sim_time", True)
         except BaseException:
             self.stop()
             raise
+
+    def set_param(self, name: str, value: bool | int | float | str) -> None:
+        """Set the parameter ``name`` on this master (XML-RPC; ``RuntimeError`` if refused)."""
+        code, message, _ = cast(
+            tuple[int, str, int], xmlrpc.client.ServerProxy(self.uri).setParam("/pycram_launcher", name, value)
+        )
+        if code != 1:
+            raise RuntimeError(f"the ROS master on {self.uri} refused to set {name}: {message}")
 
     def _wait_ready(self, timeout: float) -> None:
         """The master has no "ready" event: ask it (getPid) every 50 ms, within ``timeout``."""

@@ -36,7 +36,14 @@ from typing import Any
 
 from pycram.backends.ros.config import RosRobotConfig
 from pycram.backends.ros.detections import report_of
-from pycram.backends.ros.transport import ActionServerLost, GoalHandle, GoalOutcome, RosMotionFailed, Transport
+from pycram.backends.ros.transport import (
+    ActionServerLost,
+    GoalHandle,
+    GoalOutcome,
+    Publication,
+    RosMotionFailed,
+    Transport,
+)
 from pycram.core.fluent import Fluent
 from pycram.execution.module_support import (
     cancel_running_handle,
@@ -109,7 +116,18 @@ class RosRobotState:
     ``base_pose`` (``Pose2D``, map frame, from the pose topic), ``joint_states`` (``{name:
     position}``), ``gripper_openings[g]`` [m] (sum of the gripper's opening joints). Each is set
     in the middleware's thread at the topic's rate. Also serves as the "world" the motion
-    resolvers read the base pose from.
+    resolvers read the base pose from. ``stamp`` is the (ROS) time [s] of the newest sensor
+    instant taken in: the older of the latest pose and joint-state stamps.
+
+    Keeping step with a simulator: it also follows ``config.clock_topic`` and acknowledges each
+    sensor instant it has taken in completely -- base pose, joint states *and* ``/clock`` at
+    that time, each in its fluents or clock -- by publishing the instant's stamp on
+    ``config.sensor_ack_topic`` (a ``rosgraph_msgs/Clock``; nobody listens on a real robot).
+    ``pycram sim-ros-bridge`` publishes the next instant only then, so the simulation never
+    runs ahead of this process by more than one sensor period. A message repeating the instant
+    last acknowledged (the bridge resends an instant nobody acknowledged) is acknowledged again;
+    a stamp older than the last one on its topic (a restarted simulator) forgets every instant
+    taken in so far. :meth:`close` ends the acknowledgements.
     """
 
     def __init__(self, transport: Transport, config: RosRobotConfig) -> None:
@@ -125,16 +143,54 @@ class RosRobotState:
         self._ready = threading.Event()
         self.pose_updates = MessageCounter()  #: base-pose messages received
         self.joint_updates = MessageCounter()  #: joint-state messages received
+        self.stamp = -math.inf
+        #: per topic: the latest stamp taken in [s] and as the message had it
+        self._stamps: dict[str, tuple[float, Any]] = dict.fromkeys(("pose", "joints", "clock"), (-math.inf, None))
+        self._acknowledged = -math.inf  # the newest complete instant acknowledged [s]
+        self._stamp_lock = threading.Lock()
+        self._transport = transport
+        self._acknowledge: Publication | None = None
+        try:
+            self._acknowledge = transport.advertise(config.sensor_ack_topic, "rosgraph_msgs/Clock")
+        except NotImplementedError:
+            pass
         self._subscriptions = [
             transport.subscribe(config.pose_topic, "geometry_msgs/PoseWithCovarianceStamped", self._on_pose),
             transport.subscribe(config.joint_states_topic, "sensor_msgs/JointState", self._on_joints),
         ]
+        if self._acknowledge is not None:
+            self._subscriptions.append(
+                transport.subscribe(config.clock_topic, "rosgraph_msgs/Clock", lambda m: self._taken("clock", m.clock))
+            )
 
     def _on_pose(self, message: Any) -> None:
         pose = message.pose.pose
         self.base_pose.set_value(Pose2D(pose.position.x, pose.position.y, yaw_of(pose.orientation)))
         self.pose_updates.tick()
         self._check_ready()
+        self._taken("pose", message.header.stamp)
+
+    def _taken(self, topic: str, stamp: Any) -> None:
+        """A message of ``topic`` stamped ``stamp`` is taken in: acknowledge the newest complete
+        instant when it grew, or again when this message repeats it (see the class docstring)."""
+        seconds = self._transport.time_to_seconds(stamp)
+        with self._stamp_lock:
+            if seconds < self._stamps[topic][0]:  # a restarted simulator: its instants only
+                self._stamps = dict.fromkeys(self._stamps, (-math.inf, None))
+                self._acknowledged = -math.inf
+            self._stamps[topic] = (seconds, stamp)
+            self.stamp = min(self._stamps["pose"][0], self._stamps["joints"][0])
+            newest, newest_stamp = min(self._stamps.values(), key=lambda entry: entry[0])
+            if newest == -math.inf or newest < self._acknowledged:
+                return
+            if newest == self._acknowledged and seconds != newest:
+                return  # nothing new, and not a repetition of the instant acknowledged
+            self._acknowledged = newest
+        if self._acknowledge is not None:
+            try:
+                self._acknowledge.publish(self._transport.message("rosgraph_msgs/Clock", clock=newest_stamp))
+            except Exception:  # e.g. the node shutting down
+                logger.debug("could not acknowledge the sensor instant %.3f", newest, exc_info=True)
 
     def fresh_base_pose(self, timeout: float = 2.0) -> Pose2D | None:
         """The base pose from a message sampled after now (see :meth:`wait_fresh`)."""
@@ -157,6 +213,7 @@ class RosRobotState:
                 self.gripper_openings[name].set_value(sum(positions[j] for j in gripper.opening_joints))
         self.joint_updates.tick()
         self._check_ready()
+        self._taken("joints", message.header.stamp)
 
     def _check_ready(self) -> None:
         if (
@@ -171,8 +228,11 @@ class RosRobotState:
         return self._ready.wait(timeout)
 
     def close(self) -> None:
+        """End the subscriptions and the acknowledgements (idempotent)."""
         for subscription in self._subscriptions:
             subscription.close()
+        if self._acknowledge is not None:
+            self._acknowledge.close()
 
     def __repr__(self) -> str:
         return f"RosRobotState({self.robot!r})"

@@ -29,6 +29,7 @@ from pycram.backends.ros.transport import (
     ActionServerUnavailable,
     GoalHandle,
     GoalOutcome,
+    Publication,
     Subscription,
     Transport,
 )
@@ -215,6 +216,24 @@ class _Ros1Subscription(Subscription):
         self._topic.remove(self._callback)
 
 
+class _Ros1Publication(Publication):
+    def __init__(self, publisher: Any) -> None:
+        self._publisher: Any = publisher
+        self._lock = threading.Lock()
+
+    def publish(self, message: Any) -> None:
+        with self._lock:
+            publisher = self._publisher
+        if publisher is not None:
+            publisher.publish(message)
+
+    def close(self) -> None:
+        with self._lock:
+            publisher, self._publisher = self._publisher, None
+        if publisher is not None:
+            publisher.unregister()
+
+
 def rosgraph_master() -> str:
     import rosgraph
 
@@ -265,6 +284,12 @@ class Ros1Transport(Transport):
     def message(self, msg_type: str, **fields: Any) -> Any:
         return message_class(msg_type)(**fields)
 
+    def advertise(self, topic: str, msg_type: str) -> Publication:
+        """A rospy publisher on ``topic`` with ``queue_size=1``: ``publish`` never waits for a
+        subscriber, one that cannot keep up gets the newest message. ``close`` unregisters it
+        (rospy shares one publisher per topic and process; the last ``close`` ends it)."""
+        return _Ros1Publication(rospy.Publisher(topic, message_class(msg_type), queue_size=1))
+
     def service(self, name: str, srv_type: str, timeout: float = 10.0) -> Any:
         """A callable proxy of service ``name``; ``ActionServerUnavailable`` if it does not
         appear within ``timeout`` [s, wall]."""
@@ -283,8 +308,12 @@ class Ros1Transport(Transport):
         return stamp.to_sec()
 
     def sim_clock(self, topic: str = "/clock") -> ManualClock:
-        """A clock that follows the simulation time published on ``topic`` (ROS'
-        ``use_sim_time``); activate it with ``pycram.runtime.set_clock``."""
+        """A PyCRAM clock that follows the simulated time published on ``topic`` [s] (as ROS'
+        ``use_sim_time`` does for rospy): activate it with ``pycram.runtime.set_clock`` and
+        ``pycram.sleep``, fluent time-outs and the process modules' goal time-outs run in
+        simulated time. It never goes backwards (an older ``/clock``, e.g. of a restarted
+        simulator, is ignored until the new one passes it) and stands still while no ``/clock``
+        arrives."""
         clock = ManualClock(0.0)
 
         def tick(message: Any) -> None:

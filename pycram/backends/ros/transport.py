@@ -36,6 +36,7 @@ __all__ = [
     "GoalHandle",
     "ActionChannel",
     "Subscription",
+    "Publication",
     "Transport",
     "GOAL_STATUSES",
 ]
@@ -138,6 +139,18 @@ class Subscription(ABC):
         """Stop receiving messages (idempotent)."""
 
 
+class Publication(ABC):
+    """A topic this process publishes on, as returned by :meth:`Transport.advertise`."""
+
+    @abstractmethod
+    def publish(self, message: Any) -> None:
+        """Send ``message``; never waits for a subscriber."""
+
+    @abstractmethod
+    def close(self) -> None:
+        """Stop publishing (idempotent): subscribers lose their connection to it."""
+
+
 class Transport(ABC):
     """A connection to a robot's middleware (one per process)."""
 
@@ -148,6 +161,11 @@ class Transport(ABC):
     @abstractmethod
     def subscribe(self, topic: str, msg_type: str, callback: Callable[[Any], None]) -> Subscription:
         """Call ``callback(message)`` (in a middleware thread) for each message on ``topic``."""
+
+    def advertise(self, topic: str, msg_type: str) -> Publication:
+        """Publish messages of ``msg_type`` on ``topic`` (default: this transport cannot publish,
+        ``NotImplementedError``)."""
+        raise NotImplementedError(f"{type(self).__name__} cannot publish on {topic}")
 
     @abstractmethod
     def message(self, msg_type: str, **fields: Any) -> Any:

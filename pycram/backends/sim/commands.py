@@ -19,7 +19,6 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from pycram.core.runtime.clock import ManualClock
-from pycram.core.runtime.lockstep import LockstepClock
 from pycram.world.environment import Environment
 from pycram.world.types import Outcome
 
@@ -78,11 +77,9 @@ class CommandQueue:
                 batch.append(self._inbox.get_nowait())
             except queue.Empty:
                 break
-        if isinstance(self.clock, LockstepClock):
-            # Lock-step: the commands sent while the simulation stood still all start at one
-            # simulated instant; take them in a canonical order (by command name; a command's
-            # own start and cancel keep their order), not in the order the plan's threads sent them.
-            batch.sort(key=lambda entry: entry[2].name)
+        # Lock-step: the commands sent while the simulation stood still all start at one
+        # simulated instant, in the order they were sent -- one plan thread ran at a time, in
+        # task order (`pycram.core.runtime.lockstep`), so that order is the same in every run.
         for kind, ctrl, handle in batch:
             if kind == "cancel":
                 for channel, (_ctrl, h) in list(self._active.items()):

@@ -16,6 +16,11 @@ time-outs follow simulated time. Headless it runs as fast as it can; `realtime=T
 `realtime_factor` x (wall time + `REALTIME_SLACK`); a machine that cannot keep up runs slower,
 and never races afterwards to catch up.
 
+The simulation thread also samples the world's state every `TRAJECTORY_PERIOD` of simulated time
+(`trajectory()`: the robot's base and joints, every item's pose, the containers' joints), for a
+run's fingerprint (`pycram.trace.fingerprint`), and `hold_at(t)` stops it from stepping past a
+simulated time while it still serves commands (pictures of the world as it stood at `t`).
+
 This module holds `World` itself: construction, lifecycle (`close`), the simulation thread's loop
 and the sensor fluents it publishes. Its commands are grouped by concept in the classes it
 inherits: `commands.CommandQueue` (submitting, starting, cancelling and ending commands),
@@ -39,7 +44,7 @@ import numpy as np
 
 from pycram.core.fluent import Fluent
 from pycram.core.runtime.clock import ManualClock, current_clock, set_clock
-from pycram.core.runtime.lockstep import STEPPING_MODES, LockstepClock
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES, LockstepClock
 from pycram.environments import DEFAULT_ENVIRONMENT
 from pycram.environments import load as load_environment
 from pycram.world.environment import Environment
@@ -75,6 +80,8 @@ _CLOCK_LOCK = threading.Lock()
 #: In real-time mode, how far [s of wall time] the simulation may fall behind before it stops
 #: trying to catch up (it then paces from where it is).
 REALTIME_SLACK = 0.05
+#: Simulated time between two samples of `World.trajectory()` [s].
+TRAJECTORY_PERIOD = 1.0
 #: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
 #: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
 _LIVE_WORLDS: weakref.WeakSet[World] = weakref.WeakSet()
@@ -124,7 +131,7 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         offscreen_size: tuple[int, int] = (640, 480),
         activate_clock: bool = True,
         perception_faults: PerceptionFaults | None = None,
-        stepping: str = "free",
+        stepping: str = DEFAULT_STEPPING,
     ) -> None:
         if stepping not in STEPPING_MODES:
             raise ValueError(f"stepping must be one of {', '.join(STEPPING_MODES)}, not {stepping!r}")
@@ -184,6 +191,13 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         self._renderers: Renderers | None = None
         self._perception_renderers: Renderers | None = None
         self.error: BaseException | None = None
+        # --- trajectory samples (appended by the simulation thread only) and hold_at
+        self._trajectory: list[tuple[float, dict[str, tuple[float, ...]]]] = [self._sample_state()]
+        self._next_sample = eng.time + TRAJECTORY_PERIOD
+        self._hold_cv = threading.Condition(threading.Lock())
+        self._hold_at: float | None = None
+        #: Set once the simulation stands still at the time given to `hold_at`.
+        self.held = threading.Event()
         self._previous_clock = set_clock(self.clock) if activate_clock else None
         self._clock_active = activate_clock
         self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
@@ -229,6 +243,8 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         self._stop.set()
         if isinstance(self.clock, LockstepClock):
             self.clock.poke()
+        with self._hold_cv:
+            self._hold_cv.notify_all()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout)
             if self._thread.is_alive():  # pragma: no cover
@@ -263,11 +279,18 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         next_sensor = eng.time + self._sensor_period  # the constructor published at eng.time
         wall0, sim0 = time.monotonic(), eng.time
         lockstep = self.clock if isinstance(self.clock, LockstepClock) else None
+        if lockstep is not None:
+            lockstep.steps_here()  # the threads its steps wake run once each step is over
+        tick = self._steps_per_tick * float(self.scene.model.opt.timestep)
         try:
             while not self._stop.is_set():
                 if lockstep is not None and not lockstep.quiet():
                     # plan code runs: the world stands still (commands wait for the next step)
                     lockstep.wait_until_quiet(self._stop.is_set)
+                    continue
+                hold = self._hold_at
+                if hold is not None and eng.time + tick > hold + 1e-9:
+                    self._serve_held()  # the next step would pass `hold`: stand still, serve commands
                     continue
                 self._drain_inbox()
                 t = eng.time
@@ -277,6 +300,9 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
                         self._end(channel, out, stop=not out.succeeded)
                 eng.step(self._steps_per_tick)
                 self.clock.advance_to(eng.time)
+                if eng.time >= self._next_sample - 1e-9:  # a fixed schedule in simulated time
+                    self._trajectory.append(self._sample_state())
+                    self._next_sample += TRAJECTORY_PERIOD
                 due = eng.time >= next_sensor - 1e-9
                 if due or self._finished:
                     if due:  # a fixed schedule: exactly `sensor_rate` publications per simulated second
@@ -303,6 +329,86 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         finally:
             self._shutdown()
 
+    def _sample_state(self) -> tuple[float, dict[str, tuple[float, ...]]]:
+        """The world's state now, for `trajectory()` (simulation thread; a few microseconds)."""
+        eng = self._engine
+        data = eng.data
+        state: dict[str, tuple[float, ...]] = {
+            "base": tuple(float(data.qpos[i]) for i in eng.base_qpos),
+            "joints": tuple(float(data.qpos[a]) for _, a, _ in eng.robot_joints),
+        }
+        for name in eng.item_bodies:
+            pose = eng.item_pose(name)
+            state[name] = (*pose.position, *pose.orientation)
+        if eng.furniture.containers:
+            positions = eng.furniture.positions(data)
+            state["containers"] = tuple(positions[n] for n in sorted(positions))
+        return float(eng.time), state
+
+    def trajectory(self) -> list[tuple[float, dict[str, tuple[float, ...]]]]:
+        """The world's state sampled by the simulation thread at its start and then every
+        `TRAJECTORY_PERIOD` [s] of simulated time (at the first control tick at or after each
+        whole period): a list of (simulated time [s], state), oldest first. Each state maps
+        "base" to the base's planar joints (x [m], y [m], yaw [rad], unwrapped), "joints" to the
+        robot's joint positions (in the description's order), each item's name to its position
+        [m] and orientation (w, x, y, z), and "containers" (if any) to the containers' joint
+        positions [m or rad] sorted by name. In lock-step the samples depend on the seed and
+        the options alone. Thread-safe; a copy."""
+        return list(self._trajectory)
+
+    def hold_at(self, sim_time: float) -> None:
+        """Stop stepping before simulated time would pass `sim_time` [s]: the world then stands
+        still at the last control tick at or before it (at once if that has passed), publishes
+        its sensors once, sets `held`, and from then on only serves commands that need no step
+        (pictures, instant commands; motions start but do not move) until `release()` or
+        `close()`. Plan code waiting on simulated time waits until then. Thread-safe."""
+        if sim_time < 0:
+            raise ValueError(f"hold_at needs a simulated time >= 0 [s], not {sim_time!r}")
+        with self._hold_cv:
+            self._hold_at = float(sim_time)
+            self._hold_cv.notify_all()
+        if isinstance(self.clock, LockstepClock):
+            self.clock.poke()
+
+    def release(self) -> None:
+        """Undo `hold_at`: the world steps on (as it did before)."""
+        with self._hold_cv:
+            self._hold_at = None
+            self._hold_cv.notify_all()
+        if isinstance(self.clock, LockstepClock):
+            self.clock.poke()
+
+    def submit(self, ctrl: Controller, name: str) -> CommandHandle:
+        """`CommandQueue.submit`; a held world (`hold_at`) is woken to serve the command."""
+        handle = super().submit(ctrl, name)
+        if self._hold_at is not None:  # a held world waits for commands, not for the plan
+            with self._hold_cv:
+                self._hold_cv.notify_all()
+        return handle
+
+    def _serve_held(self) -> None:
+        """One round of the held world (simulation thread, while every plan thread waits):
+        publish once when it starts to hold, then start what was sent and deliver what ended
+        (the plan threads that wakes get their turns in `_run`, as after a step), or wait for
+        more commands, `release` or `close`."""
+        if not self.held.is_set():
+            self._publish()
+            self.held.set()
+            _log.info("the world holds at t=%.3f s of simulated time", self._engine.time)
+            return
+        self._drain_inbox()
+        if self._finished:
+            self._publish()
+            finished, self._finished = self._finished, []
+            for handle, outcome in finished:
+                handle._finish(outcome)
+            return
+        with self._hold_cv:
+            while self._hold_at is not None and self._inbox.empty() and not self._stop.is_set():
+                self._hold_cv.wait()
+            if self._hold_at is None:
+                self.held.clear()
+
     def _shutdown(self) -> None:
         reason = "error" if self.error else "closed"
         with self._lock:
@@ -324,7 +430,9 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
                 renderers.close()
         if self._recorder is not None:
             self._recorder.abort()  # never blocks; close() joins the thread
-        # wake anybody waiting on simulated time one last time
+        # wake anybody waiting on simulated time one last time (no turns any more: nothing steps)
+        if isinstance(self.clock, LockstepClock):
+            self.clock.stop()
         self.clock.advance_to(self._engine.time + 1e9)
 
     def _tool_poses(self) -> dict[str, Pose]:
@@ -374,4 +482,4 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         return f"<World {self.robot} t={self.sim_time.get_value():.2f}s {'running' if self.running else 'closed'}>"
 
 
-__all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK"]
+__all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK", "TRAJECTORY_PERIOD"]

@@ -546,16 +546,21 @@ class TaskGroup:
         self.tasks.append(task)
         trace = _debugger_trace()
         lockstep = current_lockstep()  # the branch counts as running from now on (lock-step time)
-        if lockstep is not None:
-            lockstep.spawned()
-        submit(lambda: self._thread_main(task, runner, fn, trace, lockstep))
+        ticket = lockstep.spawned() if lockstep is not None else None
+        submit(lambda: self._thread_main(task, runner, fn, trace, lockstep, ticket))
         return task
 
     def _thread_main(
-        self, task: Task, runner: Runner, fn: Callable[[], Any], trace: Any = None, lockstep: Any = None
+        self,
+        task: Task,
+        runner: Runner,
+        fn: Callable[[], Any],
+        trace: Any = None,
+        lockstep: Any = None,
+        ticket: Any = None,
     ) -> None:
         if lockstep is not None:
-            lockstep.adopt()
+            lockstep.adopt(ticket)  # runs when it is its turn (in task order)
         try:
             self._run_branch(task, runner, fn, trace)
         finally:

@@ -8,14 +8,15 @@ closed; 2 for bad options; else 1.
 
 from __future__ import annotations
 
+import math
 import time
 from pathlib import Path
 from typing import Any
 
 from pycram.apps.scenarios.set_table.data import OBJECTS
-from pycram.apps.scenarios.set_table.driver import _check, run_scenario
+from pycram.apps.scenarios.set_table.driver import _check, record_replay_info, run_scenario
 from pycram.apps.scenarios.set_table.judge import SetTableResult
-from pycram.core.runtime.lockstep import STEPPING_MODES
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 __all__ = ["main", "main_on_open_surfaces"]
@@ -36,12 +37,15 @@ def main(
     quiet: bool = False,
     animation: bool = True,
     in_containers: bool = True,
-    stepping: str = "free",
+    stepping: str | None = None,
+    until: float | None = None,
 ) -> int:
     """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
     tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
-    the task-tree SVG and the timeline of the recorded run. Returns the exit code: 0 only when
-    every object is at its place setting and every drawer closed; 2 for bad options; else 1."""
+    the task-tree SVG and the timeline of the recorded run. With `until` [s of simulated time]:
+    stop there and write the scene and belief pictures and the task tree of that moment. Returns
+    the exit code: 0 only when every object is at its place setting and every drawer closed, or
+    when the run was stopped at `until` and its pictures written; 2 for bad options; else 1."""
     import os
 
     from rich.console import Console
@@ -54,8 +58,11 @@ def main(
     console = Console()
     try:
         kinds = _check(robot, seed, faults)
+        stepping = stepping or DEFAULT_STEPPING
         if stepping not in STEPPING_MODES:
             raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {stepping!r}")
+        if until is not None and (not math.isfinite(until) or until < 0):
+            raise ValueError(f"--until must be a simulated time >= 0 [s], not {until}")
     except ValueError as error:
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
         return 2
@@ -95,14 +102,20 @@ def main(
             progress=progress,
             in_containers=in_containers,
             stepping=stepping,
+            until=until,
         )
     finally:
         if live is not None:
             live.stop()
         if recorder is not None:
+            record_replay_info(
+                recorder, result, task, in_containers=in_containers, stepping=stepping, pictures=True, until=until
+            )
             ok = result is not None and result.success
+            stopped = result is not None and result.stopped_at is not None
             run_id = recorder.finish(
-                "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
+                "succeeded" if ok else "interrupted" if stopped else "failed",
+                None if ok else (result.summary() if result else "error"),
             )
     files = [folder / n for n in ("start.png", "end.png", "run.gif") if (folder / n).exists()]
     if recorder is not None:
@@ -125,6 +138,13 @@ def main(
     console.print(f"pictures in {folder.resolve()}: " + ", ".join(p.name for p in files))
     if run_id is not None:
         console.print(f"recorded as run {run_id} (see `pycram show {run_id}`)")
+    if result.stopped_at is not None:
+        console.print(
+            f"[bold yellow]STOPPED[/bold yellow] at t={result.stopped_at:.2f} s of simulated time (--until {until:g}): "
+            f"the scene, the belief and the task tree of that moment are in {result.stop_folder}",
+            highlight=False,
+        )
+        return 0
     if result.success:
         console.print("[bold green]SUCCESS[/bold green]: the table is set, every drawer closed")
         return 0

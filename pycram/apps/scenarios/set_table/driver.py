@@ -12,6 +12,7 @@ the plan. `run_set_table` and `run_set_table_on_open_surfaces` are the ``set-tab
 from __future__ import annotations
 
 import logging
+import math
 import random
 import time
 from pathlib import Path
@@ -22,10 +23,11 @@ from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
 from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
 from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
-from pycram.core.runtime.lockstep import LockstepClock, PlanThread
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, LockstepClock, PlanThread
 
 __all__ = [
     "open_world",
+    "record_replay_info",
     "run_scenario",
     "run_set_table",
     "run_set_table_on_open_surfaces",
@@ -80,12 +82,14 @@ def open_world(
     faults: frozenset[str] = frozenset(),
     objects: tuple[str, ...] = OBJECTS,
     in_containers: bool = True,
-    stepping: str = "free",
+    stepping: str = DEFAULT_STEPPING,
+    offscreen_size: tuple[int, int] | None = None,
 ) -> tuple[Any, list[Any]]:
     """The apartment with the scenario's objects at random spots from `seed` (`start_scene`,
     some inside closed containers with `in_containers`) and `robot` at the start pose
     (perception misses detections with the ``missed`` fault), simulated with `stepping` ("free"
-    or "lockstep", see `pycram.sim.World`). Returns the world and the placements."""
+    or "lockstep", see `pycram.sim.World`; `offscreen_size` [px]: the largest picture it renders,
+    None for the world's default). Returns the world and the placements."""
     from pycram.backends.sim import ItemSpec, World
     from pycram.backends.sim.perception import PerceptionFaults
     from pycram.environments import load as load_environment
@@ -94,7 +98,8 @@ def open_world(
     placements = start_scene(load_environment("apartment"), seed, objects, in_containers)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
-    world = World(robot, items, environment="apartment", perception_faults=perception, stepping=stepping)
+    size: dict[str, Any] = {"offscreen_size": offscreen_size} if offscreen_size is not None else {}
+    world = World(robot, items, environment="apartment", perception_faults=perception, stepping=stepping, **size)
     return world, placements
 
 
@@ -119,21 +124,30 @@ def run_scenario(
     progress: Any = None,
     objects: tuple[str, ...] = OBJECTS,
     in_containers: bool = True,
-    stepping: str = "free",
+    stepping: str = DEFAULT_STEPPING,
+    until: float | None = None,
+    until_folder: Path | None = None,
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
     `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
     faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
     objects may start inside closed containers (`start_scene`); `stepping`: "lockstep" for a
-    run that depends on the seed alone (see `pycram.sim.World`). Returns the result and the
-    plan's task (the root of its task tree, None if it never started)."""
+    run that depends on the seed alone (see `pycram.sim.World`); `until` [s of simulated time]:
+    stop the world there, write the scene and belief pictures and the task tree of that moment
+    (`write_stop_pictures`) into a folder ``until-T.Ts`` below `until_folder` (default: `output`,
+    else ``output/set-table-ROBOT-SEED``), then stop the plan (`result.stopped_at`). Returns the
+    result and the plan's task (the root of its task tree, None if it never started)."""
     from pycram import robots as robot_packages
+    from pycram.apps.terminal import STOP_PICTURE_SIZE, write_stop_pictures
 
     kinds = _check(robot, seed, faults)
+    if until is not None and (not math.isfinite(until) or until < 0):
+        raise ValueError(f"--until must be a simulated time >= 0 [s], not {until}")
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
-    world, placements = open_world(robot, seed, kinds, objects, in_containers, stepping)
+    size = STOP_PICTURE_SIZE if until is not None else None
+    world, placements = open_world(robot, seed, kinds, objects, in_containers, stepping, offscreen_size=size)
     result.started_in = {p.name: p.container for p in placements if p.container is not None}
     plan: _PlanThread | None = None
     injector: Faults | None = None
@@ -153,6 +167,8 @@ def run_scenario(
         held_at_once = _HeldAtOnce(world)
         plan = _PlanThread(robot_handle, settings)
         sim_start = world.sim_time.get_value()
+        if until is not None:
+            world.hold_at(until)
         injector.start()
         plan.start()
         if isinstance(world.clock, LockstepClock):
@@ -161,6 +177,17 @@ def run_scenario(
         while not plan.join(0.25):
             if progress is not None:
                 progress(world, plan, injector)
+            if until is not None and world.held.is_set():  # the world stands at `until`: look, then stop
+                result.stopped_at = world.sim_time.get_value()
+                folder = until_folder or output or Path("output") / f"set-table-{robot}-{seed}"
+                result.stop_folder = folder / f"until-{result.stopped_at:.1f}s"
+                title = f"set table · {robot} · seed {seed} · t={result.stopped_at:.2f} s"
+                write_stop_pictures(world, robot_handle.belief, plan.task, result.stop_folder, title)
+                if isinstance(world.clock, LockstepClock):
+                    world.clock.leave()  # its waits for the pictures made it a plan thread: watch again
+                result.error = f"stopped at t={result.stopped_at:.2f} s of simulated time (--until {until:g})"
+                plan.stop()  # evaporated while the world stands still: no task ends after `until`
+                break
             if world.sim_time.get_value() > sim_deadline:
                 result.error = f"TimeoutError: the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
             elif time.monotonic() > wall_deadline:
@@ -180,6 +207,7 @@ def run_scenario(
         result.faults_injected = list(injector.injected)
         judge(world, settings, plan.outcomes, result)
         result.final_poses = {"base": world.base_pose.get_value(), **world.item_poses.get_value()}
+        result.trajectory = world.trajectory()
         if output is not None:
             world.snapshot(output / "end.png", camera=camera)
             if animation:
@@ -196,6 +224,39 @@ def run_scenario(
         world.close()
         result.wall_time = time.monotonic() - started_wall
     return result, plan.task if plan is not None else None
+
+
+def record_replay_info(
+    recorder: Any,
+    result: SetTableResult | None,
+    task: Any,
+    *,
+    in_containers: bool,
+    stepping: str,
+    pictures: bool,
+    until: float | None = None,
+) -> None:
+    """Store in the recorded run's info what `pycram replay` needs to run it again and -- for a
+    run that ended by itself (not stopped by `until`) -- its fingerprint
+    (`pycram.trace.fingerprint.recording_info`). Nothing without a `result`."""
+    from pycram.trace.fingerprint import recording_info
+
+    if result is None:
+        return
+    options: dict[str, Any] = {"faults": sorted(result.faults), "pictures": pictures}
+    if until is not None:
+        options["until"] = until
+    finished = result.stopped_at is None and task is not None
+    info = recording_info(
+        "set-table" if in_containers else "set-table-open",
+        result.robot,
+        "apartment",
+        result.seed,
+        stepping,
+        options,
+        fingerprint=(task, result.final_poses, result.trajectory) if finished else None,
+    )
+    recorder.set_run_info(**info)
 
 
 def _caption() -> str:
@@ -215,8 +276,10 @@ def run_set_table(
     pictures: bool = False,
     objects: tuple[str, ...] = OBJECTS,
     in_containers: bool = True,
+    stepping: str = DEFAULT_STEPPING,
 ) -> dict[str, Any]:
-    """Run the set-table scenario once, headless and without animation, for `pycram experiment`.
+    """Run the set-table scenario once, headless and without animation, simulated with
+    `stepping` (see `pycram.sim.World`), for `pycram experiment`.
 
     `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
     recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``
@@ -243,19 +306,32 @@ def run_set_table(
     scenario = "set-table" if in_containers else "set-table-open"
     output = Path("output") / f"{scenario}-{robot}-{seed}" if pictures else None
     result: SetTableResult | None = None
+    task = None
     try:
-        result, _ = run_scenario(
-            robot, seed, kinds, recorder=recorder, output=output, objects=tuple(objects), in_containers=in_containers
+        result, task = run_scenario(
+            robot,
+            seed,
+            kinds,
+            recorder=recorder,
+            output=output,
+            objects=tuple(objects),
+            in_containers=in_containers,
+            stepping=stepping,
         )
     finally:
         run_id = None
         if recorder is not None:
+            if tuple(objects) == OBJECTS:  # a replay brings every object
+                record_replay_info(
+                    recorder, result, task, in_containers=in_containers, stepping=stepping, pictures=pictures
+                )
             ok = result is not None and result.success
             run_id = recorder.finish(
                 "succeeded" if ok else "failed", None if ok else (result.summary() if result else "error")
             )
     out = result.as_dict()
     out["run_id"] = run_id
+    out["stepping"] = stepping
     return out
 
 
@@ -265,7 +341,8 @@ def run_set_table_on_open_surfaces(
     faults: frozenset[str] = frozenset(),
     db_url: str | None = None,
     pictures: bool = False,
+    stepping: str = DEFAULT_STEPPING,
 ) -> dict[str, Any]:
     """The ``set-table-open`` scenario of `pycram experiment`: `run_set_table` with every object
     starting on an open surface (the scenes of the same seeds without `START_CONTAINERS`)."""
-    return run_set_table(robot, seed, faults, db_url, pictures, in_containers=False)
+    return run_set_table(robot, seed, faults, db_url, pictures, in_containers=False, stepping=stepping)

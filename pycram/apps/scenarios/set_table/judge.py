@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import threading
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from pycram.apps.scenarios.set_table.data import CLOSED, MAX_TILT, TOLERANCE
@@ -68,6 +69,12 @@ class SetTableResult:
     started_in: dict[str, str] = field(default_factory=dict)
     #: The robot's base and every object at the end (the simulator's truth; for fingerprints).
     final_poses: dict[str, Any] = field(default_factory=dict)
+    #: The world's state every simulated second (`pycram.sim.World.trajectory`; for fingerprints).
+    trajectory: list[Any] = field(default_factory=list)
+    #: With `until`: the simulated time [s] the run was stopped at, and the folder the pictures
+    #: and the task tree of that moment went to (None: the run was not stopped so).
+    stopped_at: float | None = None
+    stop_folder: Path | None = None
 
     @property
     def success(self) -> bool:
