@@ -209,7 +209,12 @@ def test_set_table_is_registered_lazily():
         ):
             get_scenario("set-table")
     else:
+        from pycram.apps.scenarios.set_table import FAULTS
+
         assert callable(get_scenario("set-table").load())
+        # `--faults all` expands to the scenario's faults (the registry reads them after import)
+        assert get_scenario("set-table").known_faults() == tuple(sorted(FAULTS))
+        assert get_scenario("set-table-open").known_faults() == tuple(sorted(FAULTS))
 
 
 def test_seed_parsing():

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from pycram.apps.scenarios.set_table.data import MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
+from pycram.apps.scenarios.set_table.data import FAULTS, MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
 from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
 from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
@@ -346,3 +346,8 @@ def run_set_table_on_open_surfaces(
     """The ``set-table-open`` scenario of `pycram experiment`: `run_set_table` with every object
     starting on an open surface (the scenes of the same seeds without `START_CONTAINERS`)."""
     return run_set_table(robot, seed, faults, db_url, pictures, in_containers=False, stepping=stepping)
+
+
+# the fault names `pycram experiment --faults all` expands to (read by the scenario registry)
+run_set_table.FAULTS = FAULTS  # type: ignore[attr-defined]
+run_set_table_on_open_surfaces.FAULTS = FAULTS  # type: ignore[attr-defined]
