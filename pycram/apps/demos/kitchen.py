@@ -381,8 +381,6 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
             result.stop_folder = output / f"until-{result.stopped_at:.1f}s"
             title = f"thesis demo · {options.robot} · seed {options.seed} · t={result.stopped_at:.2f} s"
             result.files.extend(write_stop_pictures(world, robot.belief, run.task, result.stop_folder, title))
-            if isinstance(world.clock, LockstepClock):
-                world.clock.leave()  # its waits for the pictures made it a plan thread: watch again
             result.message = (
                 f"stopped at t={result.stopped_at:.2f} s of simulated time (--until {options.until:g}); "
                 f"the scene, the belief and the task tree of that moment are in {result.stop_folder}"

@@ -183,8 +183,6 @@ def run_scenario(
                 result.stop_folder = folder / f"until-{result.stopped_at:.1f}s"
                 title = f"set table · {robot} · seed {seed} · t={result.stopped_at:.2f} s"
                 write_stop_pictures(world, robot_handle.belief, plan.task, result.stop_folder, title)
-                if isinstance(world.clock, LockstepClock):
-                    world.clock.leave()  # its waits for the pictures made it a plan thread: watch again
                 result.error = f"stopped at t={result.stopped_at:.2f} s of simulated time (--until {until:g})"
                 plan.stop()  # evaporated while the world stands still: no task ends after `until`
                 break
