@@ -10,7 +10,11 @@ For each robot, in one process:
   in lock-step, with 1 and then 2 local worker processes: runs per minute of wall time, and
   whether every seed's result (simulated time, success) is the same with 1 and with 2 workers.
 Each run prints its simulated time, its wall time, the speed (sim / wall) and that speed as a
-share of physics alone; lock-step runs also print their fingerprint, which repeats run after run
+share of physics alone, and a second table says where the wall time of each lock-step run
+went (`World.time_spent()`: physics, controllers, starting commands -- IK, path planning,
+perception's rendering --, publishing sensors, recording, and the plan's own code while the
+world stood still; "other" is outside the loop: building the scene, closing); lock-step runs
+also print their fingerprint, which repeats run after run
 (free-running ones differ). The target of issue 31: a set-table run at >= 70 % of physics
 alone in lock-step.
 
@@ -30,6 +34,25 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+#: `World.time_spent()` of the last world closed (see `_keep_time_spent`).
+_SPENT: dict[str, float] = {}
+
+
+def _keep_time_spent() -> None:
+    """Keep the time spent by each world's simulation loop when the world is closed."""
+    from pycram.backends.sim.world import World
+
+    close = World.close
+
+    def closing(self, *args, **kwargs):
+        if self.running:
+            _SPENT.clear()
+            _SPENT.update(self.time_spent())
+        return close(self, *args, **kwargs)
+
+    World.close = closing
 
 
 def physics_alone(robot: str, environment: str, seconds: float) -> float:
@@ -104,6 +127,10 @@ def main() -> None:
     from rich.console import Console
     from rich.table import Table
 
+    _keep_time_spent()
+    breakdown = Table(title="where the wall time of the lock-step runs went (World.time_spent, % of the run's wall)")
+    for column in ("robot", "run", "physics", "controllers", "commands", "sensors", "recording", "plan", "other"):
+        breakdown.add_column(column, justify="left" if column in ("robot", "run") else "right")
     table = Table(title="lock-step vs free-running (sim / wall: x real time; share: of physics alone)")
     for column in ("robot", "run", "stepping", "sim [s]", "wall [s]", "x real time", "share", "fingerprint"):
         table.add_column(column, justify="right" if column not in ("robot", "run", "stepping") else "left")
@@ -118,6 +145,10 @@ def main() -> None:
                 for _ in range(args.repeat):
                     sim, wall, fingerprint = run(robot, stepping)
                     speed = sim / wall if wall > 0 else 0.0
+                    if stepping == "lockstep" and _SPENT and wall > 0:
+                        shares = {part: 100 * seconds / wall for part, seconds in _SPENT.items()}
+                        other = 100 - sum(shares.values())
+                        breakdown.add_row(robot, name, *(f"{shares[p]:.0f} %" for p in _SPENT), f"{other:.0f} %")
                     table.add_row(
                         robot,
                         name,
@@ -130,6 +161,7 @@ def main() -> None:
                     )
     console = Console(width=140)
     console.print(table)
+    console.print(breakdown)
     if args.throughput:
         per_minute = {}
         for workers in (1, 2):

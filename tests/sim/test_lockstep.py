@@ -40,6 +40,19 @@ def test_a_plan_computing_for_a_long_wall_time_loses_no_simulated_time():
     assert free > 0.5  # beside the plan, the simulation runs on while the plan thinks
 
 
+def test_the_world_says_where_its_wall_time_went():
+    from pycram.backends.sim.world import TIME_SPENT_PARTS
+
+    with World("pr2") as world:
+        handle = world.drive_to(1.5, 0.6, 0.0)
+        time.sleep(0.3)  # the plan thinks: the simulation stands still, and counts it as the plan's
+        assert handle.wait(30.0).succeeded
+        spent = world.time_spent()
+    assert tuple(spent) == TIME_SPENT_PARTS
+    assert spent["plan"] >= 0.3 and spent["physics"] > 0.0 and spent["controllers"] > 0.0
+    assert sum(spent.values()) < 30.0
+
+
 def test_concurrent_branches_that_compute_hold_the_simulation_until_they_wait():
     with World("pr2", stepping="lockstep") as world:
         starts = []

@@ -82,6 +82,8 @@ _CLOCK_LOCK = threading.Lock()
 REALTIME_SLACK = 0.05
 #: Simulated time between two samples of `World.trajectory()` [s].
 TRAJECTORY_PERIOD = 1.0
+#: The parts of the simulation thread's loop that `World.time_spent()` accounts for.
+TIME_SPENT_PARTS = ("physics", "controllers", "commands", "sensors", "recording", "plan")
 #: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
 #: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
 _LIVE_WORLDS: weakref.WeakSet[World] = weakref.WeakSet()
@@ -198,6 +200,8 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         self._hold_at: float | None = None
         #: Set once the simulation stands still at the time given to `hold_at`.
         self.held = threading.Event()
+        # wall time [s] the simulation thread spent on each part of its loop (see `time_spent`)
+        self._spent = dict.fromkeys(TIME_SPENT_PARTS, 0.0)
         self._previous_clock = set_clock(self.clock) if activate_clock else None
         self._clock_active = activate_clock
         self._thread = threading.Thread(target=self._run, name=f"pycram-sim-{robot}", daemon=True)
@@ -282,23 +286,34 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         if lockstep is not None:
             lockstep.steps_here()  # the threads its steps wake run once each step is over
         tick = self._steps_per_tick * float(self.scene.model.opt.timestep)
+        spent = self._spent
+        clock = time.perf_counter
         try:
             while not self._stop.is_set():
                 if lockstep is not None and not lockstep.quiet():
                     # plan code runs: the world stands still (commands wait for the next step)
+                    t0 = clock()
                     lockstep.wait_until_quiet(self._stop.is_set)
+                    spent["plan"] += clock() - t0
                     continue
                 hold = self._hold_at
                 if hold is not None and eng.time + tick > hold + 1e-9:
                     self._serve_held()  # the next step would pass `hold`: stand still, serve commands
                     continue
+                t0 = clock()
                 self._drain_inbox()
+                t1 = clock()
                 t = eng.time
                 for channel, (ctrl, _handle) in list(self._active.items()):
                     out = ctrl.update(eng, t)
                     if out is not None:
                         self._end(channel, out, stop=not out.succeeded)
+                t2 = clock()
                 eng.step(self._steps_per_tick)
+                t3 = clock()
+                spent["commands"] += t1 - t0
+                spent["controllers"] += t2 - t1
+                spent["physics"] += t3 - t2
                 self.clock.advance_to(eng.time)
                 if eng.time >= self._next_sample - 1e-9:  # a fixed schedule in simulated time
                     self._trajectory.append(self._sample_state())
@@ -314,9 +329,13 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
                     finished, self._finished = self._finished, []
                     for handle, outcome in finished:
                         handle._finish(outcome)
+                t4 = clock()
                 recorder = self._recorder
                 if recorder is not None and recorder.due(eng.time):
                     recorder.capture(eng.data)  # a copy of the state; rendered in the recorder's thread
+                t5 = clock()
+                spent["sensors"] += t4 - t3
+                spent["recording"] += t5 - t4
                 if self.realtime:
                     ahead = (eng.time - sim0) / self.realtime_factor - (time.monotonic() - wall0)
                     if ahead > 0:
@@ -355,6 +374,17 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         positions [m or rad] sorted by name. In lock-step the samples depend on the seed and
         the options alone. Thread-safe; a copy."""
         return list(self._trajectory)
+
+    def time_spent(self) -> dict[str, float]:
+        """Wall time [s] the simulation thread has spent so far on each part of its loop:
+        "physics" (`mj_step`), "controllers" (each command's control law, every tick),
+        "commands" (starting commands: IK, path planning, perception's rendering, pictures),
+        "sensors" (publishing the sensor fluents and waking the plan threads waiting on them,
+        the trajectory samples), "recording" (copying frames for a recording), and "plan" (in
+        lock-step: standing still while plan code ran -- thinking, belief updates, location
+        reasoning). What is left of the wall time was spent outside the loop (construction,
+        closing, a held world). Approximate while the simulation runs; a copy."""
+        return dict(self._spent)
 
     def hold_at(self, sim_time: float) -> None:
         """Stop stepping before simulated time would pass `sim_time` [s]: the world then stands
@@ -482,4 +512,4 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         return f"<World {self.robot} t={self.sim_time.get_value():.2f}s {'running' if self.running else 'closed'}>"
 
 
-__all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK", "TRAJECTORY_PERIOD"]
+__all__ = ["World", "DEFAULT_BASE_POSE", "REALTIME_SLACK", "TIME_SPENT_PARTS", "TRAJECTORY_PERIOD"]
