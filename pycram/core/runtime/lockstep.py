@@ -44,8 +44,9 @@ A plan thread blocked outside PyCRAM (a lock, a queue, `time.sleep`, joining ano
 keeps the turn: the simulation and every other plan thread stand still until it waits in
 PyCRAM again. Waiting for the simulation or for another plan thread that way hangs a lock-step
 world -- wait on fluents or command handles; a thread that only watches a plan by wall time
-`leave`s first (or waits inside `LockstepClock.watching()`). A PyCRAM wait while holding another lock that a plan thread may need deadlocks
-too (the waiter, woken, waits for its turn holding it).
+`leave`s first (or waits inside `LockstepClock.watching()`). A PyCRAM wait while holding
+another lock that a plan thread may need deadlocks too (the waiter, woken, waits for its turn
+holding it).
 """
 
 from __future__ import annotations
