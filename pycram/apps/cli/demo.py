@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import typer
 
 from pycram.apps.cli.app import (
@@ -15,6 +13,7 @@ from pycram.apps.cli.app import (
     record_flag,
     trace_errors,
 )
+from pycram.apps.run_options import check_until
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 #: `--steal` above this is refused: the plan gives up long before (it retries a few times).
@@ -92,8 +91,10 @@ def demo_command(
     Exit code: 0 on success (or, with --until, once the pictures of that moment are written);
     1 when the plan failed; 2 for bad options; 130 / 143 when stopped by SIGINT / SIGTERM.
     A recorded run can be run again with `pycram replay RUN`."""
-    if until is not None and (not math.isfinite(until) or until < 0):
-        fail(f"--until must be a simulated time >= 0 [s], not {until}", code=2)
+    try:
+        check_until(until)
+    except ValueError as error:
+        fail(str(error), code=2)
     if until is not None and backend != "sim":
         fail("--until applies to --backend sim only", code=2)
     if output is not None:

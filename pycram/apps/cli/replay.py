@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
@@ -10,6 +9,7 @@ import typer
 from rich.markup import escape
 
 from pycram.apps.cli.app import DbOption, app, console, err, fail
+from pycram.apps.run_options import check_until
 
 
 @app.command("replay")
@@ -32,8 +32,10 @@ def replay_command(
     simulated time, the task path, which pose). Exit code 0 only when identical; 1 when it
     diverged; 2 when the run cannot be replayed (not found, recorded without what a replay needs,
     free-running, stopped early) -- one line saying why."""
-    if until is not None and (not math.isfinite(until) or until < 0):
-        fail(f"--until must be a simulated time >= 0 [s], not {until}", code=2)
+    try:
+        check_until(until)
+    except ValueError as error:
+        fail(str(error), code=2)
     try:
         from pycram.apps.replay import CannotReplay, load_replay, replay_run
         from pycram.trace.db import TraceDatabaseError, resolve_url, sqlite_file

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from pycram.apps.run_options import check_stepping, check_until
 from pycram.apps.terminal import (
     STOP_PICTURE_SIZE,
     log_to_terminal,
@@ -37,7 +38,7 @@ from pycram.apps.terminal import (
     write_run_pictures,
     write_stop_pictures,
 )
-from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES, LockstepClock, PlanThread
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING, LockstepClock, PlanThread
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 if TYPE_CHECKING:  # imported where used: the ROS backend is optional
@@ -211,12 +212,11 @@ def run_demo(options: DemoOptions, stop: Any = None) -> DemoResult:
         raise ValueError(f"--backend must be 'sim' or 'ros', not {options.backend!r}")
     if options.robot not in robot_names():
         raise ValueError(f"--robot must be {robot_choices()}, not {options.robot!r}")
-    if options.stepping is not None and options.stepping not in STEPPING_MODES:
-        raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {options.stepping!r}")
-    if options.stepping is not None and options.backend != "sim":
-        raise ValueError("--stepping applies to --backend sim only (over ROS the bridge keeps the time)")
-    if options.until is not None and (not math.isfinite(options.until) or options.until < 0):
-        raise ValueError(f"--until must be a simulated time >= 0 [s], not {options.until}")
+    if options.stepping is not None:
+        check_stepping(options.stepping)
+        if options.backend != "sim":
+            raise ValueError("--stepping applies to --backend sim only (over ROS the bridge keeps the time)")
+    check_until(options.until)
     if options.until is not None and options.backend != "sim":
         raise ValueError("--until applies to --backend sim only")
     stop = stop if stop is not None else StopSignals()  # never signalled unless entered

@@ -43,7 +43,8 @@ from pathlib import Path
 from typing import Any
 
 from pycram.apps.experiments.scenarios import RunInterrupted, Scenario, UnknownScenario, get_scenario
-from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES
+from pycram.apps.run_options import check_stepping
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 log = logging.getLogger(__name__)
@@ -206,8 +207,11 @@ def prepare_experiment(
             existing = store.find_experiment(db, name)
         except store.ExperimentNotFound:
             existing = None
-    if stepping is not None and stepping not in STEPPING_MODES:
-        raise ExperimentInputError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {stepping!r}")
+    if stepping is not None:
+        try:
+            check_stepping(stepping)
+        except ValueError as error:
+            raise ExperimentInputError(str(error)) from None
     spec = scenario if scenario is not None else existing.scenario if existing is not None else "thesis"
     try:
         entry = get_scenario(spec)

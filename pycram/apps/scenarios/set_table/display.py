@@ -8,15 +8,14 @@ closed; 2 for bad options; else 1.
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
 from typing import Any
 
+from pycram.apps.run_options import check_stepping, check_until
 from pycram.apps.scenarios.set_table.data import OBJECTS
 from pycram.apps.scenarios.set_table.driver import _check, record_replay_info, run_scenario
 from pycram.apps.scenarios.set_table.judge import SetTableResult
-from pycram.core.runtime.lockstep import DEFAULT_STEPPING, STEPPING_MODES
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 __all__ = ["main", "main_on_open_surfaces"]
@@ -58,11 +57,8 @@ def main(
     console = Console()
     try:
         kinds = _check(robot, seed, faults)
-        stepping = stepping or DEFAULT_STEPPING
-        if stepping not in STEPPING_MODES:
-            raise ValueError(f"--stepping must be {' or '.join(STEPPING_MODES)}, not {stepping!r}")
-        if until is not None and (not math.isfinite(until) or until < 0):
-            raise ValueError(f"--until must be a simulated time >= 0 [s], not {until}")
+        stepping = check_stepping(stepping)
+        check_until(until)
     except ValueError as error:
         console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
         return 2

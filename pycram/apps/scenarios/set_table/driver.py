@@ -12,12 +12,12 @@ the plan. `run_set_table` and `run_set_table_on_open_surfaces` are the ``set-tab
 from __future__ import annotations
 
 import logging
-import math
 import random
 import time
 from pathlib import Path
 from typing import Any
 
+from pycram.apps.run_options import check_until
 from pycram.apps.scenarios.set_table.data import FAULTS, MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
 from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
@@ -142,8 +142,7 @@ def run_scenario(
     from pycram.apps.terminal import STOP_PICTURE_SIZE, write_stop_pictures
 
     kinds = _check(robot, seed, faults)
-    if until is not None and (not math.isfinite(until) or until < 0):
-        raise ValueError(f"--until must be a simulated time >= 0 [s], not {until}")
+    check_until(until)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
     size = STOP_PICTURE_SIZE if until is not None else None
