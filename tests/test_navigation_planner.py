@@ -113,3 +113,23 @@ def test_a_robot_touching_a_wall_can_still_leave():
     start = BasePose(0.38, 3.0, 0.0)  # its back edge 2 cm into the wall's clearance
     assert not planner.pose_free(start.x, start.y, start.yaw)
     assert planner.plan(start, (3.0, 3.0, 0.0))[-1] == BasePose(3.0, 3.0, 0.0)
+
+
+def test_squared_distances_are_exact_within_reach_and_follow_the_mask_content():
+    from pycram.world.navigation import squared_distances
+
+    rng = np.random.default_rng(1)
+    mask = rng.random((30, 45)) > 0.98
+    rr, cc = np.nonzero(mask)
+    R, C = np.mgrid[0:30, 0:45]
+    brute = np.min([(R - r) ** 2 + (C - c) ** 2 for r, c in zip(rr, cc)], axis=0)
+    for reach in (2.0, 6.5, 4.0, 13.0):  # asking farther than before computes again
+        d2 = squared_distances(mask, reach)
+        near = brute <= reach * reach
+        assert np.array_equal(d2[near], brute[near])
+        assert (d2[~near] > reach * reach).all()
+        assert np.array_equal(dilate(mask, reach), near)
+    far_cell = tuple(np.argwhere(brute > 9)[0])
+    assert squared_distances(mask, 3.0)[far_cell] > 9
+    mask[far_cell] = True  # changed in place: another content, not the cached answer
+    assert squared_distances(mask, 3.0)[far_cell] == 0

@@ -38,8 +38,11 @@ Failures: :class:`NoPathError` (a :class:`NavigationFailure`) with ``reason`` ``
 
 from __future__ import annotations
 
+import hashlib
 import heapq
 import math
+import threading
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -56,6 +59,7 @@ __all__ = [
     "OccupancyGrid",
     "PathPlanner",
     "dilate",
+    "squared_distances",
 ]
 
 SQRT2 = math.sqrt(2.0)
@@ -165,26 +169,69 @@ class Footprint:
 
 
 def dilate(mask: np.ndarray, radius_cells: float) -> np.ndarray:
-    """``mask`` grown by a disk of ``radius_cells`` (cells within that distance of a set cell)."""
-    out = mask.copy()
-    r = int(math.floor(radius_cells))
-    if r <= 0 or not mask.any():
-        return out
+    """``mask`` grown by a disk of ``radius_cells``: the cells whose centre is within that
+    distance [cells] of a set cell's centre (a new array; thread-safe)."""
+    if int(math.floor(radius_cells)) <= 0 or not mask.any():
+        return mask.copy()
+    return _within(mask, radius_cells)
+
+
+def _within(mask: np.ndarray, radius_cells: float) -> np.ndarray:
+    """The cells within ``radius_cells`` of a set cell of ``mask`` (none when it is negative)."""
+    if radius_cells < 0:
+        return np.zeros_like(mask, dtype=bool)
+    return squared_distances(mask, radius_cells) <= radius_cells * radius_cells
+
+
+#: Masks whose squared distances `squared_distances` keeps (the least recently used go first).
+DISTANCE_CACHE_SIZE = 16
+_distance_cache: OrderedDict[bytes, tuple[int, np.ndarray]] = OrderedDict()
+_distance_lock = threading.Lock()
+
+
+def squared_distances(mask: np.ndarray, reach: float) -> np.ndarray:
+    """The squared distance [cells^2] from each cell's centre to the nearest set cell's centre of
+    the 2D boolean ``mask``: exact wherever it is at most ``reach``^2; any larger value only says
+    "farther than ``reach``". Read-only (shared).
+
+    The last `DISTANCE_CACHE_SIZE` masks' answers are kept (by content), so growing the same
+    obstacles by several radii -- a planner's inflation layers, the next planner of an unchanged
+    room -- computes them once: O(reach x cells) with numpy."""
+    need = max(0, int(math.ceil(reach)))
+    key = np.asarray(mask.shape, np.int64).tobytes() + hashlib.blake2b(mask.tobytes(), digest_size=16).digest()
+    with _distance_lock:
+        cached = _distance_cache.get(key)
+        if cached is not None and cached[0] >= need:
+            _distance_cache.move_to_end(key)
+            return cached[1]
+    if cached is not None:  # asked farther than before: at least twice as far, so this is rare
+        need = max(need, 2 * cached[0])
+    distances = _squared_distances(np.asarray(mask, bool), need)
+    distances.setflags(write=False)
+    with _distance_lock:
+        _distance_cache[key] = (need, distances)
+        _distance_cache.move_to_end(key)
+        while len(_distance_cache) > DISTANCE_CACHE_SIZE:
+            _distance_cache.popitem(last=False)
+    return distances
+
+
+def _squared_distances(mask: np.ndarray, reach: int) -> np.ndarray:
+    """`squared_distances` computed: each row's distance to its nearest set cell (both
+    directions, by running maxima of indices), then the minimum over rows up to ``reach`` away
+    of that distance squared plus the rows' offset squared. Values above ``reach``^2 are capped
+    at (``reach`` + 1)^2."""
     rows, cols = mask.shape
-    for dr in range(-r, r + 1):
-        w = int(math.floor(math.sqrt(radius_cells * radius_cells - dr * dr)))
-        # rows shifted by dr, then a horizontal run of half-width w (a 1D dilation by doubling)
-        src = mask[max(0, -dr) : rows - max(0, dr)]
-        run = src.copy()
-        span = 1
-        while span <= w:
-            step = min(span, w - span + 1)
-            shifted = np.zeros_like(run)
-            shifted[:, step:] |= run[:, :-step]
-            shifted[:, :-step] |= run[:, step:]
-            run |= shifted
-            span += step
-        out[max(0, dr) : rows - max(0, -dr)] |= run
+    far = reach + 1
+    index = np.arange(cols, dtype=np.int64)
+    left = np.maximum.accumulate(np.where(mask, index, -(cols + far)), axis=1)
+    right = np.minimum.accumulate(np.where(mask, index, 2 * cols + far)[:, ::-1], axis=1)[:, ::-1]
+    across = np.minimum(np.minimum(index - left, right - index), far)
+    across = across * across
+    out = np.full(mask.shape, far * far, dtype=np.int64)
+    for dr in range(-min(reach, rows - 1), min(reach, rows - 1) + 1):
+        target = out[max(0, dr) : rows - max(0, -dr)]
+        np.minimum(target, across[max(0, -dr) : rows - max(0, dr)] + dr * dr, out=target)
     return out
 
 
@@ -286,11 +333,15 @@ class PathPlanner:
         sure_not_free = np.zeros_like(occupied)
         for layer in self._layers:
             m = layer.mask
-            self.lethal |= dilate(m, (layer.inscribed + self._margin) / res)
-            self.caution |= dilate(m, (layer.circumscribed + self._margin) / res)
+            if not m.any():
+                continue
+            # the largest radius first: one distance map serves all four
+            reach = (layer.circumscribed + self._margin + half) / res
+            sure_not_free |= _within(m, reach)
+            self.lethal |= _within(m, (layer.inscribed + self._margin) / res)
+            self.caution |= _within(m, (layer.circumscribed + self._margin) / res)
             # for single poses anywhere in a cell (up to half a diagonal from its centre)
-            self._sure_hit |= dilate(m, (layer.inscribed + self._margin - half) / res)
-            sure_not_free |= dilate(m, (layer.circumscribed + self._margin + half) / res)
+            self._sure_hit |= _within(m, (layer.inscribed + self._margin - half) / res)
         self._sure_free = ~sure_not_free
         self._turn_radius = max(layer.circumscribed for layer in self._layers)
 

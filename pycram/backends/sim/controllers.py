@@ -321,10 +321,11 @@ class HeadPointing(Controller):
         cam = eng.camera
         forward = -d.cam_xmat[cam].reshape(3, 3)[:, 2]
         to = self.point - d.cam_xpos[cam]
-        to /= max(np.linalg.norm(to), 1e-9)
-        axis = np.cross(forward, to)
-        s = np.linalg.norm(axis)
-        angle = math.atan2(s, float(forward @ to))
+        to /= max(math.sqrt(float(to @ to)), 1e-9)
+        (f0, f1, f2), (t0, t1, t2) = forward.tolist(), to.tolist()
+        axis = np.array((f1 * t2 - f2 * t1, f2 * t0 - f0 * t2, f0 * t1 - f1 * t0))  # forward x to
+        s = math.sqrt(float(axis @ axis))
+        angle = math.atan2(s, f0 * t0 + f1 * t1 + f2 * t2)
         if s < 1e-9:
             return np.zeros(3), angle
         return axis / s * angle, angle
@@ -335,7 +336,12 @@ class HeadPointing(Controller):
         body = int(m.cam_bodyid[eng.camera])
         mujoco.mj_jacBody(m, d, None, self.jacr, body)
         J = self.jacr[:, self.dofs]
-        dq = np.linalg.lstsq(J, err, rcond=1e-3)[0]
+        normal = J.T @ J  # 2 x 2: solved directly unless (nearly) singular, e.g. looking straight down
+        (a, b), (_, c) = normal.tolist()
+        if a * c - b * b > 1e-6 * (a + c) ** 2:
+            dq = np.linalg.solve(normal, J.T @ err)
+        else:
+            dq = np.linalg.lstsq(J, err, rcond=1e-3)[0]
         wanted = np.array([eng.q(j) for j in self.joints]) + dq
         if self._previous is not None and t > self._previous[0]:
             rate = (wanted - self._previous[1]) / (t - self._previous[0])

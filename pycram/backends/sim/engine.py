@@ -79,8 +79,8 @@ class Gripper:
             data.qpos[adr] = offset + factor * q
 
     def _opening(self, data: mujoco.MjData) -> float:
-        a, b = data.site_xpos[self.pads[0]], data.site_xpos[self.pads[1]]
-        return float(np.linalg.norm(a - b) - self.spec["pad_offset"])
+        a, b = data.site_xpos[self.pads[0]].tolist(), data.site_xpos[self.pads[1]].tolist()
+        return math.dist(a, b) - float(self.spec["pad_offset"])
 
     def opening(self, data: mujoco.MjData) -> float:
         """Measured opening [m] (distance between the finger pads), clipped at 0."""
@@ -108,6 +108,8 @@ class Engine:
         self.camera = scene.camera(HEAD_CAMERA)
         self.tool_sites = {arm: scene.site(tool_site(arm)) for arm in desc.ARMS}
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
+        self._base_mask: np.ndarray | None = None  # see `base_contacts`
+        self._environment_mask: np.ndarray = np.zeros(0, bool)
         self.item_geoms = {
             it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name) for it in scene.items
         }
@@ -214,17 +216,20 @@ class Engine:
 
     def base_contacts(self) -> list[tuple[str, str]]:
         """Pairs (robot geom, environment geom) of base links touching the environment."""
+        if self.data.ncon == 0:
+            return []
+        if self._base_mask is None:  # geom id -> is a base geom / an environment geom
+            self._base_mask = np.zeros(self.model.ngeom, bool)
+            self._base_mask[list(self.scene.base_geoms)] = True
+            self._environment_mask = np.zeros(self.model.ngeom, bool)
+            self._environment_mask[list(self.scene.environment_geoms)] = True
+        contact = self.data.contact
+        g1, g2, touching = contact.geom1, contact.geom2, contact.dist <= 0.0
+        base, env = self._base_mask, self._environment_mask
         out = []
-        base, env = self.scene.base_geoms, self.scene.environment_geoms
-        for i in range(self.data.ncon):
-            c = self.data.contact[i]
-            g1, g2 = int(c.geom1), int(c.geom2)
-            if c.dist > 0.0:
-                continue
-            if g1 in base and g2 in env:
-                out.append((self.model.geom(g1).name, self.model.geom(g2).name))
-            elif g2 in base and g1 in env:
-                out.append((self.model.geom(g2).name, self.model.geom(g1).name))
+        for i in np.flatnonzero(touching & ((base[g1] & env[g2]) | (base[g2] & env[g1]))).tolist():
+            a, b = (int(g1[i]), int(g2[i])) if base[g1[i]] and env[g2[i]] else (int(g2[i]), int(g1[i]))
+            out.append((self.model.geom(a).name, self.model.geom(b).name))
         return out
 
     # --- grasping -------------------------------------------------------------------------

@@ -10,6 +10,7 @@ meshes: mesh vertices, other shapes: their bounding box).
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -31,6 +32,9 @@ BAND = 0.1
 #: Directions along which outlines of many points are sampled (see `planar_extremes`).
 EXTREME_DIRECTIONS = 64
 
+#: (directions, digest of a mesh's vertices) -> the indices `local_vertices` keeps of them.
+_EXTREMES: dict[tuple[int, bytes], np.ndarray] = {}
+
 _UNIT_BOX = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
 
 
@@ -44,12 +48,16 @@ def local_vertices(model: mujoco.MjModel, geom: int, directions: int = 0) -> np.
         adr, num = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
         local = np.asarray(model.mesh_vert[adr : adr + num], float)
         if directions and num > directions:
-            k = np.arange(directions) + 0.5  # a Fibonacci sphere
-            z = 1.0 - 2.0 * k / directions
-            phi = np.pi * (1.0 + 5**0.5) * k
-            r = np.sqrt(1.0 - z * z)
-            dirs = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
-            local = local[np.unique(np.argmax(local @ dirs.T, axis=0))]
+            key = (directions, hashlib.blake2b(local.tobytes(), digest_size=16).digest())
+            chosen = _EXTREMES.get(key)
+            if chosen is None:  # the same mesh in the next scene (a robot's links) is not searched again
+                k = np.arange(directions) + 0.5  # a Fibonacci sphere
+                z = 1.0 - 2.0 * k / directions
+                phi = np.pi * (1.0 + 5**0.5) * k
+                r = np.sqrt(1.0 - z * z)
+                dirs = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+                chosen = _EXTREMES[key] = np.unique(np.argmax(local @ dirs.T, axis=0))
+            local = local[chosen]
         return local
     if gtype == mujoco.mjtGeom.mjGEOM_BOX:
         return _UNIT_BOX * model.geom_size[geom]

@@ -44,6 +44,8 @@ class Scene:
     robot_geoms: frozenset[int] = field(default_factory=frozenset)
     base_geoms: frozenset[int] = field(default_factory=frozenset)
     environment_geoms: frozenset[int] = field(default_factory=frozenset)
+    #: Joint name -> id, filled as joints are looked up (controllers look up every tick).
+    _joint_ids: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def robot(self) -> str:
@@ -59,9 +61,12 @@ class Scene:
         return int(self.model.jnt_dofadr[self.joint_id(joint)])
 
     def joint_id(self, joint: str) -> int:
-        jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-        if jid < 0:
-            raise UnknownNameError("joint", joint, self.joint_names())
+        jid = self._joint_ids.get(joint)
+        if jid is None:
+            jid = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+            if jid < 0:
+                raise UnknownNameError("joint", joint, self.joint_names())
+            self._joint_ids[joint] = jid
         return jid
 
     def joint_names(self) -> list[str]:
