@@ -10,6 +10,20 @@ A :class:`Prospection` answers three questions for the robot it belongs to:
 - :meth:`Prospection.visible` -- with the head camera pointed at a target from a base pose, which
   fraction of the target would it see?
 
+and, for arm motion planning (:mod:`pycram.reasoning.motion`), three more:
+
+- :meth:`Prospection.arm_joint_limits` -- an arm's joints (the torso first when asked) with their
+  position, velocity and acceleration limits;
+- :meth:`Prospection.configuration_checker` -- a :class:`ConfigurationChecker` that tells, fast
+  (tens of microseconds a question), whether an arm joint configuration at a base pose is free of
+  collisions with the environment, the objects, the robot's other parts, with a held object moving
+  with the hand and the object being grasped exempt at the gripper;
+- :meth:`Prospection.solve_ik` -- an arm configuration that puts the tool frame at a pose, within
+  the joint limits and (optionally) free of collisions: an :class:`IKResult`.
+
+Implementations that do not plan arm motion need not provide these: the defaults raise
+``NotImplementedError`` naming the implementation.
+
 Guarantees every implementation gives
 -------------------------------------
 - **The world as it is now**: each answer reflects the state of the world at (or shortly before)
@@ -36,6 +50,7 @@ import abc
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from types import TracebackType
 from typing import Any
 
 __all__ = [
@@ -45,6 +60,10 @@ __all__ = [
     "Reachability",
     "Visibility",
     "REACH_FAILURES",
+    "JointLimits",
+    "ConfigurationChecker",
+    "IKResult",
+    "IK_FAILURES",
     "as_base_pose",
     "as_tool_pose",
 ]
@@ -54,6 +73,11 @@ __all__ = [
 #: ``'joint_limit'`` -- one does, but only outside the joint limits;
 #: ``'collision'`` -- every solution found (or the base pose itself) collides with the environment.
 REACH_FAILURES = ("out_of_reach", "joint_limit", "collision")
+
+#: Reasons why :meth:`Prospection.solve_ik` fails (``IKResult.reason``):
+#: ``'no_solution'`` -- no seed converged to the pose within the tolerances and the joint limits;
+#: ``'collision'`` -- solutions were found, but every one collides (with ``avoid_collisions``).
+IK_FAILURES = ("no_solution", "collision")
 
 
 @dataclass(frozen=True)
@@ -164,6 +188,117 @@ class Visibility:
         return self.visible
 
 
+@dataclass(frozen=True)
+class JointLimits:
+    """The joints of an arm (the torso first when it is included) and their limits, index by index.
+
+    ``lower``/``upper``: position limits [rad or m] (``-inf``/``inf`` for a continuous joint);
+    ``velocity``: speed limits [rad/s or m/s] (> 0); ``acceleration``: acceleration limits
+    [rad/s^2 or m/s^2] (> 0). All tuples have the length of ``joints``.
+    """
+
+    joints: tuple[str, ...]
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    velocity: tuple[float, ...]
+    acceleration: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        n = len(self.joints)
+        for name in ("lower", "upper", "velocity", "acceleration"):
+            if len(getattr(self, name)) != n:
+                raise ValueError(f"JointLimits.{name} has {len(getattr(self, name))} values for {n} joints")
+        if any(v <= 0 for v in self.velocity + self.acceleration):
+            raise ValueError("velocity and acceleration limits must be positive")
+        if any(lo > hi for lo, hi in zip(self.lower, self.upper)):
+            raise ValueError("a lower position limit exceeds its upper limit")
+
+    @property
+    def continuous(self) -> tuple[bool, ...]:
+        """Per joint: True when it has no position limits (a continuous revolute joint)."""
+        return tuple(math.isinf(lo) and math.isinf(hi) for lo, hi in zip(self.lower, self.upper))
+
+    def within(self, q: Sequence[float], tolerance: float = 1e-6) -> bool:
+        """Whether ``q`` (one position per joint) lies within the position limits (+- tolerance)."""
+        return len(q) == len(self.joints) and all(
+            lo - tolerance <= v <= hi + tolerance for v, lo, hi in zip(q, self.lower, self.upper)
+        )
+
+
+class ConfigurationChecker(abc.ABC):
+    """Collision questions about one arm's joint configurations in one fixed setting (base pose,
+    other joints, held and exempt objects), made by :meth:`Prospection.configuration_checker`.
+
+    A configuration is a sequence of positions [rad or m] in the order of :attr:`joints`. The
+    world is the one of the moment the checker was made; asking never changes it. A checker holds
+    scratch data of its own: use it from one thread at a time, and :meth:`close` it (or use it as
+    a context manager) when done. :attr:`checks` counts the configurations checked so far.
+    """
+
+    #: The joints of a configuration, in order (the torso first when included).
+    joints: tuple[str, ...] = ()
+    #: Configurations checked so far (by :meth:`is_free`, :meth:`contacts` and :meth:`motion_free`).
+    checks: int = 0
+
+    @abc.abstractmethod
+    def is_free(self, q: Sequence[float]) -> bool:
+        """True iff the robot with the arm at ``q`` touches nothing (environment, objects, its own
+        other parts), counting contacts closer than the checker's clearance."""
+
+    @abc.abstractmethod
+    def contacts(self, q: Sequence[float]) -> list[tuple[str, str]]:
+        """The distinct touching pairs (robot part or held object, obstacle) with the arm at ``q``."""
+
+    def motion_free(self, q0: Sequence[float], q1: Sequence[float], resolution: float = 0.02) -> bool:
+        """True iff every configuration on the straight joint-space segment from ``q0`` to ``q1``,
+        sampled no more than ``resolution`` [rad or m, largest joint step] apart (both ends
+        included), is free."""
+        steps = max(1, math.ceil(max((abs(b - a) for a, b in zip(q0, q1)), default=0.0) / resolution))
+        for i in range(steps + 1):
+            s = i / steps
+            if not self.is_free([a + s * (b - a) for a, b in zip(q0, q1)]):
+                return False
+        return True
+
+    def close(self) -> None:  # noqa: B027 - optional hook: implementations release their data here
+        """Release the checker's scratch data; it must not be used afterwards."""
+
+    def __enter__(self) -> ConfigurationChecker:
+        return self
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Answer of :meth:`Prospection.solve_ik`; truthy iff a solution was found.
+
+    ``joints``: the solved joints in order; ``positions``: their positions [rad or m] (empty on
+    failure); ``position_error`` [m] and ``orientation_error`` [rad]: the remaining tool-frame
+    errors of the solution (of the best attempt on failure); ``reason`` (one of
+    :data:`IK_FAILURES`) and ``message`` say why not; ``iterations``: solver iterations spent.
+    """
+
+    arm: str
+    joints: tuple[str, ...]
+    positions: tuple[float, ...] = ()
+    position_error: float = math.inf
+    orientation_error: float = math.inf
+    reason: str | None = None
+    message: str = ""
+    iterations: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return self.reason is None
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+
 class Prospection(abc.ABC):
     """What-if questions about one robot in the current world (see the module's guarantees)."""
 
@@ -215,3 +350,85 @@ class Prospection(abc.ABC):
         keeps its configuration. ``visible`` is ``fraction >= threshold``. Raises ``ValueError``
         for an unknown object (listing the known ones).
         """
+
+    # ---------------------------------------------------------------- arm motion planning
+    # Optional: implementations that do not plan arm motion keep these defaults.
+
+    def arm_joint_limits(self, arm: str, include_torso: bool = False) -> JointLimits:
+        """The joints of ``arm`` (in the robot description's order; the torso joint first with
+        ``include_torso``) and their position, velocity and acceleration limits.
+
+        Raises ``ValueError`` for an unknown arm (listing the valid ones), ``NotImplementedError``
+        when this prospection does not support arm motion planning.
+        """
+        raise NotImplementedError(f"{type(self).__name__} does not provide arm_joint_limits (arm motion planning)")
+
+    def configuration_checker(
+        self,
+        arm: str,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        *,
+        include_torso: bool = False,
+        held_object: str | None = None,
+        exempt_object: str | None = None,
+        clearance: float = 0.0,
+        self_collision: bool = True,
+    ) -> ConfigurationChecker:
+        """A :class:`ConfigurationChecker` for ``arm`` (joints as in :meth:`arm_joint_limits`) with
+        the robot at ``base_pose``, its other joints as they are now (or as in
+        ``joint_configuration``).
+
+        Obstacles: the environment, the objects of the world, and (``self_collision``) the robot's
+        parts that do not move with the arm. ``held_object`` (an object's name) moves rigidly with
+        the hand as it is held now and counts as part of the arm; ``exempt_object`` may touch the
+        gripper (the object being grasped) but nothing else of the arm. A pair counts as touching
+        when closer than ``clearance`` [m] (negative: that much penetration is tolerated).
+
+        Raises ``ValueError`` for an unknown arm, joint or object (listing the valid ones),
+        ``NotImplementedError`` when this prospection does not support arm motion planning.
+        """
+        raise NotImplementedError(f"{type(self).__name__} does not provide configuration_checker (arm motion planning)")
+
+    def arm_configuration_free(
+        self,
+        arm: str,
+        q: Sequence[float],
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        **options: Any,
+    ) -> bool:
+        """Whether ``arm`` at ``q`` is free of collisions (one question; for many, make one
+        :meth:`configuration_checker` and ask it). ``options`` are those of
+        :meth:`configuration_checker`."""
+        with self.configuration_checker(arm, base_pose, joint_configuration, **options) as checker:
+            return checker.is_free(q)
+
+    def solve_ik(
+        self,
+        arm: str,
+        pose: Any,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        *,
+        seeds: Sequence[Sequence[float]] = (),
+        avoid_collisions: bool = True,
+        held_object: str | None = None,
+        exempt_object: str | None = None,
+        clearance: float = 0.0,
+        position_tolerance: float = 0.001,
+        orientation_tolerance: float = 0.01,
+    ) -> IKResult:
+        """Arm joint positions (order of :meth:`arm_joint_limits` without the torso) that put the
+        tool frame of ``arm`` at ``pose`` (a tool pose: position [m], orientation (w, x, y, z) or
+        None for any) with the robot at ``base_pose``, within the joint limits and the tolerances
+        (position [m], orientation [rad]).
+
+        Tries the given ``seeds`` first, then the arm's current configuration, its named
+        configurations and a few random ones (deterministic). With ``avoid_collisions`` the
+        solution is also free of collisions, as :meth:`configuration_checker` judges with
+        ``held_object``, ``exempt_object`` and ``clearance``. Raises ``ValueError`` for an
+        unknown arm or a malformed pose, ``NotImplementedError`` when this prospection does not
+        support it.
+        """
+        raise NotImplementedError(f"{type(self).__name__} does not provide solve_ik (arm motion planning)")

@@ -12,12 +12,18 @@ Costs on this machine (PR2 in the thesis kitchen, one thread, simulation paused)
 check ~0.1 ms, a reachability check of 3 poses ~1-5 ms (more when it fails), a visibility
 check ~0.5 ms; with the simulation running beside it, about half as many per second (see
 `benchmarks/prospection.py`).
+
+For arm motion planning (:mod:`pycram.reasoning.motion`) it also gives an arm's joint limits
+(:mod:`.arm_limits`), configuration checkers on planning copies of the model whose collision
+filter lets only the arm's pairs through (:mod:`.arm_checker`: ~20-30 us a check), and IK with
+mink (:mod:`.mink_ik`).
 """
 
 from __future__ import annotations
 
 import math
 import queue
+import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -25,8 +31,29 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from pycram.world.prospection import Prospection, Reachability, ToolPose, Visibility, as_base_pose, as_tool_pose
+from pycram.world.prospection import (
+    ConfigurationChecker,
+    IKResult,
+    JointLimits,
+    Prospection,
+    Reachability,
+    ToolPose,
+    Visibility,
+    as_base_pose,
+    as_tool_pose,
+)
 
+from . import arm_checker
+from .arm_checker import (
+    ArmBodies,
+    SelfGroup,
+    SimConfigurationChecker,
+    arm_bodies,
+    configure_filter,
+    self_collision_exclusions,
+    self_collision_groups,
+)
+from .arm_limits import joint_limits
 from .ik import dls_ik
 from .occupancy import descends
 from .recording import StateSnapshot
@@ -48,6 +75,9 @@ IK_ITERATIONS = 100
 IK_STALL = 15
 #: IK: after this many solutions that all collide, the pose counts as "collision".
 MAX_COLLIDING_SOLUTIONS = 3
+#: `solve_ik` (mink): iterations per seed, random seeds after the named ones.
+MINK_ITERATIONS = 80
+MINK_RANDOM_SEEDS = 4
 
 
 class _Arm:
@@ -126,6 +156,11 @@ class SimProspection(Prospection):
         self._is_head = np.array([int(m.geom_bodyid[g]) in head_bodies for g in range(m.ngeom)], bool)
         with self._data() as d:
             self._measure_reach(d)
+        # arm motion planning: planning copies of the model, per-arm geom masks, IK solvers
+        self._planning_pool: queue.SimpleQueue[tuple[mujoco.MjModel, mujoco.MjData]] = queue.SimpleQueue()
+        self._parts: dict[tuple[str, bool], tuple[ArmBodies, np.ndarray, list[SelfGroup]]] = {}
+        self._ik_pools: dict[str, queue.SimpleQueue[Any]] = {}
+        self._planning_lock = threading.Lock()
 
     # ------------------------------------------------------------------ plumbing
     @property
@@ -205,6 +240,225 @@ class SimProspection(Prospection):
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
             return bool(self._touching(d)[3].any())
+
+    # ------------------------------------------------------------------ arm motion planning
+    def arm_joint_limits(self, arm: str, include_torso: bool = False) -> JointLimits:
+        return joint_limits(self.scene, arm, include_torso)
+
+    def _arm_parts(self, arm: str, include_torso: bool) -> tuple[ArmBodies, np.ndarray, list[SelfGroup]]:
+        """The geom masks of `arm`, the (ngeom x ngeom) pairs never counted as collisions
+        (self-collision exclusions) and the self-collision groups, measured once per arm."""
+        key = (arm, include_torso)
+        with self._planning_lock:
+            found = self._parts.get(key)
+        if found is not None:
+            return found
+        if arm not in self._arms:
+            raise ValueError(f"unknown arm {arm!r} of {self.scene.robot}; valid arms: {list(self._arms)}")
+        parts = arm_bodies(self.scene, arm, include_torso)
+        model, data = arm_checker.take(self._planning_pool, self.model)
+        try:
+            initial = self._initial_qpos()
+            pairs = self_collision_exclusions(model, data, self.scene, parts, initial)
+        finally:
+            self._planning_pool.put((model, data))
+        body = self.model.geom_bodyid
+        ignore = pairs[body[:, None], body[None, :]]
+        groups = self_collision_groups(self.model, parts, pairs)
+        with self._planning_lock:
+            return self._parts.setdefault(key, (parts, ignore, groups))
+
+    def _initial_qpos(self) -> np.ndarray:
+        """The latest snapshot with the robot's joints at the description's initial configuration."""
+        qpos = np.array(self._snapshot().qpos, float)
+        desc = self.scene.description
+        for name, value in {**desc.INITIAL_CONFIGURATION, desc.TORSO["joint"]: desc.TORSO["default"]}.items():
+            adr = self._joint_qpos.get(name)
+            if adr is not None:
+                qpos[adr] = value
+        return qpos
+
+    def _object_body(self, name: str) -> int:
+        """The body of the object `name` (a body with a free joint); ValueError listing the objects."""
+        m = self.model
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        free = mujoco.mjtJoint.mjJNT_FREE
+        if bid < 0 or m.body_jntnum[bid] != 1 or m.jnt_type[m.body_jntadr[bid]] != free:
+            known = sorted(
+                m.body(b).name
+                for b in range(1, m.nbody)
+                if m.body_jntnum[b] == 1 and m.jnt_type[m.body_jntadr[b]] == free
+            )
+            raise ValueError(f"unknown object {name!r}; known objects: {known}")
+        return bid
+
+    def configuration_checker(
+        self,
+        arm: str,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        *,
+        include_torso: bool = False,
+        held_object: str | None = None,
+        exempt_object: str | None = None,
+        clearance: float = 0.0,
+        self_collision: bool = True,
+    ) -> ConfigurationChecker:
+        if not math.isfinite(clearance):
+            raise ValueError(f"clearance must be finite [m], got {clearance!r}")
+        parts, self_ignore, groups = self._arm_parts(arm, include_torso)
+        m = self.model
+        held_geoms = np.zeros(m.ngeom, bool)
+        held = None
+        ignore = self_ignore
+        if exempt_object is not None:
+            exempt = m.geom_bodyid == self._object_body(exempt_object)
+            ignore = ignore.copy()
+            ignore[np.ix_(exempt, parts.gripper)] = True
+            ignore[np.ix_(parts.gripper, exempt)] = True
+        planning, d = arm_checker.take(self._planning_pool, m)
+        try:
+            if held_object is not None:
+                body = self._object_body(held_object)
+                held_geoms = m.geom_bodyid == body
+                # the grasp as it is now: the object's pose in the hand, from the latest snapshot
+                snap = self._snapshot()
+                d.qpos[:] = snap.qpos
+                d.mocap_pos[:] = snap.mocap_pos
+                d.mocap_quat[:] = snap.mocap_quat
+                mujoco.mj_kinematics(m, d)
+                hand = parts.hand_body
+                inv_pos, inv_quat = np.zeros(3), np.zeros(4)
+                mujoco.mju_negPose(inv_pos, inv_quat, d.xpos[hand], d.xquat[hand])
+                rel_pos, rel_quat = np.zeros(3), np.zeros(4)
+                mujoco.mju_mulPose(rel_pos, rel_quat, inv_pos, inv_quat, d.xpos[body], d.xquat[body])
+                held = (int(m.jnt_qposadr[m.body_jntadr[body]]), rel_pos, rel_quat)
+            configure_filter(planning, parts, held_geoms, groups if self_collision else None, clearance)
+            self._prepare(d, base_pose, joint_configuration)
+        except BaseException:
+            self._planning_pool.put((planning, d))
+            raise
+        return SimConfigurationChecker(
+            planning,
+            d,
+            parts,
+            ignore,
+            clearance,
+            held,
+            self._geom_name,
+            lambda: self._planning_pool.put((planning, d)),
+        )
+
+    def solve_ik(
+        self,
+        arm: str,
+        pose: Any,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        *,
+        seeds: Sequence[Sequence[float]] = (),
+        avoid_collisions: bool = True,
+        held_object: str | None = None,
+        exempt_object: str | None = None,
+        clearance: float = 0.0,
+        position_tolerance: float = 0.001,
+        orientation_tolerance: float = 0.01,
+    ) -> IKResult:
+        from .mink_ik import MinkArmIK
+
+        goal = as_tool_pose(pose)
+        parts = self._arm_parts(arm, False)[0]
+        a = self._arms[arm]
+        with self._planning_lock:
+            pool = self._ik_pools.setdefault(arm, queue.SimpleQueue())
+        try:
+            solver = pool.get_nowait()
+        except queue.Empty:
+            solver = MinkArmIK(self.model, arm, parts, a.jids)
+        target_p = np.asarray(goal.position, float)
+        target_q = None if goal.orientation is None else np.asarray(goal.orientation, float)
+        try:
+            with self._data() as d:
+                self._prepare(d, base_pose, joint_configuration)
+                qpos = d.qpos.copy()
+            candidates = [np.asarray(s, float) for s in seeds] + a.seeds(qpos[a.qadr], None)
+            rng = np.random.default_rng(0)
+            candidates += [
+                rng.uniform(np.where(a.limited, a.lo, -np.pi), np.where(a.limited, a.hi, np.pi))
+                for _ in range(MINK_RANDOM_SEEDS)
+            ]
+            checker = (
+                self.configuration_checker(
+                    arm,
+                    base_pose,
+                    joint_configuration,
+                    held_object=held_object,
+                    exempt_object=exempt_object,
+                    clearance=clearance,
+                )
+                if avoid_collisions
+                else None
+            )
+            best = (math.inf, math.inf)
+            iterations = 0
+            collided: list[tuple[str, str]] = []
+            try:
+                for seed in candidates:
+                    if len(seed) != len(a.joints):
+                        raise ValueError(
+                            f"an IK seed has {len(a.joints)} positions ({', '.join(a.joints)}), got {len(seed)}"
+                        )
+                    q, pe, re, its, converged = solver.solve(
+                        qpos,
+                        target_p,
+                        target_q,
+                        seed,
+                        MINK_ITERATIONS,
+                        position_tolerance,
+                        orientation_tolerance,
+                        # mink's limit keeps the whole arm off every object: not with an object
+                        # grasped or held (the solution is checked below either way)
+                        avoid_collisions and held_object is None and exempt_object is None,
+                    )
+                    iterations += its
+                    if pe + 0.1 * re < best[0] + 0.1 * best[1]:
+                        best = (pe, re)
+                    if not converged:
+                        continue
+                    if checker is not None:
+                        contacts = checker.contacts(q)
+                        if contacts:
+                            collided = collided or contacts
+                            continue
+                    return IKResult(arm, a.joints, tuple(map(float, q)), pe, re, None, "", iterations)
+            finally:
+                if checker is not None:
+                    checker.close()
+        finally:
+            pool.put(solver)
+        if collided:
+            a_part, b_part = collided[0]
+            return IKResult(
+                arm,
+                a.joints,
+                (),
+                best[0],
+                best[1],
+                "collision",
+                f"every solution found touches {b_part} with {a_part}",
+                iterations,
+            )
+        return IKResult(
+            arm,
+            a.joints,
+            (),
+            best[0],
+            best[1],
+            "no_solution",
+            f"no seed converged within {position_tolerance} m / {orientation_tolerance} rad "
+            f"(best {best[0]:.4f} m / {best[1]:.4f} rad)",
+            iterations,
+        )
 
     # ------------------------------------------------------------------ reachability
     def _measure_reach(self, d: mujoco.MjData) -> None:
