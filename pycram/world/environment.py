@@ -9,7 +9,7 @@ Polygons are convex and counter-clockwise (checked on construction).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol, TypeVar
 
@@ -206,6 +206,23 @@ class Container:
             if surface.height - 0.01 <= z <= surface.height + min(above, surface.clearance):
                 return surface
         return None
+
+    def opened_interior(self, q: float, margin: float = 0.0) -> tuple[Surface, ...]:
+        """The interior surfaces that are open to above with the joint at `q` [m or rad]: a
+        drawer's, moved out by `q` along the opening direction and cut at the furniture's
+        `front` plus `margin` [m] (what lies behind is under the furniture); a door's shelves as
+        they are (they do not move). Same names as `interior`; none when nothing is out."""
+        if self.kind != "drawer":
+            return self.interior
+        dx, dy = self.opening_direction
+        cut = self.front + margin
+        out = []
+        for surface in self.interior:
+            moved = [(x + dx * q, y + dy * q) for x, y in surface.polygon]
+            kept = _clip_half_plane(moved, lambda x, y: self.along_slide(x, y) - cut)
+            if len(kept) >= 3 and _area(kept) > 1e-6:
+                out.append(Surface(surface.name, tuple(kept), surface.height, surface.kind, surface.clearance))
+        return tuple(out)
 
     def handle_position(self, q: float) -> Vec3:
         """Where the handle is when the joint is at `q` [m or rad] (the opening trajectory)."""
@@ -419,3 +436,32 @@ __all__ = [
     "rect_around",
     "UnknownNameError",
 ]
+
+
+def _clip_half_plane(polygon: Sequence[XY], side: Callable[[float, float], float]) -> list[XY]:
+    """The part of the convex `polygon` where `side(x, y) >= 0` (`side` affine), counter-clockwise."""
+    out: list[XY] = []
+    n = len(polygon)
+    for i in range(n):
+        a, b = polygon[i], polygon[(i + 1) % n]
+        sa, sb = side(*a), side(*b)
+        if sa >= 0.0:
+            out.append(a)
+        if (sa >= 0.0) != (sb >= 0.0):
+            t = sa / (sa - sb)
+            out.append((a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+    deduplicated: list[XY] = []
+    for p in out:
+        if not deduplicated or math.dist(p, deduplicated[-1]) > 1e-9:
+            deduplicated.append(p)
+    if len(deduplicated) > 1 and math.dist(deduplicated[0], deduplicated[-1]) <= 1e-9:
+        deduplicated.pop()
+    return deduplicated
+
+
+def _area(polygon: Sequence[XY]) -> float:
+    """The area [m^2] of a simple polygon (positive when counter-clockwise)."""
+    n = len(polygon)
+    return 0.5 * sum(
+        polygon[i][0] * polygon[(i + 1) % n][1] - polygon[(i + 1) % n][0] * polygon[i][1] for i in range(n)
+    )

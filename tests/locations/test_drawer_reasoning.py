@@ -145,3 +145,24 @@ def test_the_base_stands_clear_of_an_open_door_not_only_of_the_furniture():
         t = max(0.0, min(1.0, ((s.x - ax) * (bx - ax) + (s.y - ay) * (by - ay)) / ((bx - ax) ** 2 + (by - ay) ** 2)))
         distance = math.dist((s.x, s.y), (ax + t * (bx - ax), ay + t * (by - ay)))
         assert distance >= pr2.BASE["inscribed_radius"] + DOOR_CLEARANCE - 0.05, (s, distance)
+
+
+def test_in_a_drawer_means_inside_it_as_it_is_believed_open():
+    drawer = APARTMENT.container("drawer 2")
+    assert drawer.opened_interior(0.0) == ()  # closed: its inside lies under the cabinet top
+    (inside,) = drawer.opened_interior(0.3)
+    x0, y0, x1, y1 = inside.bounds
+    closed = drawer.interior[0].bounds
+    assert x0 == pytest.approx(drawer.front) and x1 == pytest.approx(closed[2] + 0.3)
+    assert (y0, y1) == pytest.approx((closed[1], closed[3]))
+    with resolver_set(ScriptedProspection(), {"drawer 2": 0.3}):
+        spots = first(LocationDesignator([("in", "drawer 2"), ("for", "cup")]), 10)
+    assert spots and all(s.container == "drawer 2" and s.surface == "drawer 2 inside" for s in spots)
+    for s in spots:  # out from under the cabinet, inside the moved drawer, clear of its walls
+        assert inside.contains(s[0], s[1], 0.035 + 0.03 - 1e-9)
+        assert drawer.along_slide(s[0], s[1]) - 0.035 >= drawer.front
+    with (
+        resolver_set(ScriptedProspection(), {}),
+        pytest.raises(NoSolutionError, match="closed as far as the robot knows"),
+    ):
+        LocationDesignator([("in", "drawer 2"), ("for", "cup")]).reference()

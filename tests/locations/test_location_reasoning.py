@@ -55,12 +55,13 @@ class ScriptedProspection:
         raise AssertionError("not used here")
 
 
-def resolver_set(description=pr2, prospection=None, known=()):
+def resolver_set(description=pr2, prospection=None, known=(), states=None):
     reasoner = LocationReasoner(
         RobotGeometry.from_description(description),
         lambda: APARTMENT,
         lambda: prospection or ScriptedProspection(),
         lambda: list(known),
+        container_states=lambda: dict(states or {}),
     )
     rs = ResolverSet("test locations")
     rs.location_generators.append(reasoner.generator)
@@ -201,7 +202,7 @@ def test_on_spots_fit_the_type_and_keep_off_other_objects():
 
 
 def test_in_a_container_checks_its_clearance():
-    rs, _ = resolver_set()
+    rs, _ = resolver_set(states={"drawer 2": 0.3})
     with rs:
         spot = LocationDesignator([("in", "drawer 2"), ("for", "spoon")]).reference()
         assert spot.container == "drawer 2" and spot.surface == "drawer 2 inside"

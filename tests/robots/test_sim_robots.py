@@ -80,12 +80,14 @@ def test_load_builds_the_robot_with_its_modules(robot):
         robots.load(other, robot.world)
 
 
-def test_reasoning_reaches_the_worlds_prospection_through_the_active_robot(robot):
+def test_reasoning_reaches_the_prospection_of_the_robots_belief_through_the_active_robot(robot):
     from pycram.robot import current_prospection
     from pycram.world.prospection import Prospection
 
     p = current_prospection()
-    assert isinstance(p, Prospection) and p is robot.world.prospection()
+    assert isinstance(p, Prospection) and p is robot.world.prospection(robot.belief)
+    assert p is not robot.world.prospection()  # the simulator's truth is not the robot's
+    assert p.believed is not None and p.believed.belief is robot.belief
     assert not p.in_collision(robot.world.base_pose.get_value())
 
 

@@ -51,11 +51,16 @@ def motion(**properties):
 
 
 def believed(world, name):
-    """The object `name` as the robot believes it (here: as it is; a test judges with truth)."""
+    """The object `name` as the robot believes it (here: as it is, put into the active robot's
+    belief as if perceived -- prospection knows only believed objects; a test judges with truth)."""
+    from pycram.robot import current_robot
+    from pycram.world.belief import PerceivedObject
+
     pose = world.item_poses.get_value()[name]
     w, x, y, z = pose.orientation
     yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     item = world.scene.item(name)
+    current_robot().belief.add(PerceivedObject(name, item.type, tuple(pose.position)))
     return KnownObject(name, item.type, tuple(pose.position), yaw)
 
 

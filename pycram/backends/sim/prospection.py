@@ -54,6 +54,7 @@ from .arm_checker import (
     self_collision_groups,
 )
 from .arm_limits import joint_limits
+from .believed_world import BelievedWorld
 from .ik import dls_ik
 from .occupancy import descends
 from .recording import StateSnapshot
@@ -118,12 +119,22 @@ class SimProspection(Prospection):
 
     `snapshot` must return the latest `StateSnapshot` published by the simulation thread (a
     reference read is enough: snapshots are immutable once published).
+
+    With `believed` (a :class:`~pycram.backends.sim.believed_world.BelievedWorld`; `scene` and
+    `snapshot` are then its scene and its `snapshot`), objects are named as the belief names
+    them ("cup-1") and stand in prospection as the believed world's proxies: the robot's
+    prospection, which knows only what the robot knows.
     """
 
     def __init__(
-        self, scene: Scene, snapshot: Callable[[], StateSnapshot], tolerance: float = COLLISION_TOLERANCE
+        self,
+        scene: Scene,
+        snapshot: Callable[[], StateSnapshot],
+        tolerance: float = COLLISION_TOLERANCE,
+        believed: BelievedWorld | None = None,
     ) -> None:
         self.scene = scene
+        self.believed = believed
         self.tolerance = tolerance
         self.model = scene.model
         self._snapshot = snapshot
@@ -278,10 +289,20 @@ class SimProspection(Prospection):
                 qpos[adr] = value
         return qpos
 
+    def _body_name(self, name: str) -> str:
+        """The body that stands for the object `name` here: itself, or in a believed world the
+        proxy of the believed object of that name (ValueError naming the believed objects)."""
+        if self.believed is None:
+            return name
+        proxy = self.believed.body_of(name)
+        if proxy is None:
+            raise ValueError(f"unknown object {name!r}; believed objects: {self.believed.names()}")
+        return proxy
+
     def _object_body(self, name: str) -> int:
         """The body of the object `name` (a body with a free joint); ValueError listing the objects."""
         m = self.model
-        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, self._body_name(name))
         free = mujoco.mjtJoint.mjJNT_FREE
         if bid < 0 or m.body_jntnum[bid] != 1 or m.jnt_type[m.body_jntadr[bid]] != free:
             known = sorted(
@@ -317,6 +338,10 @@ class SimProspection(Prospection):
             ignore[np.ix_(exempt, parts.gripper)] = True
             ignore[np.ix_(parts.gripper, exempt)] = True
         planning, d = arm_checker.take(self._planning_pool, m)
+        # objects sized since the copy was made (a believed world's generic proxies)
+        planning.geom_size[:] = m.geom_size
+        planning.geom_rbound[:] = m.geom_rbound
+        planning.geom_aabb[:] = m.geom_aabb
         try:
             if held_object is not None:
                 body = self._object_body(held_object)
@@ -584,7 +609,7 @@ class SimProspection(Prospection):
     def _geoms_of(self, name: str) -> list[int]:
         """The visible geoms of the object (body) `name`; ValueError listing the objects if none."""
         m = self.model
-        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, self._body_name(name))
         geoms = [
             g
             for g in range(m.ngeom)

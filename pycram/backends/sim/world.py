@@ -181,6 +181,7 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         #: the latest state copied by the simulation thread, for prospection (never its MjData)
         self._state = StateSnapshot.of(eng.data)
         self._prospection: SimProspection | None = None
+        self._believed_prospections: list[tuple[Any, SimProspection]] = []  # (belief, its prospection)
         # --- command plumbing
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()
         self._lock = threading.Lock()
@@ -489,16 +490,39 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
             self.container_states.set_value(eng.furniture.positions(eng.data))
 
     # ------------------------------------------------------------------ prospection
-    def prospection(self) -> SimProspection:
+    def prospection(self, belief: Any = None) -> SimProspection:
         """The robot's prospection (`pycram.world.prospection.Prospection`) in this world: "what
-        if" questions answered on scratch copies of the latest published state (thread-safe;
-        never disturbs the simulation). The same object on every call."""
-        with self._lock:
-            if self._prospection is None:
-                from .prospection import SimProspection
+        if" questions answered on scratch copies of a state (thread-safe; never disturbs the
+        simulation).
 
-                self._prospection = SimProspection(self.scene, lambda: self._state)
-            return self._prospection
+        With `belief` (the robot's `pycram.world.belief.BeliefState`): prospection of the world
+        the robot believes in -- the environment's description, the robot's own joints as its
+        sensors last published them, the containers as last seen, the objects it perceived,
+        named as the belief names them; nothing it did not perceive (see
+        `pycram.backends.sim.believed_world`). This is what a robot's reasoning uses. Without:
+        prospection of the simulation's true state, as last published (for tools and tests).
+        The same object for the same `belief` on every call."""
+        with self._lock:
+            if belief is None:
+                if self._prospection is None:
+                    from .prospection import SimProspection
+
+                    self._prospection = SimProspection(self.scene, lambda: self._state)
+                return self._prospection
+            for known, prospection in self._believed_prospections:
+                if known is belief:
+                    return prospection
+        from .believed_world import BelievedWorld
+        from .prospection import SimProspection
+
+        believed = BelievedWorld(self.scene, belief, lambda: self._state)  # compiles outside the lock
+        with self._lock:
+            for known, prospection in self._believed_prospections:
+                if known is belief:
+                    return prospection
+            prospection = SimProspection(believed.scene, believed.snapshot, believed=believed)
+            self._believed_prospections.append((belief, prospection))
+            return prospection
 
     # ------------------------------------------------------------------ conveniences
     def kitchen_base_pose(self, place: str) -> Pose2D:

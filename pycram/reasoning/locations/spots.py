@@ -2,7 +2,9 @@
 
 ``('on', s)`` [``('near', o)``, ``('for', type/object)``] is answered with `Spot`s on surface
 ``s`` where an object of that type fits without touching the known objects; ``('in', c)`` [same
-options] with `Spot`s on the interior surfaces of container ``c``. Spots lie on a grid of
+options] with `Spot`s on the interior surfaces of container ``c`` -- a drawer's as the robot
+believes it open (``container_states``): moved out, only the part out from under the furniture
+(none while it is closed). Spots lie on a grid of
 `SPOT_RESOLUTION` [m], keep `SPOT_GAP` [m] from other objects and `SPOT_EDGE_MARGIN` [m] from the
 surface's edge, come nearest ``near`` (or the surface's centre) first and keep `SPACING` apart.
 """
@@ -51,7 +53,21 @@ class SpotVocabulary(CandidateSearch):
         container = value if isinstance(value, Container) else env.container(value)
         if not container.interior:
             raise self._fail(desig, f"{container.name!r} has no surfaces inside")
-        return self._spots(desig, list(container.interior), container.name)
+        if container.kind != "drawer":
+            return self._spots(desig, list(container.interior), container.name)
+        # a drawer's inside as it is believed open: out from under the furniture, reachable from above
+        q = float(self.container_states().get(container.name, 0.0))
+        exposed = container.opened_interior(q)  # spots keep their margin from the cut edge too
+        half = self._object_size(desig.prop_value("for"), list(self.known_objects()))[1]
+        if not any(s.clearance >= 2 * half + 0.01 for s in container.interior):
+            return self._spots(desig, list(container.interior), container.name)  # says it does not fit
+        if not exposed:
+            raise self._fail(
+                desig,
+                f"{container.name!r} is closed as far as the robot knows (open {q:.2f} m): nothing "
+                "inside is reachable from above -- open it first (Open, then look or resolve again)",
+            )
+        return self._spots(desig, list(exposed), container.name)
 
     def _object_size(self, value: Any, known: Sequence[KnownObject]) -> tuple[float, float, str, str | None]:
         """(footprint radius [m], half height [m], description, name) of the object to put down."""

@@ -407,7 +407,9 @@ class SimRobot(Robot):
         self.belief = BeliefState(getattr(world, "environment", None))
         self.object_resolvers.append(self.belief.resolver)
         make_prospection = getattr(world, "prospection", None)
-        self.prospection = make_prospection() if callable(make_prospection) else None
+        #: Prospection of the world this robot believes in (its belief, the environment's
+        #: description, its own joints): what its reasoning asks.
+        self.prospection = make_prospection(self.belief) if callable(make_prospection) else None
 
     def shutdown(self) -> None:
         """Stop subscriptions and take all process modules offline (running motions finish)."""

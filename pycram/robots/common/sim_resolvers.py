@@ -453,15 +453,16 @@ def known_objects_of(belief: Any) -> list:
 def make_location_generator(world: Any, description: Any, belief: Any) -> Callable[[Any], Any]:
     """The location generator of the robot of `description` in the simulated `world`: the
     general reasoning of :mod:`pycram.locations` (``to_reach``, ``to_see``, ``to_open``, ``on``,
-    ``in``), with prospection from the world and the objects of the robot's ``belief`` as known
-    objects. Returns ``None`` for designators outside that vocabulary."""
+    ``in``), with prospection of the world the robot believes in (``world.prospection(belief)``)
+    and the objects of the robot's ``belief`` as known objects. Returns ``None`` for designators
+    outside that vocabulary."""
     from pycram.reasoning.locations import LocationReasoner, RobotGeometry
 
     def prospection() -> Any:
         make = getattr(world, "prospection", None)
         if make is None:
             raise LookupError(f"{world!r} offers no prospection")
-        return make()
+        return make(belief)
 
     reasoner = LocationReasoner(
         RobotGeometry.from_description(description),
