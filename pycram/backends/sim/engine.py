@@ -108,6 +108,9 @@ class Engine:
         self.camera = scene.camera(HEAD_CAMERA)
         self.tool_sites = {arm: scene.site(tool_site(arm)) for arm in desc.ARMS}
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
+        self._item_names = list(self.item_bodies)
+        self._item_ids = np.array([self.item_bodies[n] for n in self._item_names], dtype=np.int64)
+        self._quat = np.zeros(4)  # scratch of `site_pose` (the simulation thread only)
         self._base_mask: np.ndarray | None = None  # see `base_contacts`
         self._environment_mask: np.ndarray = np.zeros(0, bool)
         self.item_geoms = {
@@ -134,6 +137,11 @@ class Engine:
             for j in range(self.model.njnt)
             if self.model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE and self.model.joint(j).name not in furniture_joints
         ]
+        self._joint_index = (  # names, qpos and qvel addresses of `robot_joints` (`joint_states`)
+            [n for n, _, _ in self.robot_joints],
+            np.array([a for _, a, _ in self.robot_joints], dtype=np.int64),
+            np.array([d for _, _, d in self.robot_joints], dtype=np.int64),
+        )
         self.furniture = Furniture(self)
         self.obstacles = {
             f"obstacle_{i}": int(self.model.body_mocapid[scene.body(f"obstacle_{i}")])
@@ -192,11 +200,11 @@ class Engine:
         return Pose2D(x, y, math.atan2(math.sin(yaw), math.cos(yaw)))
 
     def joint_states(self) -> JointStates:
-        qp, qv = self.data.qpos, self.data.qvel
+        names, qadr, dadr = self._joint_index
         return JointStates(
             self.time,
-            {n: float(qp[a]) for n, a, _ in self.robot_joints},
-            {n: float(qv[d]) for n, a, d in self.robot_joints},
+            dict(zip(names, self.data.qpos[qadr].tolist())),
+            dict(zip(names, self.data.qvel[dadr].tolist())),
         )
 
     def gripper_state(self, name: str) -> GripperState:
@@ -207,12 +215,20 @@ class Engine:
 
     def item_pose(self, name: str) -> Pose:
         b = self.item_bodies[name]
-        return Pose(cast(Vec3, tuple(map(float, self.data.xpos[b]))), cast(Quat, tuple(map(float, self.data.xquat[b]))))
+        return Pose(cast(Vec3, tuple(self.data.xpos[b].tolist())), cast(Quat, tuple(self.data.xquat[b].tolist())))
+
+    def item_poses(self) -> dict[str, Pose]:
+        """Every item's `item_pose`, by name (one read of the state)."""
+        names = self._item_names
+        if not names:
+            return {}
+        positions, orientations = self.data.xpos[self._item_ids].tolist(), self.data.xquat[self._item_ids].tolist()
+        return {n: Pose(cast(Vec3, tuple(p)), cast(Quat, tuple(q))) for n, p, q in zip(names, positions, orientations)}
 
     def site_pose(self, site: int) -> Pose:
-        quat = np.zeros(4)
+        quat = self._quat
         mujoco.mju_mat2Quat(quat, self.data.site_xmat[site])
-        return Pose(cast(Vec3, tuple(map(float, self.data.site_xpos[site]))), cast(Quat, tuple(map(float, quat))))
+        return Pose(cast(Vec3, tuple(self.data.site_xpos[site].tolist())), cast(Quat, tuple(quat.tolist())))
 
     def base_contacts(self) -> list[tuple[str, str]]:
         """Pairs (robot geom, environment geom) of base links touching the environment."""

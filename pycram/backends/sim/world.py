@@ -471,8 +471,7 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         return {arm: eng.site_pose(s) for arm, s in eng.tool_sites.items()}
 
     def _item_poses(self) -> dict[str, Pose]:
-        eng = self._engine
-        return {name: eng.item_pose(name) for name in eng.item_bodies}
+        return self._engine.item_poses()
 
     def _publish(self) -> None:
         eng = self._engine
