@@ -144,7 +144,18 @@ def test_start_or_goal_in_collision_gives_the_typed_reason(world, around_the_wal
     assert {"start_in_collision", "goal_in_collision", "no_path", "outside_limits"} == set(PLAN_FAILURES)
 
 
-def test_no_path_within_the_time_limit_says_so(world, around_the_wall):
+def test_no_path_within_the_check_budget_says_so_and_is_the_same_every_time(world, around_the_wall):
+    _, prospection = world
+    start, goal = around_the_wall
+    planner = OMPLPlanner(max_checks=40, search_resolution=0.02)
+    plans = [planner.plan(prospection, ARM, start, goal, BASE, seed=3) for _ in range(2)]
+    for plan in plans:
+        assert plan.reason == "no_path" and "found no path in" in plan.message
+    assert plans[0].checks == plans[1].checks  # the budget is counted in checks, not in wall time
+    assert 40 <= plans[0].checks < 40 + 200  # the last extension finishes its checks
+
+
+def test_no_path_within_the_wall_time_safety_net_says_so(world, around_the_wall):
     _, prospection = world
     start, goal = around_the_wall
     plan = OMPLPlanner(time_limit=1e-4, search_resolution=0.02).plan(prospection, ARM, start, goal, BASE)

@@ -87,8 +87,10 @@ class MotionPlanner(abc.ABC):
         seed: int = 0,
     ) -> MotionPlan:
         """A path from ``start`` to ``goal`` (positions in the order of ``limits.joints``, which must
-        be ``checker.joints``) whose segments ``checker`` finds free, found within ``time_limit``
-        [s] (None: the planner's default). The same ``seed`` and world give the same path.
+        be ``checker.joints``) whose segments ``checker`` finds free. ``time_limit`` [s of wall
+        time] (None: the planner's default) bounds the search; a planner should end its search
+        by a deterministic budget first (`OMPLPlanner`: collision checks), so that the same
+        ``seed`` and world give the same path on any machine and load.
         Raises ``ValueError`` when a configuration has the wrong length."""
 
     def plan(
