@@ -249,11 +249,11 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
             c, s = math.cos(location.yaw), math.sin(location.yaw)
             back = [point[0] - grasp.radius * c, point[1] - grasp.radius * s, point[2]]
             try:
-                motion(type="reaching", arm=arm, target=back, phase="pre_grasp")
+                motion(type="reaching", arm=arm, target=back, phase="pre_grasp", object=obj)
             except RECOVERABLE as error:
                 log.info("grasping %s: no pose farther back first (%s)", obj.name, unwrap(error))
-        _reach(arm, location, 0, "pre_grasp", point)
-        _reach(arm, location, 1, "grasp", point)
+        _reach(arm, location, 0, "pre_grasp", point, obj)
+        _reach(arm, location, 1, "grasp", point, obj)
         opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
     except RECOVERABLE:
         _let_go_and_retract(arm, gripper, point, location)

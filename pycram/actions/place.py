@@ -199,7 +199,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     if belief is not None:
         belief.put_down(obj, spot)
     try:
-        _reach(arm, location, 2, "retreat", point)
+        _reach(arm, location, 2, "retreat", point, obj)  # the fingers may still touch it
     except RECOVERABLE as error:  # the object is down: backing off is best effort
         log.info("placing %s: retreat: %s", obj.name, unwrap(error))
     motion(type="setting_arm_configuration", arm=arm, configuration="carry")

@@ -13,6 +13,7 @@ from typing import cast
 
 from pycram.world.types import Pose, Pose2D, Quat, Vec3
 
+from .arm_path import PATH_TOLERANCE, JointPath
 from .commands import CommandQueue
 from .controllers import BaseDrive, GripperCommand, HeadPointing, JointTrajectory, Reach
 from .errors import UnknownNameError
@@ -79,6 +80,39 @@ class MotionCommands(CommandQueue):
             cast(Quat, tuple(map(float, orientation))) if orientation is not None else (1.0, 0.0, 0.0, 0.0),
         )
         return self.submit(Reach(arm, goal, orientation is not None, duration, tolerance), f"reach:{arm}")
+
+    def follow_arm_path(
+        self,
+        arm: str,
+        joints: Sequence[str],
+        samples: Sequence[tuple[float, Sequence[float]]],
+        exempt_item: str | None = None,
+        tolerance: float | None = None,
+        exempt_near: Sequence[float] | None = None,
+    ) -> CommandHandle:
+        """Move `arm` along a timed joint path: `samples` are (t [s] from 0, positions [rad or m]
+        in the order of `joints`, joints of that arm), e.g. a planned path's
+        `pycram.reasoning.motion.time_parameterize(...).samples()`.
+
+        Monitored while it runs (see `pycram.backends.sim.arm_path`): an unexpected contact of the
+        arm or of the object its gripper holds (not the item being grasped, at the fingers:
+        `exempt_item` by name, or the item nearest to `exempt_near` [m, map], within
+        `arm_path.EXEMPT_RADIUS`) ends with "collision", a joint that lags its reference with "blocked"; either
+        stops the arm where it is, the outcome's value a `PathStop` (where, the last sample
+        passed, the pair). Succeeds (value: the largest remaining joint error) when the joints
+        are at the path's end (within `tolerance` [rad or m]; None: `arm_path.PATH_TOLERANCE`);
+        "invalid" for malformed samples.
+        """
+        self._check_arm(arm)
+        path = JointPath(
+            arm,
+            joints,
+            samples,
+            exempt_item=exempt_item,
+            exempt_near=exempt_near,
+            tolerance=tolerance or PATH_TOLERANCE,
+        )
+        return self.submit(path, f"arm_path:{arm}")
 
     def point_head(self, point: Sequence[float]) -> CommandHandle:
         """Turn the head camera to `point` [m, map frame]; succeeds when it looks at it (< ~1 deg)."""

@@ -58,6 +58,7 @@ __all__ = [
     "cancel_running_handle",
     "seen_objects",
     "shutdown_modules",
+    "plan_arm_motions",
 ]
 
 logger = logging.getLogger(__name__)
@@ -238,38 +239,108 @@ class ArmModule(SimProcessModule):
     description) and ``'cmd': 'reach'`` (``'position'`` [m, map], ``'orientation'`` (w, x, y, z)
     or ``None``, ``'tolerance'`` [m]).
 
+    With ``robot`` (its ``prospection`` and ``belief`` read at each motion) the motions are
+    planned: a collision-free path in prospection's world, timed within the joints' limits,
+    executed and watched, re-planned after an unexpected contact (see
+    :mod:`pycram.robots.common.arm_motion`); the object being grasped is the motion
+    designator's ``object`` (a believed object or its name), exempt at the fingers. Motions that
+    start or end in contact (handles, doors), and every motion without ``robot`` or without a
+    prospection that plans, move directly (joint interpolation, as the simulator's ``move_arm`` /
+    ``reach``).
+
+    Planning is off unless the module has a ``robot``: :func:`plan_arm_motions` switches it on for
+    every arm module of a robot (off by default while issue 32's integration is completed: with
+    it on, pick-and-place tests of deep and flat objects fail, see the module
+    :mod:`pycram.robots.common.arm_motion`).
+
     ``reach`` returns the reached tool ``Pose``; an unreachable target fails with reason
-    ``'unreachable'``.
+    ``'unreachable'``, a motion stopped by a contact with ``'collision'`` and one stopped by a
+    lagging joint with ``'blocked'`` (after its re-plans).
     """
 
-    def __init__(self, world: Any, arm: str, name: str | None = None) -> None:
+    def __init__(self, world: Any, arm: str, name: str | None = None, robot: Robot | None = None) -> None:
         super().__init__(name or f"arm_{arm}", world)
         self.arm = arm
+        self.robot = robot
+        self._motions: Any = None  # the ArmMotionPlanner, made at the first motion
+
+    def _planner(self) -> Any:
+        if self.robot is None:
+            return None
+        if self._motions is None:
+            from .arm_motion import ArmMotionPlanner  # OMPL and Ruckig: imported when first used
+
+            try:
+                self._motions = ArmMotionPlanner(
+                    self.world, self.arm, lambda: self.robot, self._run_command, SimMotionFailed
+                )
+            except ImportError as missing:  # without the planning libraries: direct motions
+                logger.warning("%s: arm motions are not planned: %s", self.name, missing)
+                self.robot = None
+                return None
+        return self._motions
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
         cmd = solution.get("cmd")
+        planner = self._planner()
+        grasped = _object_of(designator)
         if cmd == "move_arm":
             positions = tuple(float(v) for v in solution["positions"])
-            what = solution.get("configuration") or format_values(positions)
-            return self._run_command(
-                lambda: self.world.move_arm(self.arm, positions), f"move the {self.arm} arm to {what}", timeout=30.0
-            )
+            what = f"move the {self.arm} arm to {solution.get('configuration') or format_values(positions)}"
+
+            def move_directly() -> Any:
+                return self._run_command(lambda: self.world.move_arm(self.arm, positions), what, timeout=30.0)
+
+            if planner is None:
+                return move_directly()
+            return planner.move(positions, what, move_directly, grasped)
         if cmd == "reach":
             position = tuple(float(v) for v in solution["position"])
             orientation = solution.get("orientation")
+            tolerance = float(solution.get("tolerance", 0.01))
             phase = solution.get("phase")
             what = f"reach with the {self.arm} arm to {format_values(position)}" + (
                 f" ({phase} of {format_values(solution['target'])})" if phase else ""
             )
-            return self._run_command(
-                lambda: self.world.reach(
-                    self.arm, position, orientation, tolerance=float(solution.get("tolerance", 0.01))
-                ),
-                what,
-                timeout=30.0,
-            )
+
+            def reach_directly() -> Any:
+                return self._run_command(
+                    lambda: self.world.reach(self.arm, position, orientation, tolerance=tolerance), what, timeout=30.0
+                )
+
+            if planner is None:
+                return reach_directly()
+            if grasped[1] is None:  # what lies at the target is what the hand goes for
+                grasped = (grasped[0], tuple(float(v) for v in solution.get("target") or position))
+            return planner.reach(position, orientation, tolerance, what, reach_directly, grasped, phase)
         check_command(self, solution, "move_arm", "reach")
+
+
+def plan_arm_motions(robot: Robot, on: bool = True) -> None:
+    """Switch planned arm motions (:mod:`pycram.robots.common.arm_motion`) on (or off) for every
+    :class:`ArmModule` of ``robot``: their motions are then planned in ``robot.prospection``
+    with ``robot.belief``'s held objects, executed by the monitored path controller and re-planned
+    after an unexpected contact."""
+    for module in robot.process_modules.values():
+        if isinstance(module, ArmModule):
+            module.robot = robot if on else None
+            module._motions = None
+
+
+def _object_of(designator: Any) -> tuple[str | None, tuple[float, float, float] | None]:
+    """The name and believed position [m, map] of the object a motion designator's ``object``
+    property names (a believed object, or only a name), else (None, None)."""
+    value = designator.prop_value("object")
+    if value is None or isinstance(value, str):
+        return value, None
+    name = getattr(value, "name", None)
+    pose = getattr(value, "pose", None)
+    try:
+        position = None if pose is None else (float(pose[0]), float(pose[1]), float(pose[2]))
+    except (TypeError, ValueError, IndexError):
+        position = None
+    return (name if isinstance(name, str) else None), position
 
 
 class GripperModule(SimProcessModule):

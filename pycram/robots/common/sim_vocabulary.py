@@ -144,6 +144,13 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                     form="numbers",
                     required=False,
                 ),
+                MotionKey(
+                    "object",
+                    "the object being grasped (a believed object or its name): it may touch the "
+                    "fingers on the way (default: none)",
+                    form="any",
+                    required=False,
+                ),
             ),
         ),
         MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)", (fluent,)),

@@ -1,0 +1,393 @@
+"""Planned arm motions for the simulated robots' arm process module: plan, time, execute, watch,
+re-plan.
+
+**Off by default** (switched on per robot by
+:func:`pycram.robots.common.sim_modules.plan_arm_motions`): with it on for the robots' action
+plans, pick-and-place tests of the PR2's cereal box (placed, then the arm raised to carry brushes
+it; picked turned by 30 deg) and the TIAGo's plate failed -- contacts with objects the belief
+places elsewhere than they are, which the re-plans cannot go round until the robot looks at what
+it hit.
+
+:class:`ArmMotionPlanner` is what :class:`pycram.robots.common.sim_modules.ArmModule` does for
+``move_arm`` (joint goal) and ``reach`` (tool pose) when its robot has a prospection that plans
+arm motion:
+
+1. **goal** -- the joint goal as given, or for a tool pose an IK solution from prospection
+   (:meth:`~pycram.world.prospection.Prospection.solve_ik`, seeded with the current joints,
+   collision-free with the held and grasped objects as below);
+2. **plan** -- a collision-free joint-space path from the arm's current joints in prospection's
+   world (:class:`~pycram.reasoning.motion.OMPLPlanner`: the straight line when it is free, else
+   RRT-Connect), with the object the arm's gripper holds (the belief's ``in_hand``) moving with
+   the hand and the object being grasped (the motion's ``object``) exempt at the fingers;
+3. **timing** -- :func:`~pycram.reasoning.motion.time_parameterize` within `VELOCITY_SCALE` x
+   the joints' velocity limits;
+4. **execution** -- the simulator's monitored path controller
+   (:meth:`pycram.sim.World.follow_arm_path`, :mod:`pycram.backends.sim.arm_path`): an
+   unexpected contact or a joint that lags stops the arm where it is;
+5. **re-planning** -- after such a stop the arm backs off along the way it came (to the last
+   configuration prospection finds free, at least `BACK_OFF` back) and the motion is planned
+   again from there, from the world as prospection knows it then; at most `REPLANS` times, then
+   the stop's typed failure (``SimMotionFailed`` with reason ``'collision'`` or ``'blocked'``).
+   When prospection still sees nothing in the way (the re-plan is the straight line again: what
+   was hit is not in the believed world, and nobody looked at it yet) the motion goes on directly,
+   as before planning existed.
+
+A motion towards an object being grasped, or with an object held, is executed planned only when
+the straight line is free; otherwise it moves directly. The object being grasped is exempt at the
+fingers in planning, so a detour could sweep it away with them; a held object is believed at the
+tool frame (``pycram.backends.sim.believed_world``), not where the fingers hold it, so a detour
+planned for it may press it against what it passes (both measured).
+
+A motion without a collision-free path is planned once more tolerating shallow contacts
+(`TOLERATED_PENETRATION`, as location reasoning does when it validates a grasp).
+
+**Contact motions are not planned.** A motion whose start or goal touches something even then --
+the fingers closed round a handle, a hand pushing a door, a grasp whose fingers press on the
+counter -- has no collision-free path by definition; it is executed as before planning existed:
+the direct joint interpolation (``World.move_arm`` / ``World.reach``), which ends with
+``'blocked'`` when the arm cannot follow (the drawer at its stop). So is, for now, a motion for
+which the planner finds no path within its time limit (``'no_path'``: a narrow passage, or a goal
+walled in): the direct motion is watched by nothing but its end (``'blocked'``), as before; making
+``'no_path'`` a failure of its own is left until grasps and places are chosen with planning
+(issue 32, point 3), so that a refused motion has an alternative. The same holds when prospection's IK finds no
+solution for a tool pose (the simulator's own IK is tried, as before) and when the robot has no
+prospection that plans (``NotImplementedError``; the ROS robot has its own modules), and while
+the base or the torso moves (`MOVING`: a plan holds for the robot standing where it stands; the
+thesis demo raises the arm while the base drives up).
+
+**The torso is not planned** (``include_torso=False``): torso motions are the actions' explicit
+``setting_torso`` motions, and the torso's lift is slow (0.05 m/s on the PR2): planning it with
+every arm motion would slow each of them and move the head camera the plans point.
+
+Determinism: every plan's seed is the module's count of plans so far, so the same run plans the
+same paths (lock-step).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable, Sequence
+from functools import partial
+from typing import Any
+
+__all__ = [
+    "ArmMotionPlanner",
+    "BACK_OFF",
+    "DIRECT_PHASES",
+    "MOVING",
+    "PERIOD",
+    "REPLANS",
+    "TOLERATED_PENETRATION",
+    "VELOCITY_SCALE",
+]
+
+logger = logging.getLogger(__name__)
+
+#: The object being grasped: its name (as prospection knows it) and believed position [m, map];
+#: either may be None.
+Grasped = tuple[str | None, tuple[float, float, float] | None]
+
+#: Re-plans after a monitored stop (contact or lag) before the motion fails.
+REPLANS = 2
+#: Fraction of the joints' velocity limits (the URDF's) planned motions move at.
+VELOCITY_SCALE = 0.5
+#: Sample period [s] of a timed path (the controller interpolates between samples).
+PERIOD = 0.02
+#: After a stop the arm backs off along the way it came at least this far [rad or m, Euclidean
+#: over the arm's joints] (and on until prospection finds it free) before planning again.
+BACK_OFF = 0.1
+#: The base (linear [m/s], turning [rad/s]) or the torso [m/s] moves faster than this: the arm's
+#: motion is not planned (the plan would hold for where the robot was), it moves directly.
+MOVING = (0.01, 0.02, 0.005)
+#: A motion with no collision-free path is planned again tolerating contacts this deep [m]: what
+#: location reasoning tolerates when it validates a grasp (``pycram.backends.sim.prospection``'s
+#: ``COLLISION_TOLERANCE``: link meshes collide as their convex hulls, a little larger than the
+#: links), so a pose it found reachable is not refused on the way for a brush.
+TOLERATED_PENETRATION = 0.015
+#: Reaching phases executed directly (not planned): they end with the held object touching down
+#: (``place``: 1 cm above the believed surface; touching down earlier stops the arm with
+#: ``'blocked'``, which the place action takes for "down").
+DIRECT_PHASES = ("place",)
+
+
+class _Direct(Exception):
+    """Internal: execute this motion the direct way (a contact motion, or no planning)."""
+
+
+class ArmMotionPlanner:
+    """Plans and executes the motions of one arm of a simulated robot (see the module docstring).
+
+    ``world``: the :class:`pycram.sim.World`; ``arm``: the physical arm; ``robot``: a callable
+    returning the robot (its ``prospection`` and ``belief`` are read at each motion: they may be
+    replaced); ``run``: the process module's ``_run_command`` (send, wait, raise
+    ``SimMotionFailed``); ``failure``: that exception class (raised with ``(command, reason,
+    message, outcome)``; its ``reason``, ``message``, ``command`` and ``outcome`` are read).
+    """
+
+    def __init__(
+        self, world: Any, arm: str, robot: Callable[[], Any], run: Callable[..., Any], failure: type[Exception]
+    ) -> None:
+        from pycram.reasoning.motion import OMPLPlanner
+
+        self.world, self.arm = world, arm
+        self._robot, self._run, self._failure = robot, run, failure
+        self.planner = OMPLPlanner()
+        self.plans = 0  #: plans made so far (each plan's seed)
+        #: The last motion's plans (:class:`~pycram.reasoning.motion.MotionPlan`, one per attempt)
+        #: and its monitored stops (``SimMotionFailed``, reason ``'collision'`` or ``'blocked'``).
+        self.last_plans: list[Any] = []
+        self.last_stops: list[Any] = []
+        self.description = world.description
+        self.joints = tuple(self.description.ARMS[arm]["joints"])
+        self.gripper = self.description.ARMS[arm]["gripper"]
+
+    # ------------------------------------------------------------------ the world as known
+    def prospection(self) -> Any:
+        robot = self._robot()
+        prospection = getattr(robot, "prospection", None)
+        if prospection is None:
+            raise _Direct("no prospection")
+        return prospection
+
+    def _still(self) -> None:
+        """Raise `_Direct` while the base or the torso moves: a plan is made for the robot standing
+        as it stands now (e.g. an arm raised to carry while the base still drives up: the thesis
+        demo's)."""
+        velocity = self.world.joint_states.get_value().velocity
+        base = math.hypot(velocity.get("base_x", 0.0), velocity.get("base_y", 0.0))
+        turn = abs(velocity.get("base_yaw", 0.0))
+        torso = abs(velocity.get(self.description.TORSO["joint"], 0.0))
+        if base > MOVING[0] or turn > MOVING[1] or torso > MOVING[2]:
+            raise _Direct(f"the robot moves (base {base:.3f} m/s, {turn:.3f} rad/s, torso {torso:.3f} m/s)")
+
+    def _current(self) -> list[float]:
+        positions = self.world.joint_states.get_value().position
+        return [float(positions[j]) for j in self.joints]
+
+    def _held(self) -> tuple[str, ...]:
+        """Names the object in this arm's gripper may have in prospection, best first: the
+        belief's (its ``in_hand``), then the gripper's own reading of what it holds (the name a
+        prospection of the simulation's state knows it by); empty when it holds nothing."""
+        belief = getattr(self._robot(), "belief", None)
+        held = getattr(belief, "in_hand", {}).get(self.gripper) if belief is not None else None
+        names = [getattr(held, "name", None)]
+        states = getattr(self.world, "gripper_states", None)
+        if held is not None and states is not None and self.gripper in states:
+            names.append(getattr(states[self.gripper].get_value(), "holding", None))
+        return tuple(dict.fromkeys(n for n in names if isinstance(n, str)))
+
+    def _holds(self) -> bool:
+        """Whether this arm's gripper holds an object (the belief's ``in_hand``)."""
+        belief = getattr(self._robot(), "belief", None)
+        return belief is not None and getattr(belief, "in_hand", {}).get(self.gripper) is not None
+
+    # ------------------------------------------------------------------ motions
+    def move(self, goal: Sequence[float], what: str, direct: Callable[[], Any], grasped: Grasped = (None, None)) -> Any:
+        """Move the arm to the joint ``goal`` [rad or m]; ``direct()`` runs it the direct way;
+        ``grasped``: the object being grasped (name, believed position [m, map]), if any."""
+        try:
+            return self._planned(list(goal), what, grasped, PathGoal())
+        except _Direct as why:
+            logger.debug("%s: direct (%s)", what, why)
+            return direct()
+
+    def reach(
+        self,
+        position: Sequence[float],
+        orientation: Sequence[float] | None,
+        tolerance: float,
+        what: str,
+        direct: Callable[[], Any],
+        grasped: Grasped = (None, None),
+        phase: str | None = None,
+    ) -> Any:
+        """Move the tool to ``position`` [m, map] (``orientation`` (w, x, y, z) or None); returns
+        the reached tool pose; ``direct()`` runs it the direct way (always for the phases of
+        `DIRECT_PHASES`); ``grasped`` as in :meth:`move`."""
+        exempt = grasped[0]
+        try:
+            if phase in DIRECT_PHASES:
+                raise _Direct(f"the {phase} phase")
+            self._still()
+            prospection = self.prospection()
+            held = self._held()
+            base = self.world.base_pose.get_value()
+            current = self._current()
+            pose = (tuple(position), None if orientation is None else tuple(orientation))
+            ik = _with_known_objects(
+                partial(prospection.solve_ik, self.arm, pose, base, seeds=[current]),
+                held,
+                exempt,
+            )
+            if not ik:  # no solution, or only touching ones (a contact motion): as before
+                raise _Direct(f"IK: {ik.reason}: {ik.message}")
+            goal = PathGoal(position=tuple(float(v) for v in position), tolerance=tolerance)
+            return self._planned(list(ik.positions), what, grasped, goal)
+        except NotImplementedError as why:
+            logger.debug("%s: direct (%s)", what, why)
+            return direct()
+        except _Direct as why:
+            logger.debug("%s: direct (%s)", what, why)
+            return direct()
+
+    def _planned(self, goal: list[float], what: str, grasped: Grasped, target: PathGoal) -> Any:
+        from pycram.reasoning.motion import time_parameterize
+
+        self._still()
+        prospection = self.prospection()
+        limits = prospection.arm_joint_limits(self.arm)
+        held = self._held()
+        exempt, near = grasped
+        stopped: Any = None  # the last monitored stop
+        self.last_plans, self.last_stops = [], []
+        for attempt in range(REPLANS + 1):
+            base = self.world.base_pose.get_value()
+            current = self._current()
+            seed = self.plans
+            self.plans += 1
+            plan = _with_known_objects(
+                partial(self.planner.plan, prospection, self.arm, current, goal, base, seed=seed), held, exempt
+            )
+            if not plan and plan.reason != "outside_limits":  # shallow contacts tolerated, as reasoning does
+                self.last_plans.append(plan)
+                plan = _with_known_objects(
+                    partial(
+                        self.planner.plan,
+                        prospection,
+                        self.arm,
+                        current,
+                        goal,
+                        base,
+                        clearance=-TOLERATED_PENETRATION,
+                        seed=seed,
+                    ),
+                    held,
+                    exempt,
+                )
+            self.last_plans.append(plan)
+            if plan and plan.planner != "straight_line" and (exempt is not None or self._holds()):
+                # the planner lets the fingers through the object being grasped: a detour could
+                # sweep it away with them (measured: the PR2's hand swung round a mug and pushed it
+                # 14 cm); a held object is believed at the tool frame, not where the hand holds it:
+                # a detour planned for it may press it on the counter (measured: the PR2's cereal
+                # box, held by its near side) -- such motions are the straight line or direct
+                raise _Direct(f"a detour ({plan.planner}) with an object grasped or held")
+            if plan and stopped is not None and plan.planner == "straight_line":
+                # prospection sees nothing in the way of the line just stopped on: what was hit is
+                # not in the believed world (nobody looked), so planning again cannot go round it;
+                # the motion goes on directly, as before planning (looking at what was hit and
+                # putting it into the belief is left to the actions)
+                raise _Direct(f"after {stopped.reason}: {stopped.message}, nothing known in the way")
+            if not plan:
+                if stopped is not None:  # no way on from where it stopped: the stop is the failure
+                    raise self._failure(
+                        stopped.command,
+                        stopped.reason,
+                        f"{stopped.message}; planning again: {plan.reason}: {plan.message}",
+                        stopped.outcome,
+                    )
+                raise _Direct(f"plan: {plan.reason}: {plan.message}")
+            timed = time_parameterize(plan.path, limits, period=PERIOD, velocity_scale=VELOCITY_SCALE)
+            samples = timed.samples()
+            try:
+                value = self._run(
+                    partial(
+                        self.world.follow_arm_path,
+                        self.arm,
+                        plan.joints,
+                        samples,
+                        exempt_near=near,
+                    ),
+                    what,
+                    timeout=timed.duration + 10.0,
+                )
+            except self._failure as failure:
+                if failure.reason == "blocked" and target.position is not None:
+                    try:  # the tool there all the same (fingers pressing on what they grasp): reached
+                        return self._tool_check(what, target)
+                    except self._failure:
+                        pass
+                stop = getattr(failure.outcome, "value", None)
+                if failure.reason not in ("collision", "blocked") or attempt == REPLANS or stop is None:
+                    raise
+                stopped = failure
+                self.last_stops.append(failure)
+                logger.info("%s: %s: %s; backing off to plan again", what, failure.reason, failure.message)
+                self._back_off(prospection, samples, stop, held, grasped, limits)
+                continue
+            if target.position is None:
+                return value
+            return self._tool_check(what, target)
+        raise AssertionError("unreachable")  # pragma: no cover - the loop returns or raises
+
+    def _back_off(
+        self, prospection: Any, samples: list, stop: Any, held: Sequence[str], grasped: Grasped, limits: Any
+    ) -> None:
+        """Back along the executed samples from where the arm stopped: to the first one at least
+        `BACK_OFF` away that prospection finds free (else the path's start), then stop there.
+        Best effort: a back-off that itself stops leaves the arm where it stopped."""
+        from pycram.reasoning.motion import time_parameterize
+
+        here = list(stop.positions)
+        exempt, near = grasped
+        base = self.world.base_pose.get_value()
+        target = list(samples[0][1])
+        try:
+            checker = _with_known_objects(
+                partial(prospection.configuration_checker, self.arm, base),
+                held,
+                exempt,
+            )
+        except ValueError:
+            checker = None
+        try:
+            for k in range(min(stop.sample, len(samples) - 1), -1, -1):
+                q = list(samples[k][1])
+                if math.dist(q, here) >= BACK_OFF and (checker is None or checker.is_free(q)):
+                    target = q
+                    break
+        finally:
+            if checker is not None:
+                checker.close()
+        timed = time_parameterize([here, target], limits, period=PERIOD, velocity_scale=VELOCITY_SCALE)
+        try:
+            self._run(
+                lambda: self.world.follow_arm_path(self.arm, self.joints, timed.samples(), exempt_near=near),
+                f"back off with the {self.arm} arm",
+                timeout=timed.duration + 10.0,
+            )
+        except self._failure as failure:
+            logger.info("backing off stopped: %s", failure)
+
+    def _tool_check(self, what: str, target: PathGoal) -> Any:
+        """The reached tool pose; ``SimMotionFailed('blocked')`` when it is farther than the
+        tolerance from the target position (as the direct reach reports it)."""
+        pose = self.world.tool_poses.get_value()[self.arm]
+        assert target.position is not None and target.tolerance is not None
+        error = math.dist(pose.position, target.position)
+        if error > target.tolerance:
+            raise self._failure(what, "blocked", f"tool stopped {error:.3f} m from the goal")
+        return pose
+
+
+class PathGoal:
+    """What a planned motion must reach: nothing beyond its joint goal (``position`` None), or the
+    tool within ``tolerance`` [m] of ``position`` [m, map]."""
+
+    def __init__(self, position: tuple[float, ...] | None = None, tolerance: float | None = None) -> None:
+        self.position, self.tolerance = position, tolerance
+
+
+def _with_known_objects(ask: Callable[..., Any], held: Sequence[str], exempt: str | None) -> Any:
+    """``ask(held_object=..., exempt_object=...)`` with the first of the ``held`` names and
+    ``exempt``; an object prospection does not know (``ValueError``, e.g. one the belief names
+    differently) is replaced by the next name or left out, and the question asked again."""
+    for h in (*held, None):
+        for e in dict.fromkeys((exempt, None)):
+            try:
+                return ask(held_object=h, exempt_object=e)
+            except ValueError:
+                if h is None and e is None:
+                    raise
+    raise AssertionError("unreachable")  # pragma: no cover - the last question raises or returns

@@ -1,0 +1,158 @@
+"""Planned arm motions in the simulator (issue 32, point 1): the arm process module plans a
+collision-free path in prospection, executes it with the monitored path controller, and plans
+again after an unexpected contact.
+
+The PR2 stands at the apartment's dining table, a thin box ("wall") on the table in front of
+it; the right arm moves its tool from one side of the wall to the other, where the straight
+joint-space line goes through the wall (checked in prospection). Prospection here is the
+simulation's true state (``world.prospection()``): what is tested is planning and monitoring,
+not perception (the robot would know the box only once perceived).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from sim_helpers import ok
+
+pytest.importorskip("ompl")
+pytest.importorskip("ruckig")
+pytest.importorskip("mink")
+
+BASE = (4.3, 1.15, math.pi / 2)  # facing the table's south edge (y = 1.55), 0.4 m from it
+FORWARD = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # tool pointing north (+y)
+TABLE = 0.75  # the table top's height [m]
+HALF = (0.03, 0.15, 0.15)  # the wall: 6 cm thin, 30 cm deep, 30 cm tall
+WALL = (4.12, 1.85, TABLE + HALF[2])
+AWAY = (4.85, 2.3, TABLE + HALF[2])  # on the table's far corner, out of the arm's way
+START, GOAL = (4.02, 1.78, 0.83), (4.24, 1.78, 0.83)  # tool positions either side of the wall
+ARM = "right"
+
+
+def _world(wall_at):
+    from pycram import robots
+    from pycram.backends.sim.items import ItemSpec
+    from pycram.sim import World
+
+    world = World(
+        "pr2",
+        items=[ItemSpec("wall", "box", "box", HALF, 1.0, wall_at[:2] + (None,))],
+        environment="apartment",
+        base_pose=BASE,
+    )
+    from pycram.robots.common.sim_modules import plan_arm_motions
+
+    robot = robots.load("pr2", world)
+    robot.prospection = world.prospection()  # the true state: the wall is known
+    plan_arm_motions(robot)
+    return world, robot
+
+
+def _joints(world, robot, position):
+    result = robot.prospection.solve_ik(ARM, (position, FORWARD), world.base_pose.get_value())
+    assert result, result.message
+    return list(result.positions)
+
+
+def _to_start(world, robot):
+    """The tool to START (beside the wall), planned; returns (start q, goal q)."""
+    from pycram.designator import MotionDesignator, perform
+
+    start, goal = _joints(world, robot, START), _joints(world, robot, GOAL)
+    with robot:
+        perform(MotionDesignator(type="setting_arm_joints", arm=ARM, positions=start))
+    return start, goal
+
+
+def _wall(world):
+    return world.item_poses.get_value()["wall"]
+
+
+def _planner(robot):
+    return robot.process_module(f"arm_{ARM}")._motions
+
+
+def test_a_planned_motion_goes_around_a_box_the_straight_line_would_hit():
+    from pycram.designator import MotionDesignator, perform
+
+    world, robot = _world(WALL)
+    try:
+        start, goal = _to_start(world, robot)
+        before = _wall(world)
+        base = world.base_pose.get_value()
+        with robot.prospection.configuration_checker(ARM, base) as checker:
+            assert not checker.motion_free(start, goal, 0.02)  # the straight line cuts the wall
+        with robot:
+            reached = perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
+        assert math.dist(reached.position, GOAL) < 0.01
+        planner = _planner(robot)
+        (plan,) = planner.last_plans
+        assert plan and plan.planner == "RRTConnect" and len(plan.path) >= 3
+        assert planner.last_stops == []  # executed without an unexpected contact
+        after = _wall(world)
+        assert math.dist(after.position, before.position) < 0.002  # untouched
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_a_box_put_in_the_way_after_planning_is_hit_softly_detected_and_planned_around():
+    from pycram.designator import MotionDesignator, perform
+
+    world, robot = _world(AWAY)
+    try:
+        _to_start(world, robot)
+        planner = _planner(robot)
+        plan_once = planner.planner.plan
+        calls = []
+
+        def plan_then_move_the_wall(*args, **kwargs):
+            plan = plan_once(*args, **kwargs)
+            calls.append(plan)
+            if len(calls) == 1:  # after the first plan (the straight line): the wall comes
+                ok(world.move_item("wall", WALL))
+            return plan
+
+        planner.planner.plan = plan_then_move_the_wall
+        with robot:
+            reached = perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
+        assert math.dist(reached.position, GOAL) < 0.01
+        first, *again = planner.last_plans
+        assert first.planner == "straight_line"  # planned before the wall was there
+        (stop,) = planner.last_stops
+        assert stop.reason == "collision" and "wall" in stop.message
+        assert again and again[-1].planner == "RRTConnect"  # around the wall, known now
+        # a soft hit: the wall was pushed by less than a few centimetres and still stands
+        wall = _wall(world)
+        assert math.dist(wall.position[:2], WALL[:2]) < 0.03
+        w, x, y, z = wall.orientation
+        assert math.acos(min(1.0, 1.0 - 2.0 * (x * x + y * y))) < math.radians(10)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_the_path_controller_refuses_malformed_samples_and_follows_a_path():
+    from pycram.sim import World
+
+    world = World("pr2", environment="apartment", base_pose=BASE)
+    try:
+        joints = world.description.ARMS[ARM]["joints"]
+        here = [world.joint_states.get_value().position[j] for j in joints]
+        bad = world.follow_arm_path(ARM, joints, [(0.0, here[:3])]).wait(10.0)
+        assert bad.reason == "invalid" and "positions" in bad.message
+        bad = world.follow_arm_path(ARM, joints, [(0.5, here), (0.2, here)]).wait(10.0)
+        assert bad.reason == "invalid" and "increase" in bad.message
+        bad = world.follow_arm_path(ARM, joints, [(0.0, here), (1.0, [math.nan] * len(here))]).wait(10.0)
+        assert bad.reason == "invalid"
+        goal = list(here)
+        goal[0] += 0.3
+        samples = [(0.02 * i, [a + (b - a) * i / 50 for a, b in zip(here, goal)]) for i in range(51)]
+        error = ok(world.follow_arm_path(ARM, joints, samples))
+        assert error <= 0.01
+        now = [world.joint_states.get_value().position[j] for j in joints]
+        assert np.allclose(now, goal, atol=0.01)
+    finally:
+        world.close()
