@@ -126,7 +126,7 @@ class ArmMotionPlanner:
     """
 
     def __init__(
-        self, world: Any, arm: str, robot: Callable[[], Any], run: Callable[..., Any], failure: type[Exception]
+        self, world: Any, arm: str, robot: Callable[[], Any], run: Callable[..., Any], failure: type[Any]
     ) -> None:
         from pycram.reasoning.motion import OMPLPlanner
 

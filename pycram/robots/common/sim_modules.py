@@ -312,7 +312,8 @@ class ArmModule(SimProcessModule):
             if planner is None:
                 return reach_directly()
             if grasped[1] is None:  # what lies at the target is what the hand goes for
-                grasped = (grasped[0], tuple(float(v) for v in solution.get("target") or position))
+                tx, ty, tz = (float(v) for v in solution.get("target") or position)
+                grasped = (grasped[0], (tx, ty, tz))
             return planner.reach(position, orientation, tolerance, what, reach_directly, grasped, phase)
         check_command(self, solution, "move_arm", "reach")
 
