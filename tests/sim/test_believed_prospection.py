@@ -101,3 +101,17 @@ def test_a_believed_object_is_an_obstacle_to_the_arm_except_to_grasp_it(apartmen
     belief.lost(belief.objects()[0])  # believed gone: no obstacle any more
     with believed.configuration_checker(ARM, base) as checker:
         assert not any("believed:cup" in env for _, env in checker.contacts(solution.positions))
+
+
+def test_untyped_objects_are_boxes_of_their_measured_size_in_each_worlds_own_model(apartment):
+    first, p = _believing(apartment)
+    second, q = _believing(apartment)
+    first.add(PerceivedObject("box-1", "box", (2.0, 2.0, 1.0), {"size": (0.1, 0.2, 0.3)}))
+    second.add(PerceivedObject("box-1", "box", (2.0, 2.0, 1.0), {"size": (0.04, 0.04, 0.04)}))
+    sizes = []
+    for prospection in (p, q):
+        model = prospection.model
+        body = prospection.scene.body(prospection.believed.body_of("box-1"))
+        (geom,) = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body]
+        sizes.append(tuple(float(v) for v in model.geom_size[geom]))
+    assert sizes == [pytest.approx((0.05, 0.1, 0.15)), pytest.approx((0.02, 0.02, 0.02))]

@@ -27,6 +27,8 @@ Thread-safe: `snapshot` may be called from any thread; snapshots are immutable o
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import logging
 import math
 import threading
@@ -72,7 +74,7 @@ def _parking(index: int) -> tuple[float, float, float]:
 def believed_scene(robot: str, environment: Environment) -> Scene:
     """The prospection scene of `robot` in `environment`: both, with proxy objects and no items
     or obstacles (see the module docstring). Compiled on first use (~0.1-0.5 s), then shared
-    (read-only: prospection keeps its own data and planning copies)."""
+    (read-only: each `BelievedWorld` works on its own copy of the model)."""
     key = (robot, environment)
     with _scenes_lock:
         scene = _scenes.get(key)
@@ -100,7 +102,9 @@ class BelievedWorld:
     """
 
     def __init__(self, true_scene: Scene, belief: Any, sensor_state: Callable[[], StateSnapshot]) -> None:
-        self.scene = believed_scene(true_scene.robot, true_scene.environment)
+        shared = believed_scene(true_scene.robot, true_scene.environment)
+        # a model of its own: generic proxies are sized for this belief's objects
+        self.scene = dataclasses.replace(shared, model=copy.copy(shared.model))
         self.belief = belief
         self._sensor_state = sensor_state
         model, true_model = self.scene.model, true_scene.model
