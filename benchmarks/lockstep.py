@@ -21,7 +21,7 @@ also print their fingerprint, which repeats run after run
 alone in lock-step.
 
     MUJOCO_GL=egl .venv/bin/python benchmarks/lockstep.py [--robots pr2,tiago] [--repeat 2]
-        [--physics 30] [--skip-set-table] [--throughput 8]
+        [--physics 60] [--skip-set-table] [--throughput 8]
 
 Numbers depend on the machine's load; run it on an otherwise idle machine for the record.
 """
@@ -149,7 +149,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", default="pr2,tiago")
     parser.add_argument("--repeat", type=int, default=2, help="runs per scenario and stepping")
-    parser.add_argument("--physics", type=float, default=20.0, help="simulated seconds of physics alone")
+    parser.add_argument("--physics", type=float, default=60.0, help="simulated seconds of physics alone")
     parser.add_argument("--skip-set-table", action="store_true")
     parser.add_argument("--throughput", type=int, default=0, help="seeds of the experiment throughput (0: skip)")
     args = parser.parse_args()
