@@ -25,7 +25,6 @@ phase too (a contype bit per group of robot bodies with the same excluded arm bo
 from __future__ import annotations
 
 import copy
-import math
 import queue
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -308,14 +307,6 @@ class SimConfigurationChecker(ConfigurationChecker):
                 g1, g2 = g2, g1
             out[(self._geom_name(g1), self._geom_name(g2))] = None
         return list(out)
-
-    def motion_free(self, q0: Sequence[float], q1: Sequence[float], resolution: float = 0.02) -> bool:
-        a, b = np.asarray(q0, float), np.asarray(q1, float)
-        steps = max(1, math.ceil(float(np.max(np.abs(b - a), initial=0.0)) / resolution))
-        for i in range(steps + 1):
-            if not self.is_free(a + (i / steps) * (b - a)):
-                return False
-        return True
 
     def close(self) -> None:
         if self._release is not None:
