@@ -115,3 +115,17 @@ def test_untyped_objects_are_boxes_of_their_measured_size_in_each_worlds_own_mod
         (geom,) = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body]
         sizes.append(tuple(float(v) for v in model.geom_size[geom]))
     assert sizes == [pytest.approx((0.05, 0.1, 0.15)), pytest.approx((0.02, 0.02, 0.02))]
+
+
+def test_proxies_nobody_stands_for_are_parked_far_below_the_floor(apartment):
+    belief, p = _believing(apartment)
+    belief.add(PerceivedObject("cup-1", "cup", (2.0, 2.0, 1.0)))
+    qpos = p.believed.snapshot().qpos
+    model, scene = p.model, p.scene
+    used = p.believed.body_of("cup-1")
+    for spec in scene.items:
+        adr = int(model.jnt_qposadr[model.body_jntadr[scene.body(spec.name)]])
+        if spec.name == used:
+            assert tuple(qpos[adr : adr + 3]) == pytest.approx((2.0, 2.0, 1.0))
+        else:
+            assert qpos[adr + 2] < -10.0 and tuple(qpos[adr + 3 : adr + 7]) == (1.0, 0.0, 0.0, 0.0)

@@ -133,7 +133,6 @@ class BelievedWorld:
             spec.name: int(model.jnt_qposadr[model.body_jntadr[self.scene.body(spec.name)]])
             for spec in self.scene.items
         }
-        self._parking = {spec.name: _parking(i) for i, spec in enumerate(self.scene.items)}
         self._tool_sites = {arm: self.scene.site(tool_site(arm)) for arm in true_scene.description.ARMS}
         self._lock = threading.Lock()
         self._assigned: dict[str, str] = {}  # belief name -> proxy name (kept for good)
@@ -207,14 +206,12 @@ class BelievedWorld:
         sensed = self._sensor_state()
         with self._lock:
             model, d = self.scene.model, self._data
-            qpos = model.qpos0.copy()
+            qpos = model.qpos0.copy()  # every proxy parked where it was compiled (`_parking`)
             qpos[self._own[:, 0]] = sensed.qpos[self._own[:, 1]]
             for name, q in dict(getattr(self.belief, "container_states", {})).items():
                 address = self._containers.get(name)
                 if address is not None:
                     qpos[address] = float(q)
-            for parked, (x, y, z) in self._parking.items():
-                qpos[self._qadr[parked] : self._qadr[parked] + 7] = (x, y, z, 1.0, 0.0, 0.0, 0.0)
             in_hand = dict(getattr(self.belief, "in_hand", {}))
             held = {id(obj): gripper for gripper, obj in in_hand.items()}
             if held:  # the tool frames of the robot as it stands now
