@@ -16,7 +16,10 @@ measured opening after closing and after lifting (an empty gripper closes to alm
 
 An object in a drawer not pulled out far enough, or behind a door not open far enough, is made
 reachable first with the `Open` action. Top grasps (bowls and plates, by the rim) follow the
-tool poses location reasoning validated, the tool pointing down. Every attempt is a task of its
+tool poses location reasoning validated, the tool pointing down. So do grasps planned from the
+object's measured shape and pose (`pycram.reasoning.grasps`: an object lying on its side, a
+box turned far from square; the location's ``grasp_candidate``), with their tool orientations,
+moved along with the object by as much as a look from the standing pose saw it move. Every attempt is a task of its
 own (kind ``attempt``), so the task tree shows each recovery. The object picked up is recorded
 in `pycram.actions.held`.
 """
@@ -63,7 +66,7 @@ from .core import (
     unwrap,
 )
 from .handling import _look_again, _pose_text, _reach, _xyz, back_away, carry_configuration
-from .held import Held, held_objects
+from .held import Held, fingers_yaw, held_objects
 from .search import search_for
 
 __all__ = [
@@ -109,13 +112,20 @@ def executable_grasps(type_name: str, requested: str | None = None) -> list[Gras
     """The grasps of an object type that picking up can execute with the active robot: the
     horizontal approaches, and ``top`` when its ``reaching`` motion takes a tool orientation
     (then the tool follows the poses location reasoning validated)."""
-    types = getattr(current_robot(), "motion_types", None) or {}
-    reaching = types.get("reaching")
-    top_ok = reaching is not None and any(k.name == "orientation" for k in reaching.all_keys())
+    top_ok = _reaching_takes_orientation()
     grasps = [g for g in object_type(type_name).grasps if top_ok or g.approach != "top"]
     if requested is not None:
         grasps = [g for g in grasps if g.approach == requested]
     return grasps
+
+
+def _reaching_takes_orientation() -> bool:
+    """Whether the active robot's ``reaching`` motion takes a tool orientation (needed for top
+    grasps and for planned grasps, `pycram.reasoning.grasps`, whose tool turns from the base's
+    heading)."""
+    types = getattr(current_robot(), "motion_types", None) or {}
+    reaching = types.get("reaching")
+    return reaching is not None and any(k.name == "orientation" for k in reaching.all_keys())
 
 
 def believed_object(action: str, wanted: Any) -> PerceivedObject:
@@ -158,11 +168,16 @@ class _ObjectMoved(PlanFailure):
     default_reason = "object_moved"
 
 
-def _let_go_and_retract(arm: str, gripper: str, point: list[float] | None, location: Any = None) -> None:
-    """Best effort after a failed grasp: open the gripper, back off, arm up for driving."""
+def _let_go_and_retract(
+    arm: str, gripper: str, point: list[float] | None, location: Any = None, reach: Any = None
+) -> None:
+    """Best effort after a failed grasp: open the gripper, back off (`reach(0, phase)`: to the
+    pre-grasp pose of a planned grasp), arm up for driving."""
 
     def retreat() -> None:
-        if location is not None and location.grasp == "top":
+        if reach is not None:
+            reach(0, "pre_grasp")
+        elif location is not None and location.grasp == "top":
             _reach(arm, location, 0, "pre_grasp", point)  # straight up, as it came
         elif point:
             motion(type="reaching", arm=arm, target=point, phase="retreat")
@@ -191,9 +206,31 @@ def _arm_to_drive(arm: str, configuration: str) -> None:
         motion(type="setting_arm_configuration", arm=arm, configuration=configuration)
 
 
+def _planned_reach(arm: str, location: Any, obj: PerceivedObject) -> Any:
+    """For a location validated for a planned grasp (``location.grasp_candidate``): a function
+    ``reach(index, phase, grasping=None)`` that moves the tool to the `index`-th validated tool
+    pose (position and orientation), moved along with the object by as much as it was seen to
+    have moved since the grasp was planned (within `MOVED`: a look from close by is the better
+    measurement). None for a location of a type's own grasp."""
+    candidate = getattr(location, "grasp_candidate", None)
+    if candidate is None:
+        return None
+    poses = location.tool_poses
+
+    def reach(index: int, phase: str, grasping: Any = None) -> None:
+        (x, y, z), orientation = poses[index]
+        dx, dy, dz = (a - b for a, b in zip(obj.pose, candidate.centre, strict=True))
+        extra = {} if grasping is None else {"object": grasping}
+        target = [x + dx, y + dy, z + dz]
+        motion(type="reaching", arm=arm, target=target, orientation=list(orientation), phase=phase, **extra)
+
+    return reach
+
+
 def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     """One pick-up attempt from the standing pose `location` (see the module's description)."""
     arm = location.arm
+    candidate = getattr(location, "grasp_candidate", None)
     gripper = gripper_of(arm)
     planned = tuple(obj.pose)
     motion(type="setting_gripper", gripper=gripper, position=1)
@@ -235,13 +272,36 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     if math.dist(obj.pose, planned) > moved:
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
     poses: Any = getattr(location, "tool_poses", ())
-    if location.grasp == "top" and len(poses) > 1:  # validated for where the object was then
+    if candidate is not None:  # planned for where the object was when the location was resolved
+        if math.dist(obj.pose, candidate.centre) > moved:
+            raise _ObjectMoved(f"{obj.name} moved from {_xyz(candidate.centre)} to {_xyz(obj.pose)}", obj)
+    elif location.grasp == "top" and len(poses) > 1:  # validated for where the object was then
         off = abs(math.dist(poses[1][0][:2], obj.pose[:2]) - grasp.radius)
         if off > moved:
             raise _ObjectMoved(f"{obj.name} is {off:.2f} m off the grasp planned for it", obj)
     point = _grasp_point(obj, grasp, location.yaw)
+    planned_reach = _planned_reach(arm, location, obj)
+
+    def reach(index: int, phase: str, grasping: Any = None) -> None:
+        if planned_reach is not None:
+            planned_reach(index, phase, grasping)
+        else:
+            _reach(arm, location, index, phase, point, grasping)
+
     try:
-        if grasp.approach != "top" and grasp.radius:
+        if candidate is not None and grasp.approach != "top" and grasp.radius:
+            # a deep object, planned: as below, along the planned tool heading and orientation
+            c, s = math.cos(candidate.heading), math.sin(candidate.heading)
+            (gx, gy, gz), orientation = poses[1]
+            dx, dy, dz = (a - b for a, b in zip(obj.pose, candidate.centre, strict=True))
+            back = [gx + dx - grasp.radius * c, gy + dy - grasp.radius * s, gz + dz]
+            try:
+                motion(
+                    type="reaching", arm=arm, target=back, orientation=list(orientation), phase="pre_grasp", object=obj
+                )
+            except RECOVERABLE as error:
+                log.info("grasping %s: no pose farther back first (%s)", obj.name, unwrap(error))
+        elif grasp.approach != "top" and grasp.radius:
             # a deep object (a cereal box) reaches towards the robot: the raised gripper would
             # swing into it on its way to the pre-grasp pose (measured: the TIAGo knocked the
             # cereal box over), so it comes to a pose `radius` farther back first -- where the
@@ -252,15 +312,15 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
                 motion(type="reaching", arm=arm, target=back, phase="pre_grasp", object=obj)
             except RECOVERABLE as error:
                 log.info("grasping %s: no pose farther back first (%s)", obj.name, unwrap(error))
-        _reach(arm, location, 0, "pre_grasp", point, obj)
-        _reach(arm, location, 1, "grasp", point, obj)
+        reach(0, "pre_grasp", obj)
+        reach(1, "grasp", obj)
         opening = float(motion(type="setting_gripper", gripper=gripper, position=0))
     except RECOVERABLE:
-        _let_go_and_retract(arm, gripper, point, location)
+        _let_go_and_retract(arm, gripper, point, location, planned_reach)
         raise
-    held = Held(obj, arm, gripper, grasp)
+    held = Held(obj, arm, gripper, grasp, fingers_yaw(location))
     if opening < held.held_opening:
-        _let_go_and_retract(arm, gripper, point, location)
+        _let_go_and_retract(arm, gripper, point, location, planned_reach)
         if not _look_again(obj):  # closed on nothing where it was believed, and not seen there: gone
             belief = getattr(current_robot(), "belief", None)
             if belief is not None:
@@ -277,7 +337,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     if belief is not None:
         belief.picked_up(obj, gripper)
     try:
-        _reach(arm, location, 2, "lift", point)
+        reach(2, "lift")
         motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, grasp))
         back_away(f"picking up {obj.name}")
         # carried with the torso up (`CARRY_TORSO`), once backed away from the furniture: from a
@@ -373,6 +433,8 @@ def _pick_up(designator: ActionDesignator) -> Held:
             "no_executable_grasp",
         )
     by_approach = {g.approach: g for g in grasps}
+    # planned grasps (`pycram.reasoning.grasps`) need a tool orientation
+    planned_ok = _reaching_takes_orientation()
     attempts: list[str] = []
     last: BaseException | None = None
     for _ in range(PICK_ROUNDS):
@@ -385,7 +447,11 @@ def _pick_up(designator: ActionDesignator) -> Held:
         perceive_again = False
         try:
             for location in solutions(LocationDesignator(properties)):
-                grasp = by_approach.get(location.grasp)
+                candidate = getattr(location, "grasp_candidate", None)
+                if candidate is not None:
+                    grasp = candidate.grasp if planned_ok else None
+                else:
+                    grasp = by_approach.get(location.grasp)
                 if grasp is None:
                     continue
                 tried += 1

@@ -14,7 +14,10 @@ once (`pursue`). Raises `GripperEmpty` when the gripper
 holds nothing, `PlacingFailed` / `ObjectOutOfReach` after its attempts.
 
 An object held from the top (bowls and plates, by the rim) is put down with the same grasp's
-place sequence, the tool pointing down. Every attempt is a task of its own (kind ``attempt``),
+place sequence, the tool pointing down; one picked up lying on its side with a planned grasp
+(`pycram.reasoning.grasps`) is put down as it hangs in the hand, lying (not counted as
+toppled). The belief turns a put-down object by as much as the hand turned it since the grasp
+(`Held.hand_turn`). Every attempt is a task of its own (kind ``attempt``),
 so the task tree shows each recovery. The object let go of is removed from
 `pycram.actions.held`.
 """
@@ -35,7 +38,7 @@ from pycram.execution.failures import GripperEmpty, ObjectOutOfReach, ObjectSlip
 from pycram.execution.robot import current_robot
 from pycram.reasoning.locations.targets import KnownObject
 from pycram.world.belief import PerceivedObject
-from pycram.world.objects import object_type
+from pycram.world.objects import FOOTPRINT_SLACK, object_type
 
 from .core import (
     RECOVERABLE,
@@ -53,7 +56,7 @@ from .core import (
     unwrap,
 )
 from .handling import _look_again, _pose_text, _reach, _xyz, back_away, carry_configuration
-from .held import Held, held_objects
+from .held import Held, fingers_yaw, held_objects
 
 __all__ = [
     "Place",
@@ -76,8 +79,6 @@ NEAR_SIDE_INSET = 0.15
 PLACE_TOLERANCE = 0.05
 #: A placed object measured taller than it is by more than this [m] does not rest on the surface.
 RESTING_SLACK = 0.05
-#: ... and one measured wider than its standing footprint by more than this [m] lies on its side.
-FOOTPRINT_SLACK = 0.02
 
 
 def Place(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
@@ -168,12 +169,19 @@ def _place_locations(held: Held, spot: tuple[float, float, float], point: list[f
     pointing down); else the tool point `point`, approached along the base's heading."""
     if held.grasp.approach == "top":
         standing = KnownObject(f"{held.object.name} at the spot", held.object.type, spot)
-        return LocationDesignator([("to_reach", standing), ("arm", held.arm), ("grasp", "top"), ("action", "place")])
+        # a type's own top grasp by its name; a planned one (`pycram.reasoning.grasps`: e.g. a
+        # carton picked up lying) as it is held, so the object is put down as it hangs in the hand
+        own = held.grasp in object_type(held.object.type).grasps
+        grasp: Any = "top" if own else held.grasp
+        return LocationDesignator([("to_reach", standing), ("arm", held.arm), ("grasp", grasp), ("action", "place")])
     return LocationDesignator([("to_reach", tuple(point)), ("arm", held.arm), ("action", "place")])
 
 
 def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point: list[float]) -> PerceivedObject:
     arm, gripper, obj = held.arm, held.gripper, held.object
+    # picked up lying on its side (the belief keeps the size measured before it was grasped):
+    # it is put down as it hangs in the hand, lying -- that is no toppling
+    lying = obj.lying_axis is not None
     if held.grasp.approach != "top" and held.grasp.radius:  # held off its centre, towards the robot
         r = held.grasp.radius
         point = [point[0] - r * math.cos(location.yaw), point[1] - r * math.sin(location.yaw), point[2]]
@@ -197,7 +205,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     held_objects().pop(arm, None)
     belief = getattr(current_robot(), "belief", None)
     if belief is not None:
-        belief.put_down(obj, spot)
+        belief.put_down(obj, spot, held.hand_turn(fingers_yaw(location)))  # it turned with the hand
     try:
         _reach(arm, location, 2, "retreat", point, obj)  # the fingers may still touch it
     except RECOVERABLE as error:  # the object is down: backing off is best effort
@@ -207,7 +215,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
     # the arm hides it from leaves the put-down pose believed (parking the arm next to the
     # object just put down knocked it over: the TIAGo's cup, measured)
     _look_again(obj, spot)
-    problem = None if obj.gone else resting_problem(obj)
+    problem = None if obj.gone else resting_problem(obj, lying)
     if obj.gone or problem is not None:
         # the arm in its carry pose may hide the object (or its top), and looks may miss what is
         # there (missed detections): park the arm and look again before believing the looks
@@ -215,7 +223,7 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
         log.info("placing %s: %s; parking the %s arm and looking again", obj.name, why, arm)
         motion(type="setting_arm_configuration", arm=arm, configuration="park")
         _look_again(obj, spot)
-        problem = None if obj.gone else resting_problem(obj)
+        problem = None if obj.gone else resting_problem(obj, lying)
     back_away(f"putting down {obj.name}")
     if problem is not None:
         reason, why = problem
@@ -244,9 +252,10 @@ def _lost_from_gripper(held: Held, park: bool = False) -> None:
         )
 
 
-def resting_problem(obj: PerceivedObject) -> tuple[str, str] | None:
+def resting_problem(obj: PerceivedObject, lying: bool = False) -> tuple[str, str] | None:
     """Why the measured `obj` does not stand upright on its surface -- ``('toppled', why)`` or
-    ``('not_resting', why)`` -- or None when its measured height fits.
+    ``('not_resting', why)`` -- or None when its measured height fits. With `lying` (it was put
+    down lying, as it was picked up) only ``'not_resting'`` is a problem.
 
     Perception measures an object's height from the surface it is over to its top. Taller than
     the object by more than `RESTING_SLACK`: it does not rest on the surface (still in the
@@ -266,6 +275,8 @@ def resting_problem(obj: PerceivedObject) -> tuple[str, str] | None:
             f"its top is measured {measured * 100:.0f} cm above the {obj.properties['on']}, "
             f"a {kind.name} is {kind.height * 100:.0f} cm tall (still held, or on something)"
         )
+    if lying:
+        return None
     wide = max(float(size[0]), float(size[1]))
     if wide > 2.0 * kind.footprint_radius + FOOTPRINT_SLACK:
         return "toppled", (

@@ -7,6 +7,10 @@ it is searched for and fetched again, at most `TRANSPORT_ROUNDS` times; then the
 last round is raised (`ObjectSlipped`, `GraspFailed`, `ObjectNotFound`, ...). Returns the
 believed object where it was put.
 
+A target inside a container (``('in', 'drawer 2')``, or the name of a drawer's, a shelf's or the
+fridge's inside) that the robot does not believe open is opened first (`Open`), before the object
+is fetched: the hand that opens it is free then, also on a one-armed robot.
+
 With ``close_container=True`` the container the object was taken from (a drawer the search
 opened) is closed again with `Close`, unless it was believed open before the transport: right
 after picking up, with a free arm (the PR2), or once the object is placed (a one-armed robot).
@@ -26,7 +30,7 @@ from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 
 from .container_state import CLOSED, DOOR_CLOSED
-from .containers import Close
+from .containers import Close, Open
 from .core import ActionParameterError, action_plan, arms, attempt, make_action
 from .held import held_objects
 from .pick_up import PickUp, believed_object
@@ -62,6 +66,23 @@ def _close(container: str, arm: str | None, obj: Any) -> None:
     perform(Close(container, arm=arm))
 
 
+def _target_container(target: Any) -> str | None:
+    """The container `target` lies in: a location designator's ``('in', container)``, or a
+    surface name of a container's inside; None for anything else."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    containers = {c.name: c for c in getattr(environment, "containers", ())}
+    prop_value = getattr(target, "prop_value", None)
+    if callable(prop_value):
+        inside = prop_value("in")
+        return str(inside) if isinstance(inside, str) and inside in containers else None
+    if isinstance(target, str):
+        for container in containers.values():
+            if target == container.name or any(s.name == target for s in container.interior):
+                return container.name
+    return None
+
+
 @action_plan("transporting")
 def transporting(designator: ActionDesignator) -> Any:
     wanted = designator.prop_value("object")
@@ -70,6 +91,10 @@ def transporting(designator: ActionDesignator) -> Any:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
     arm = designator.prop_value("arm")
     opened_before = set(_open_containers())
+    into = _target_container(target)
+    if into is not None and into not in opened_before:
+        log.info("transporting: opening %s first, to put the object in", into)
+        perform(Open(into, arm=arm))
     last: BaseException | None = None
     for round_number in range(1, TRANSPORT_ROUNDS + 1):
         if round_number > 1 and isinstance(wanted, ObjectDesignator):

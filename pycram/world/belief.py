@@ -45,6 +45,7 @@ from pycram.designators.object import Belief, BelievedObject
 
 from .environment import Environment, Surface
 from .objects import OBJECT_TYPES
+from .types import matrix_to_quat
 
 __all__ = [
     "COLOR_NAMES",
@@ -56,6 +57,7 @@ __all__ = [
     "PerceivedObject",
     "PerceptionReport",
     "color_name",
+    "lying_orientation",
     "support_of",
 ]
 
@@ -215,7 +217,9 @@ class PerceivedObject(BelievedObject):
     "size", "on" (the surface's name), "in" (the container's name or None), "first_seen",
     "last_seen" [s] and "pixels". `pose_fluent` holds the pose and pulses on every refresh;
     `gone` is True while it should have been seen but was not.
-    `misses` counts the looks in a row that should have seen it and did not.
+    `misses` counts the looks in a row that should have seen it and did not. `yaw`,
+    `lying_axis` and `orientation` say how it stands or lies, as far as its measured size and
+    the measured direction of its top's longer axis tell.
     """
 
     pose_fluent: Fluent = field(default_factory=lambda: Fluent(None))
@@ -235,6 +239,31 @@ class PerceivedObject(BelievedObject):
             return 0.0
         yaw = float(axis) - (math.pi / 2 if otype.size[1] > otype.size[0] else 0.0)
         return (yaw + math.pi) % (2 * math.pi) - math.pi
+
+    @property
+    def lying_axis(self) -> str | None:
+        """Which of its own axes (``"x"``/``"y"``) perception measured standing vertical, the
+        object lying on its side; None while it stands upright (or its type or size is not
+        known). From the measured size (`ObjectType.lying_axis`)."""
+        otype = OBJECT_TYPES.get(self.type)
+        size = self.properties.get("size")
+        return None if otype is None or not size else otype.lying_axis(size)
+
+    @property
+    def orientation(self) -> tuple[float, float, float, float] | None:
+        """Its orientation (w, x, y, z) in the map frame as far as perception measured it, up to
+        the symmetries of its shape: standing, turned by `yaw` about the vertical; lying
+        (`lying_axis`), that axis up and the longer of its two other axes along the measured
+        direction of its top's longer axis (property "axis"). None when it lies and that
+        direction was not measured (not seen from above)."""
+        up = self.lying_axis
+        if up is None:
+            return (math.cos(self.yaw / 2), 0.0, 0.0, math.sin(self.yaw / 2))
+        axis = self.properties.get("axis")
+        otype = OBJECT_TYPES.get(self.type)
+        if axis is None or otype is None:
+            return None
+        return lying_orientation(otype.extents, up, float(axis))
 
     @property
     def last_seen(self) -> float:
@@ -459,12 +488,17 @@ class BeliefState(Belief):
         for gripper in [g for g, o in self.in_hand.items() if o is obj]:
             del self.in_hand[gripper]
 
-    def put_down(self, obj: PerceivedObject, position: Iterable[float]) -> None:
-        """The robot itself put `obj` down at `position` (x, y, z) [m, map]: believe it there
-        (not gone) until the next look refreshes it; no gripper holds it any more. Its pose
-        fluent pulses."""
+    def put_down(self, obj: PerceivedObject, position: Iterable[float], turn: float = 0.0) -> None:
+        """The robot itself put `obj` down at `position` (x, y, z) [m, map], turned by `turn`
+        [rad] about the vertical since it was last seen (it turned with the hand that carried
+        it: the measured direction of its top's longer axis, property "axis", turns along):
+        believe it so (not gone) until the next look refreshes it; no gripper holds it any more.
+        Its pose fluent pulses."""
         with self._update_lock:
             self._out_of_hand(obj)
+            axis = obj.properties.get("axis")
+            if axis is not None and turn:
+                obj.properties["axis"] = (float(axis) + turn + math.pi / 2) % math.pi - math.pi / 2
             obj.pose = tuple(float(v) for v in position)
             obj.gone = False
             obj.misses = 0
@@ -510,6 +544,24 @@ def _rests_in(environment: Environment, obj: PerceivedObject, states: dict[str, 
     size = obj.properties.get("size")
     bottom = z - size[2] / 2 if size else z
     return support_of(environment, x, y, bottom, states) in inside
+
+
+def lying_orientation(
+    extents: tuple[float, float, float], up: str, direction: float
+) -> tuple[float, float, float, float]:
+    """The orientation (w, x, y, z) of an object with `extents` (its lengths along its own x, y,
+    z [m]) lying with its own axis `up` (``"x"`` or ``"y"``) vertical and the longer of its other
+    two axes pointing along `direction` [rad] (map frame, counter-clockwise from x)."""
+    i = "xyz".index(up)
+    a, b = (j for j in range(3) if j != i)
+    long, short = (a, b) if extents[a] >= extents[b] else (b, a)
+    columns = np.zeros((3, 3))  # the object's axes in the map frame, as columns
+    columns[:, i] = (0.0, 0.0, 1.0)
+    columns[:, long] = (math.cos(direction), math.sin(direction), 0.0)
+    # the third axis completes a right-handed frame: x = y cross z, y = z cross x, z = x cross y
+    nxt, prev = (short + 1) % 3, (short + 2) % 3
+    columns[:, short] = np.cross(columns[:, nxt], columns[:, prev])
+    return matrix_to_quat(columns)
 
 
 def support_of(

@@ -19,6 +19,10 @@ RGBA = tuple[float, float, float, float]
 #: Horizontal approach directions in the object's frame; "side" means any horizontal direction
 #: (round objects), "top" straight down.
 APPROACHES = ("top", "side", "+x", "-x", "+y", "-y")
+#: An object measured wider on its surface than its standing footprint (`ObjectType.footprint_radius`)
+#: by more than this [m] lies on its side (seen from above, a toppled object's shadow is longer
+#: than any standing one's: a milk carton lying shows at least 19 cm, standing at most 10 cm).
+FOOTPRINT_SLACK = 0.02
 
 
 @dataclass(frozen=True)
@@ -116,6 +120,33 @@ class ObjectType:
     def footprint_radius(self) -> float:
         """Radius [m] of the smallest circle around the object's shadow on a surface (any yaw)."""
         return math.hypot(self.size[0], self.size[1]) if self.shape == "box" else self.size[0]
+
+    @property
+    def extents(self) -> tuple[float, float, float]:
+        """The object's full lengths [m] along its own x, y and z axes (a box's sizes; a round
+        object's diameter twice, then its height)."""
+        if self.shape == "box":
+            return (2.0 * self.size[0], 2.0 * self.size[1], 2.0 * self.size[2])
+        return (2.0 * self.size[0], 2.0 * self.size[0], 2.0 * self.size[1])
+
+    def lying_axis(self, measured: tuple[float, ...] | list[float]) -> str | None:
+        """Which of the object's own axes (``"x"`` or ``"y"``) stands vertical when an object of
+        this type, measured `measured` = (width, depth, height) [m] on a surface by perception,
+        lies on its side; None when it stands upright (or the measurement does not tell).
+
+        It lies when its measured shadow is wider than its standing footprint by more than
+        `FOOTPRINT_SLACK` (the height alone is no proof: the robot's own arm hiding the top makes
+        a standing object look short). Of a box the axis whose length is nearest the measured
+        height stands up (a cereal box lies on its broad or its narrow face); a round object's
+        radial axis is called ``"x"``."""
+        if len(measured) < 3 or max(float(measured[0]), float(measured[1])) <= (
+            2.0 * self.footprint_radius + FOOTPRINT_SLACK
+        ):
+            return None
+        if self.shape != "box":
+            return "x"
+        height = float(measured[2])
+        return min(("x", "y"), key=lambda a: abs(self.extents["xy".index(a)] - height))
 
     def parts(self) -> list[Part]:
         """The object's shape as primitives (see `shape_parts`)."""
@@ -241,4 +272,13 @@ def object_type(name: str) -> ObjectType:
     return OBJECT_TYPES[name]
 
 
-__all__ = ["ObjectType", "Grasp", "Part", "OBJECT_TYPES", "APPROACHES", "object_type", "shape_parts"]
+__all__ = [
+    "ObjectType",
+    "Grasp",
+    "Part",
+    "OBJECT_TYPES",
+    "APPROACHES",
+    "FOOTPRINT_SLACK",
+    "object_type",
+    "shape_parts",
+]

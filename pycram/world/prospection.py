@@ -373,6 +373,7 @@ class Prospection(abc.ABC):
         held_object: str | None = None,
         exempt_object: str | None = None,
         clearance: float = 0.0,
+        object_clearance: float = 0.0,
         self_collision: bool = True,
     ) -> ConfigurationChecker:
         """A :class:`ConfigurationChecker` for ``arm`` (joints as in :meth:`arm_joint_limits`) with
@@ -383,7 +384,9 @@ class Prospection(abc.ABC):
         parts that do not move with the arm. ``held_object`` (an object's name) moves rigidly with
         the hand as it is held now and counts as part of the arm; ``exempt_object`` may touch the
         gripper (the object being grasped) but nothing else of the arm. A pair counts as touching
-        when closer than ``clearance`` [m] (negative: that much penetration is tolerated).
+        when closer than ``clearance`` [m] (negative: that much penetration is tolerated); the arm
+        and an object of the world (not the held one) when closer than ``object_clearance`` [m] if
+        that is larger (objects are where they were measured, a few cm off: a plan keeps away).
 
         Raises ``ValueError`` for an unknown arm, joint or object (listing the valid ones),
         ``NotImplementedError`` when this prospection does not support arm motion planning.

@@ -105,3 +105,25 @@ def wrap_angle(a: float) -> float:
 def yaw_to_quat(yaw: float) -> Quat:
     """Quaternion (w, x, y, z) of a rotation by `yaw` [rad] about z."""
     return (math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
+
+
+def matrix_to_quat(rotation: Any) -> Quat:
+    """The unit quaternion (w, x, y, z, with w >= 0) of a 3x3 rotation matrix (nested sequences or
+    an array; Shepperd's method)."""
+    m = [[float(rotation[i][j]) for j in range(3)] for i in range(3)]
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        q = (0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s)
+    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2])
+        q = ((m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s)
+    elif m[1][1] > m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2])
+        q = ((m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s)
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
+        q = ((m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s)
+    norm = math.sqrt(sum(v * v for v in q)) * (-1.0 if q[0] < 0.0 else 1.0)
+    w, x, y, z = (v / norm for v in q)
+    return (w, x, y, z)

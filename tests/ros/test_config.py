@@ -93,3 +93,21 @@ def test_bridge_cli_refuses_an_unknown_robot_and_a_remote_master(monkeypatch, ca
     monkeypatch.delenv("ROS_MASTER_URI")
     assert main(["sim-ros-bridge"]) == 2
     assert "ROS_MASTER_URI is not set" in " ".join(capsys.readouterr())
+
+
+def test_bridge_objects_and_base_pose_are_parsed_with_clear_errors():
+    from pycram.apps.cli.ros import _base_pose, object_items
+
+    cup, other, box = object_items(["cup@1.0,4.55", "cup@2,3", "cereal@4.1,1.8,0.9"])
+    assert (cup.name, cup.type, cup.position) == ("cup", "cup", (1.0, 4.55, None))  # on the surface there
+    assert other.name == "cup-2"
+    assert box.position == (4.1, 1.8, 0.9)
+    with pytest.raises(ValueError, match="TYPE one of .*cup"):
+        object_items(["teapot@1,2"])
+    with pytest.raises(ValueError, match="X,Y or X,Y,Z"):
+        object_items(["cup@1"])
+    with pytest.raises(ValueError, match="X,Y or X,Y,Z"):
+        object_items(["cup@1,nan"])
+    assert _base_pose("4.3,1.15,1.57") == (4.3, 1.15, 1.57)
+    with pytest.raises(ValueError, match="X,Y,YAW"):
+        _base_pose("4.3,1.15")

@@ -292,10 +292,12 @@ def test_a_standing_pose_that_cannot_be_reached_gives_way_to_the_next():
         assert [d.status.get_value().value for d in drives] == ["failed", "succeeded"]
 
 
-def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
+def test_an_arm_blocked_on_its_way_up_to_drive_gets_up_all_the_same():
     """Where the TIAGo stands to push the cupboard shut, the arm's way up to ``carry_top`` meets
-    the cupboard: the arm going up before a pick-up's drive backs the base away first (the
-    faulted set-table run of seed 14 failed to pick up the bowl after closing the cupboard)."""
+    the cupboard's open door, which the robot has not seen: the first try is blocked (it then
+    looks, and the door is in its belief). The arm going up before a pick-up's drive gets there
+    all the same: planned round the door now known, or after backing the base away (the faulted
+    set-table run of seed 14 failed to pick up the bowl after closing the cupboard)."""
     from pycram.actions.pick_up import _arm_to_drive
     from pycram.robots.tiago.description import ARM_CONFIGURATIONS
 
@@ -306,8 +308,6 @@ def test_an_arm_blocked_on_its_way_up_to_drive_backs_the_base_away_first():
             perform(MotionDesignator(type="setting_arm_configuration", arm="right", configuration="carry_top"))
         perform(ParkArms())
         run_as_task(lambda: _arm_to_drive("right", "carry_top"))
-        base = world.base_pose.get_value()
-        assert math.hypot(base.x - near_cupboard[0], base.y - near_cupboard[1]) > 0.2  # backed away
         joints = world.joint_states.get_value().position
         up = [joints[f"arm_{i}_joint"] for i in range(1, 8)]
         assert max(abs(a - b) for a, b in zip(up, ARM_CONFIGURATIONS["right"]["carry_top"], strict=True)) < 0.05

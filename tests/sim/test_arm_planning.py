@@ -4,9 +4,10 @@ again after an unexpected contact.
 
 The PR2 stands at the apartment's dining table, a thin box ("wall") on the table in front of
 it; the right arm moves its tool from one side of the wall to the other, where the straight
-joint-space line goes through the wall (checked in prospection). Prospection here is the
-simulation's true state (``world.prospection()``): what is tested is planning and monitoring,
-not perception (the robot would know the box only once perceived).
+joint-space line goes through the wall (checked in prospection). Prospection in the first tests
+is the simulation's true state (``world.prospection()``): what is tested is planning and
+monitoring; the last one is the robot's own, from its belief: the box is unknown until the arm
+hits it and the robot looks.
 """
 
 from __future__ import annotations
@@ -88,8 +89,9 @@ def test_a_planned_motion_goes_around_a_box_the_straight_line_would_hit():
             reached = perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
         assert math.dist(reached.position, GOAL) < 0.01
         planner = _planner(robot)
-        (plan,) = planner.last_plans
+        *refused, plan = planner.last_plans  # refused: keeping 3 cm from the box (the start is closer)
         assert plan and plan.planner == "RRTConnect" and len(plan.path) >= 3
+        assert all(not p and p.reason == "start_in_collision" for p in refused)
         assert planner.last_stops == []  # executed without an unexpected contact
         after = _wall(world)
         assert math.dist(after.position, before.position) < 0.002  # untouched
@@ -128,6 +130,49 @@ def test_a_box_put_in_the_way_after_planning_is_hit_softly_detected_and_planned_
         wall = _wall(world)
         assert math.dist(wall.position[:2], WALL[:2]) < 0.03
         w, x, y, z = wall.orientation
+        assert math.acos(min(1.0, 1.0 - 2.0 * (x * x + y * y))) < math.radians(10)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_a_box_nobody_saw_is_hit_softly_looked_at_and_planned_around_in_the_believed_world():
+    """As the robot plans by default: in its believed world, where a cereal box put in the arm's
+    way is unknown until the arm hits it; the arm stops, the head looks, the box goes into the
+    belief, the motion is planned around it. (A cereal box, not the thin "wall": perception
+    measures an untyped box's size along the camera's axes, and seen obliquely the 6-cm wall was
+    believed 16-19 cm thick, with the arm's start inside it.)"""
+    from pycram import robots
+    from pycram.designator import MotionDesignator, perform
+    from pycram.sim import World
+
+    world = World("pr2", objects=["cereal"], environment="apartment", base_pose=BASE, seed=1)
+    box = (WALL[0], WALL[1], TABLE + 0.14 + 0.002)
+    ok(world.move_item("cereal", AWAY[:2] + (box[2],)))  # out of the way, unseen
+    robot = robots.load("pr2", world)  # planned arm motions, prospection from the belief
+    try:
+        truth = world.prospection()  # only to find the arm's joint goals
+        base = world.base_pose.get_value()
+        start, goal = (
+            list(truth.solve_ik(ARM, (p, FORWARD), base, avoid_collisions=False).positions) for p in (START, GOAL)
+        )
+        assert robot.belief.objects() == []  # nobody has looked
+        with robot:
+            perform(MotionDesignator(type="setting_arm_joints", arm=ARM, positions=start))
+            ok(world.move_item("cereal", box))  # where the arm goes next; nobody sees it
+            planner = _planner(robot)
+            perform(MotionDesignator(type="setting_arm_joints", arm=ARM, positions=goal))
+        reached = world.joint_states.get_value().position
+        joints = robot.description.ARMS[ARM]["joints"]
+        assert max(abs(reached[j] - q) for j, q in zip(joints, goal, strict=True)) < 0.02
+        (stop,) = planner.last_stops
+        assert stop.reason == "collision" and "cereal" in stop.message
+        assert planner.last_plans[-1].planner == "RRTConnect"  # around the box, seen now
+        seen = [o for o in robot.belief.objects() if not o.gone]
+        assert [o.type for o in seen] == ["cereal"] and math.dist(seen[0].pose[:2], box[:2]) < 0.05
+        after = world.item_poses.get_value()["cereal"]  # a soft hit: pushed a few cm at most, standing
+        assert math.dist(after.position[:2], box[:2]) < 0.03
+        w, x, y, z = after.orientation
         assert math.acos(min(1.0, 1.0 - 2.0 * (x * x + y * y))) < math.radians(10)
     finally:
         robot.shutdown()

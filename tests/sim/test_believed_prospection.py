@@ -129,3 +129,35 @@ def test_proxies_nobody_stands_for_are_parked_far_below_the_floor(apartment):
             assert tuple(qpos[adr : adr + 3]) == pytest.approx((2.0, 2.0, 1.0))
         else:
             assert qpos[adr + 2] < -10.0 and tuple(qpos[adr + 3 : adr + 7]) == (1.0, 0.0, 0.0, 0.0)
+
+
+def test_a_believed_world_needs_no_simulator_only_the_robots_sensed_joints(apartment):
+    """Built from the robot's name, the environment's description, the belief and the joints by
+    name and base pose (what a robot over ROS has), it is the believed world of the simulation's
+    own robot: the same state, the same answers."""
+    from pycram.backends.sim.believed_world import BelievedWorld, SensedRobot
+    from pycram.backends.sim.prospection import SimProspection
+
+    belief, p = _believing(apartment)
+    belief.add(PerceivedObject("cup-1", "cup", (2.0, 2.0, 1.0)))
+    belief.update(PerceptionReport(1.0, (), None, {"drawer 2": 0.2}))
+
+    def sensed() -> SensedRobot:
+        joints = apartment.joint_states.get_value()
+        base = apartment.base_pose.get_value()
+        return SensedRobot(joints.stamp, {**joints.position, "a joint it does not have": 1.0}, base)
+
+    believed = BelievedWorld(apartment.robot, apartment.environment, belief, sensed)
+    q = SimProspection(believed.scene, believed.snapshot, believed=believed)
+    ours, theirs = believed.snapshot().qpos, p.believed.snapshot().qpos
+    assert ours == pytest.approx(theirs, abs=1e-9)
+    tool = believed.tool_poses()[ARM].position
+    assert tool == pytest.approx(apartment.tool_poses.get_value()[ARM].position, abs=1e-6)
+    base = apartment.base_pose.get_value()
+    assert q.in_collision(base) == p.in_collision(base)
+    robot, environment = apartment.robot, apartment.environment
+    broken = BelievedWorld(robot, environment, belief, lambda: SensedRobot(0.0, {"x": math.nan}))
+    broken.snapshot()  # a joint it does not have: ignored
+    broken = BelievedWorld(robot, environment, belief, lambda: SensedRobot(0.0, {"base_x": math.nan}))
+    with pytest.raises(ValueError, match="'base_x' at nan: not a finite position"):
+        broken.snapshot()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 
 import typer
@@ -11,14 +12,71 @@ from pycram.apps.cli.app import (
     app,
     fail,
 )
+from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_NAMES
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
+
+
+def object_items(values: list[str]) -> list:
+    """The simulator items of ``--object`` values ``TYPE@X,Y`` or ``TYPE@X,Y,Z`` [m, map]: objects
+    of known types (:data:`pycram.world.objects.OBJECT_TYPES`), named by their type (``cup``,
+    ``cup-2``, ...); ``ValueError`` saying what is wrong with a value."""
+    from pycram.backends.sim.items import ItemSpec
+    from pycram.world.objects import OBJECT_TYPES
+
+    items, counts = [], dict[str, int]()
+    for value in values:
+        type_name, at, where = value.partition("@")
+        if not at or type_name not in OBJECT_TYPES:
+            types = ", ".join(sorted(OBJECT_TYPES))
+            raise ValueError(f"--object {value!r}: give TYPE@X,Y or TYPE@X,Y,Z [m] with TYPE one of {types}")
+        try:
+            numbers = [float(v) for v in where.split(",")]
+        except ValueError:
+            numbers = []
+        if len(numbers) not in (2, 3) or not all(math.isfinite(v) for v in numbers):
+            raise ValueError(f"--object {value!r}: the place is X,Y or X,Y,Z in [m], got {where!r}")
+        counts[type_name] = counts.get(type_name, 0) + 1
+        name = type_name if counts[type_name] == 1 else f"{type_name}-{counts[type_name]}"
+        z = numbers[2] if len(numbers) == 3 else None
+        items.append(ItemSpec.of(OBJECT_TYPES[type_name], name, (numbers[0], numbers[1], z)))
+    return items
+
+
+def _base_pose(value: str) -> tuple[float, float, float]:
+    """``X,Y,YAW`` [m, m, rad] as numbers; ``ValueError`` saying what is wrong."""
+    try:
+        x, y, yaw = (float(v) for v in value.split(","))
+    except ValueError:
+        raise ValueError(f"--base-pose is X,Y,YAW in [m, m, rad], got {value!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, yaw)):
+        raise ValueError(f"--base-pose must be finite, got {value!r}")
+    return (x, y, yaw)
 
 
 @app.command("sim-ros-bridge")
 def sim_ros_bridge_command(
     robot: str = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP),
-    item_at: int = typer.Option(
-        1, "--item-at", min=0, max=3, help="Where the demo's mug starts: position 1, 2 or 3 (0: no item)."
+    item_at: int | None = typer.Option(
+        None,
+        "--item-at",
+        min=0,
+        max=3,
+        help="Thesis kitchen: where the demo's mug starts, position 1, 2 or 3 (0: no item; default 1).",
+    ),
+    environment: str = typer.Option(
+        DEFAULT_ENVIRONMENT, "--environment", help=f"The environment: {', '.join(ENVIRONMENT_NAMES)}."
+    ),
+    base_pose: str | None = typer.Option(
+        None,
+        "--base-pose",
+        help="Where the robot starts: X,Y,YAW (m, m, rad, map frame); default: the environment's start "
+        "(the thesis kitchen: the demo's).",
+    ),
+    objects: list[str] | None = typer.Option(
+        None,
+        "--object",
+        help="An object of a known type standing upright at x, y (m, map frame) on the highest surface there, "
+        "or with its centre at x, y, z: TYPE@X,Y or TYPE@X,Y,Z (repeatable; named TYPE, TYPE-2, ...).",
     ),
     realtime: bool = typer.Option(
         False,
@@ -56,6 +114,15 @@ def sim_ros_bridge_command(
     would. Needs ROS_MASTER_URI."""
     if robot not in robot_names():
         fail(f"--robot must be {robot_choices()}, not {robot!r}", code=2)
+    if environment not in ENVIRONMENT_NAMES:
+        fail(f"--environment must be one of {', '.join(ENVIRONMENT_NAMES)}, not {environment!r}", code=2)
+    if item_at is not None and item_at != 0 and environment != DEFAULT_ENVIRONMENT:
+        fail(f"--item-at places the demo's mug in the {DEFAULT_ENVIRONMENT}; use --object in the {environment}", code=2)
+    try:
+        placed = object_items(objects or [])
+        start = None if base_pose is None else _base_pose(base_pose)
+    except ValueError as e:
+        fail(str(e), code=2)
     try:
         from pycram.backends.ros.launch import check_master_uri
     except ImportError as e:
@@ -70,10 +137,12 @@ def sim_ros_bridge_command(
     from pycram.backends.sim.perception import PerceptionFaults
     from pycram.backends.sim.ros_bridge import run_bridge
 
+    kitchen = environment == DEFAULT_ENVIRONMENT
     run_bridge(
         robot,
-        demo_items(item_at),
-        START_POSE,
+        (demo_items(1 if item_at is None else item_at) if kitchen else []) + placed,
+        start if start is not None or not kitchen else START_POSE,
+        environment=environment,
         realtime=realtime,
         publish_rate=publish_rate,
         perception_faults=PerceptionFaults(pose_noise, miss_probability, wrong_color_probability, perception_seed),

@@ -6,4 +6,7 @@ simulator's truth), its driver (running the plan under time limits) and, for `py
 terminal display; the plan itself is a module of its own that knows nothing of the simulator.
 
 - `pycram.apps.scenarios.set_table`: setting the breakfast table in the apartment (issue 17).
+
+`pycram.apps.scenarios.reachability` is a scene-generation filter scenarios and benchmarks share:
+where some standing pose of a robot grasps an object, or places one on a target.
 """

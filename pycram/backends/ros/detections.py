@@ -22,29 +22,14 @@ from typing import Any
 import numpy as np
 
 from pycram.world.belief import CameraView, Detection, PerceptionReport
+from pycram.world.types import matrix_to_quat
 
 __all__ = ["detections_message", "report_of", "quaternion_of", "rotation_of"]
 
 
 def quaternion_of(rotation: Any) -> tuple[float, float, float, float]:
     """The unit quaternion (w, x, y, z) of a 3x3 rotation matrix (Shepperd's method)."""
-    m = np.asarray(rotation, float).reshape(3, 3)
-    trace = float(m[0, 0] + m[1, 1] + m[2, 2])
-    if trace > 0.0:
-        s = 2.0 * math.sqrt(trace + 1.0)
-        q = (0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s)
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = ((m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s)
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        q = ((m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s)
-    else:
-        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        q = ((m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s)
-    norm = math.sqrt(sum(float(v) * float(v) for v in q))
-    w, x, y, z = (float(v) / norm for v in q)
-    return (w, x, y, z)
+    return matrix_to_quat(np.asarray(rotation, float).reshape(3, 3))
 
 
 def rotation_of(w: float, x: float, y: float, z: float) -> np.ndarray:

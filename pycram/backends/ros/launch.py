@@ -162,19 +162,23 @@ class RosMaster:
 class BridgeProcess:
     """``python -m pycram sim-ros-bridge --robot ROBOT`` on the master at ``master_uri``.
 
-    Returns from the constructor once the bridge printed that it serves (within
-    ``startup_timeout`` [s, wall]). :meth:`kill` ends it abruptly (SIGKILL, as a crash would);
-    :meth:`stop` ends it cleanly.
+    ``item_at``: where the demo's mug starts in the thesis kitchen (``--item-at``; None: not
+    given); ``environment``: another environment (``--environment``) with ``objects``
+    (``--object`` values, ``TYPE@X,Y`` or ``TYPE@X,Y,Z`` [m]). Returns from the constructor once
+    the bridge printed that it serves (within ``startup_timeout`` [s, wall]). :meth:`kill` ends
+    it abruptly (SIGKILL, as a crash would); :meth:`stop` ends it cleanly.
     """
 
     def __init__(
         self,
         robot: str,
         master_uri: str,
-        item_at: int = 1,
+        item_at: int | None = 1,
         realtime: bool = False,
         startup_timeout: float = 60.0,
         extra_args: tuple[str, ...] = (),
+        environment: str | None = None,
+        objects: tuple[str, ...] = (),
     ) -> None:
         self.robot, self.master_uri = robot, master_uri
         self.log_dir = tempfile.mkdtemp(prefix="pycram-bridge-")
@@ -187,8 +191,9 @@ class BridgeProcess:
             "sim-ros-bridge",
             "--robot",
             robot,
-            "--item-at",
-            str(item_at),
+            *(["--item-at", str(item_at)] if item_at is not None else []),
+            *(["--environment", environment] if environment is not None else []),
+            *[arg for value in objects for arg in ("--object", value)],
             *(["--realtime"] if realtime else []),
             *extra_args,
         ]

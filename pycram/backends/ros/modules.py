@@ -32,6 +32,7 @@ import logging
 import math
 import threading
 import time
+from collections.abc import Sequence
 from typing import Any
 
 from pycram.backends.ros.config import RosRobotConfig
@@ -58,6 +59,7 @@ from pycram.world.types import Pose, Pose2D
 
 __all__ = [
     "MessageCounter",
+    "path_goal",
     "RosRobotState",
     "RosProcessModule",
     "RosNavigationModule",
@@ -114,7 +116,9 @@ class RosRobotState:
     """The robot's sensors over ROS, as fluents (thesis: ``subscribe_pose``/``subscribe_gripper``).
 
     ``base_pose`` (``Pose2D``, map frame, from the pose topic), ``joint_states`` (``{name:
-    position}``), ``gripper_openings[g]`` [m] (sum of the gripper's opening joints). Each is set
+    position}`` [rad or m]), ``joint_velocities`` (``{name: velocity}`` [rad/s or m/s]; empty
+    when the robot publishes no velocities), ``gripper_openings[g]`` [m] (sum of the gripper's
+    opening joints). Each is set
     in the middleware's thread at the topic's rate. Also serves as the "world" the motion
     resolvers read the base pose from. ``stamp`` is the (ROS) time [s] of the newest sensor
     instant taken in: the older of the latest pose and joint-state stamps.
@@ -139,6 +143,7 @@ class RosRobotState:
         self.environment = load_environment(config.environment)
         self.base_pose = Fluent(None, name="base_pose")
         self.joint_states = Fluent(None, name="joint_states")
+        self.joint_velocities = Fluent(None, name="joint_velocities")
         self.gripper_openings = {g: Fluent(None, name=f"{g}_gripper_opening") for g in config.grippers}
         self._ready = threading.Event()
         self.pose_updates = MessageCounter()  #: base-pose messages received
@@ -207,6 +212,8 @@ class RosRobotState:
 
     def _on_joints(self, message: Any) -> None:
         positions = dict(zip(message.name, message.position))
+        velocities = dict(zip(message.name, message.velocity)) if len(message.velocity) == len(message.name) else {}
+        self.joint_velocities.set_value(velocities)  # first: a waiter on the positions sees both
         self.joint_states.set_value(positions)
         for name, gripper in self.config.grippers.items():
             if all(j in positions for j in gripper.opening_joints):
@@ -406,14 +413,36 @@ class RosTorsoModule(RosProcessModule):
 
 
 def _trajectory_goal(transport: Transport, joints: tuple[str, ...], positions: tuple[float, ...]) -> Any:
+    """A one-point trajectory to ``positions`` (the controller interpolates from where it is)."""
+    return path_goal(transport, joints, [(ARM_MOTION_DURATION, positions)])
+
+
+def path_goal(transport: Transport, joints: Sequence[str], samples: Sequence[tuple[float, Sequence[float]]]) -> Any:
+    """A ``control_msgs/FollowJointTrajectoryGoal`` through ``samples``: (time from start [s],
+    positions [rad or m] in the order of ``joints``) pairs, times increasing, e.g. a planned
+    path's :func:`pycram.reasoning.motion.time_parameterize` samples. Velocities are left for
+    the controller to interpolate except at the last point (0: the path ends at rest).
+    ``ValueError`` for no samples, positions of the wrong length, non-finite values or times
+    that do not increase."""
+    joints = list(joints)
+    if not samples:
+        raise ValueError("a joint trajectory needs at least one sample")
     m = transport.message
-    point = m(
-        "trajectory_msgs/JointTrajectoryPoint",
-        positions=list(positions),
-        velocities=[0.0] * len(positions),
-        time_from_start=transport.duration(ARM_MOTION_DURATION),
-    )
-    trajectory = m("trajectory_msgs/JointTrajectory", joint_names=list(joints), points=[point])
+    points, last = [], -math.inf
+    for k, (t, positions) in enumerate(samples):
+        values = [float(v) for v in positions]
+        if len(values) != len(joints):
+            raise ValueError(f"sample {k}: {len(values)} positions for the {len(joints)} joints {joints}")
+        if not (math.isfinite(float(t)) and all(math.isfinite(v) for v in values)):
+            raise ValueError(f"sample {k}: time and positions must be finite, got t={t!r}, {values}")
+        if float(t) <= last:
+            raise ValueError(f"sample {k}: times must increase, got {t!r} after {last!r} [s]")
+        last = float(t)
+        fields: dict[str, Any] = {"positions": values, "time_from_start": transport.duration(float(t))}
+        if k == len(samples) - 1:
+            fields["velocities"] = [0.0] * len(values)
+        points.append(m("trajectory_msgs/JointTrajectoryPoint", **fields))
+    trajectory = m("trajectory_msgs/JointTrajectory", joint_names=joints, points=points)
     return m("control_msgs/FollowJointTrajectoryGoal", trajectory=trajectory)
 
 
@@ -452,6 +481,30 @@ class RosArmModule(RosProcessModule):
         if cmd == "reach":
             return self._reach(solution)
         check_command(self, solution, "move_arm", "reach")
+
+    def follow_path(
+        self,
+        joints: Sequence[str],
+        samples: Sequence[tuple[float, Sequence[float]]],
+        what: str,
+        timeout: float,
+    ) -> tuple[float, ...]:
+        """Send the timed joint path ``samples`` ((t [s] from 0, positions in the order of
+        ``joints``), see :func:`path_goal`) as one FollowJointTrajectory goal on this arm's
+        trajectory action and wait for it (evaporably, at most ``timeout`` [s, active clock]).
+        Returns the last sample's positions; raises :class:`RosMotionFailed` with the robot's
+        reason (the simulator bridge: ``'collision'``, ``'blocked'``, ...). Called from within
+        this module's execution (a planned motion)."""
+        unknown = sorted(set(joints) - set(self.interface.joint_names))
+        if unknown:
+            raise ValueError(
+                f"the {self.arm} arm has no joints {unknown}; its joints: {list(self.interface.joint_names)}"
+            )
+        goal = path_goal(self.transport, joints, samples)
+        self._run_goal(
+            self.interface.trajectory_action, "control_msgs/FollowJointTrajectory", goal, what, timeout=timeout
+        )
+        return tuple(float(v) for v in samples[-1][1])
 
     def _reach(self, solution: dict) -> Pose:
         m = self.transport.message

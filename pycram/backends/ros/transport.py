@@ -52,7 +52,8 @@ class RosMotionFailed(MotionFailure):
     ``reason`` (the robot's reason -- for the simulator bridge the simulator's outcome reason:
     ``'collision'``, ``'blocked'``, ``'unreachable'``, ``'timeout'``, ``'cancelled'`` ... --,
     otherwise the goal status: ``'aborted'``, ``'rejected'``, ``'preempted'``, ``'lost'``,
-    ``'unavailable'``), ``outcome`` (the :class:`GoalOutcome`, if any).
+    ``'unavailable'``), ``message`` (the robot's explanation), ``outcome`` (the
+    :class:`GoalOutcome`, if any).
     """
 
     def __init__(
@@ -60,7 +61,7 @@ class RosMotionFailed(MotionFailure):
     ) -> None:
         where = f" (action {action})" if action else ""
         super().__init__(f"{command} failed{where}: {reason}: {message}")
-        self.command, self.reason, self.action, self.outcome = command, reason, action, outcome
+        self.command, self.reason, self.message, self.action, self.outcome = command, reason, message, action, outcome
 
 
 class ActionServerUnavailable(RosMotionFailed):

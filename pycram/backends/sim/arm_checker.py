@@ -149,11 +149,14 @@ def configure_filter(
     moving_objects: np.ndarray,
     self_groups: Sequence[SelfGroup] | None,
     clearance: float,
+    objects: np.ndarray | None = None,
+    object_clearance: float = 0.0,
 ) -> None:
     """Rewrite the collision filter of ``model`` (a planning copy) for ``parts``: the arm (and the
     geoms of ``moving_objects``, a held object) against obstacles and, given ``self_groups``
     (:func:`self_collision_groups`), the robot's other parts; the torso-moved rest against
-    obstacles; nothing else."""
+    obstacles; nothing else. Contacts are found within ``clearance`` [m] of the arm, and within
+    ``object_clearance`` of the geoms of ``objects`` (a mask) if that is larger."""
     arm = parts.arm | moving_objects
     obstacles = parts.obstacles & ~moving_objects
     contype = np.zeros(model.ngeom, np.int32)
@@ -169,6 +172,8 @@ def configure_filter(
     model.geom_conaffinity[:] = conaffinity
     margin = np.zeros(model.ngeom)
     margin[arm | parts.upper] = max(clearance, 0.0)
+    if objects is not None:
+        margin[objects] = max(clearance, object_clearance, 0.0)
     model.geom_margin[:] = margin
     body_contype = np.zeros(model.nbody, np.int32)
     body_conaffinity = np.zeros(model.nbody, np.int32)
@@ -248,7 +253,7 @@ class SimConfigurationChecker(ConfigurationChecker):
         data: mujoco.MjData,
         parts: ArmBodies,
         ignore: np.ndarray,
-        clearance: float,
+        clearance: np.ndarray,
         held: tuple[int, np.ndarray, np.ndarray] | None,
         geom_name: Callable[[int], str],
         release: Callable[[], None],
@@ -258,7 +263,7 @@ class SimConfigurationChecker(ConfigurationChecker):
         self.checks = 0
         self._qadr = parts.qadr
         self._ignore = ignore
-        self._clearance = clearance
+        self._clearance = clearance  # per geom [m]: a pair is touching below the larger of its two
         self._held = held  # (qpos address of the free joint, position in the hand, quaternion in the hand)
         self._hand = parts.hand_body
         self._geom_name = geom_name
@@ -289,7 +294,8 @@ class SimConfigurationChecker(ConfigurationChecker):
     def _bad(self, n: int) -> np.ndarray:
         """Which of the first ``n`` contacts count as collisions."""
         geoms = self.data.contact.geom[:n]
-        return (self.data.contact.dist[:n] < self._clearance) & ~self._ignore[geoms[:, 0], geoms[:, 1]]
+        near = np.maximum(self._clearance[geoms[:, 0]], self._clearance[geoms[:, 1]])
+        return (self.data.contact.dist[:n] < near) & ~self._ignore[geoms[:, 0], geoms[:, 1]]
 
     def is_free(self, q: Sequence[float]) -> bool:
         n = self._collide(q)

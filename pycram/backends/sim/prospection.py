@@ -313,6 +313,18 @@ class SimProspection(Prospection):
             raise ValueError(f"unknown object {name!r}; known objects: {known}")
         return bid
 
+    def _object_geoms(self) -> np.ndarray:
+        """Mask of the geoms of objects (bodies with a free joint: items, believed objects)."""
+        mask = getattr(self, "_objects_mask", None)
+        if mask is None:
+            m = self.model
+            free = mujoco.mjtJoint.mjJNT_FREE
+            bodies = np.array(
+                [m.body_jntnum[b] == 1 and m.jnt_type[m.body_jntadr[b]] == free for b in range(m.nbody)], bool
+            )
+            mask = self._objects_mask = bodies[m.geom_bodyid]
+        return mask
+
     def configuration_checker(
         self,
         arm: str,
@@ -323,10 +335,13 @@ class SimProspection(Prospection):
         held_object: str | None = None,
         exempt_object: str | None = None,
         clearance: float = 0.0,
+        object_clearance: float = 0.0,
         self_collision: bool = True,
     ) -> ConfigurationChecker:
         if not math.isfinite(clearance):
             raise ValueError(f"clearance must be finite [m], got {clearance!r}")
+        if not math.isfinite(object_clearance):
+            raise ValueError(f"object_clearance must be finite [m], got {object_clearance!r}")
         parts, self_ignore, groups = self._arm_parts(arm, include_torso)
         m = self.model
         held_geoms = np.zeros(m.ngeom, bool)
@@ -358,7 +373,12 @@ class SimProspection(Prospection):
                 rel_pos, rel_quat = np.zeros(3), np.zeros(4)
                 mujoco.mju_mulPose(rel_pos, rel_quat, inv_pos, inv_quat, d.xpos[body], d.xquat[body])
                 held = (int(m.jnt_qposadr[m.body_jntadr[body]]), rel_pos, rel_quat)
-            configure_filter(planning, parts, held_geoms, groups if self_collision else None, clearance)
+            objects = self._object_geoms() & ~held_geoms
+            configure_filter(
+                planning, parts, held_geoms, groups if self_collision else None, clearance, objects, object_clearance
+            )
+            thresholds = np.full(m.ngeom, clearance)
+            thresholds[objects] = max(clearance, object_clearance)
             self._prepare(d, base_pose, joint_configuration)
         except BaseException:
             self._planning_pool.put((planning, d))
@@ -368,7 +388,7 @@ class SimProspection(Prospection):
             d,
             parts,
             ignore,
-            clearance,
+            thresholds,
             held,
             self._geom_name,
             lambda: self._planning_pool.put((planning, d)),
@@ -425,7 +445,7 @@ class SimProspection(Prospection):
                 else None
             )
             best = (math.inf, math.inf)
-            iterations = 0
+            iterations = colliding = 0
             collided: list[tuple[str, str]] = []
             try:
                 for seed in candidates:
@@ -454,6 +474,9 @@ class SimProspection(Prospection):
                         contacts = checker.contacts(q)
                         if contacts:
                             collided = collided or contacts
+                            colliding += 1
+                            if colliding >= MAX_COLLIDING_SOLUTIONS:
+                                break  # a goal in contact (a hand round a handle): the rest would touch too
                             continue
                     return IKResult(arm, a.joints, tuple(map(float, q)), pe, re, None, "", iterations)
             finally:

@@ -5,8 +5,12 @@ A ROS 1 node that runs a :class:`pycram.sim.World` and serves, under the names o
 
 * actions: ``move_base``, the head's PointHead, the torso's SingleJointPosition (PR2) or
   FollowJointTrajectory (TIAGo), each arm's FollowJointTrajectory and Reach, each gripper's
-  GripperCommand. One goal at a time per action: a new goal preempts the running one (the
-  simulator's command is replaced), a cancel request stops the part (base stopped, arm holding).
+  GripperCommand. An arm's trajectory of one point is a joint goal (``World.move_arm``); of
+  several, a timed path followed point by point by the monitored path controller
+  (``World.follow_arm_path``: a contact stops it with ``collision``, a lagging joint with
+  ``blocked``; see :meth:`SimRosBridge._follow_trajectory`). One goal at a time per action: a
+  new goal preempts the running one (the simulator's command is replaced), a cancel request
+  stops the part (base stopped, arm holding).
   A failed goal is aborted with the status text ``'<reason>: <message>'`` (the simulator's
   outcome reason: ``collision``, ``blocked``, ``unreachable``, ``timeout``, ``invalid`` ...);
   a malformed goal (wrong frame, unknown joints) is rejected with reason ``invalid``.
@@ -14,8 +18,9 @@ A ROS 1 node that runs a :class:`pycram.sim.World` and serves, under the names o
   real time): at every sensor publication of the world (``World.sensor_rate`` [Hz of simulated
   time], 50 Hz by default, and right after a command ended) the base pose (``/amcl_pose``, and
   as the tf transform map -> base_footprint on ``/tf``), ``/joint_states`` (gripper openings as
-  the configured opening joints), ``<sim_namespace>/items`` (simulator ground truth: where each
-  item is and which gripper holds it -- for judging runs, never for plans), and *then*
+  the configured opening joints; positions and velocities), ``<sim_namespace>/items``
+  (simulator ground truth: where each item is and which gripper holds it -- for judging runs,
+  never for plans), and *then*
   ``/clock`` (``rosgraph_msgs/Clock``) with the same simulated time: ROS time never runs ahead
   of the sensor messages already on their way. Every header stamp is simulated time.
   ``detections_topic``: what the head camera's object perception measures (type, centre, size,
@@ -216,7 +221,7 @@ class SimRosBridge:
                 _GoalServer(
                     interface.trajectory_action,
                     "control_msgs/FollowJointTrajectory",
-                    lambda goal, a=arm, j=interface.joint_names: w.move_arm(a, self._trajectory_end(goal, j)),
+                    lambda goal, a=arm, j=interface.joint_names: self._follow_trajectory(a, j, goal),
                     self._trajectory_result,
                 )
             )
@@ -326,10 +331,38 @@ class SimRosBridge:
         positions = dict(zip(names, goal.trajectory.points[-1].positions))
         return [float(positions[j]) for j in joints]
 
+    def _follow_trajectory(self, arm: str, joints: tuple[str, ...], goal: Any) -> Any:
+        """An arm's FollowJointTrajectory goal: one point -> the joint goal (``World.move_arm``:
+        interpolated from where the arm is); more -> the timed path through every point
+        (``World.follow_arm_path``: the simulated controller follows the points' positions at
+        their ``time_from_start``, from the arm's current positions at t = 0 when the first
+        point comes later; it stops the arm on a contact of the arm or of what its gripper holds
+        -- ``'collision'`` -- or on a joint lagging its reference -- ``'blocked'``). The object
+        being grasped cannot be named in a FollowJointTrajectory goal: only what the gripper
+        touches when the path starts is exempt from the contact monitoring."""
+        names = list(goal.trajectory.joint_names)
+        points = goal.trajectory.points
+        if sorted(names) != sorted(joints) or not points:
+            raise _Rejected(f"a trajectory for joints {list(joints)} with at least one point, got joints {names}")
+        if len(points) == 1:
+            return self.world.move_arm(arm, self._trajectory_end(goal, joints))
+        samples = [(p.time_from_start.to_sec(), [float(v) for v in p.positions]) for p in points]
+        if samples[0][0] > 0.0:
+            now = self.world.joint_states.get_value().position
+            samples.insert(0, (0.0, [float(now[j]) for j in names]))
+        return self.world.follow_arm_path(arm, names, samples)
+
     @staticmethod
     def _trajectory_result(outcome: Outcome) -> Any:
         cls = message_class("control_msgs/FollowJointTrajectoryResult")
-        code = cls.SUCCESSFUL if outcome.succeeded else cls.GOAL_TOLERANCE_VIOLATED
+        if outcome.succeeded:
+            code = cls.SUCCESSFUL
+        elif outcome.reason in ("collision", "blocked"):
+            code = cls.PATH_TOLERANCE_VIOLATED
+        elif outcome.reason == "invalid":
+            code = cls.INVALID_GOAL
+        else:
+            code = cls.GOAL_TOLERANCE_VIOLATED
         return cls(error_code=code, error_string="" if outcome.succeeded else outcome.message)
 
     def _reach(self, arm: str, goal: Any) -> Any:
@@ -483,7 +516,12 @@ class SimRosBridge:
             opening = instant.gripper_openings[gripper]
             for joint in interface.opening_joints:
                 positions[joint] = opening / len(interface.opening_joints)
-        joints = self._joints_cls(name=list(positions), position=list(positions.values()))
+        speeds = instant.joint_states.velocity
+        joints = self._joints_cls(
+            name=list(positions),
+            position=list(positions.values()),
+            velocity=[float(speeds.get(name, 0.0)) for name in positions],
+        )
         joints.header.stamp = stamp
         self._joints_pub.publish(joints)
         holders = {item: g for g, item in instant.holding.items()}
@@ -618,18 +656,22 @@ def _keep_wall_time() -> None:
 def run_bridge(
     robot: str,
     items: Sequence[ItemSpec],
-    base_pose: tuple[float, float, float],
+    base_pose: tuple[float, float, float] | None,
     realtime: bool = False,
     publish_rate: float = 50.0,
     detection_rate: float = 2.0,
     ready: Callable[[], None] | None = None,
     perception_faults: PerceptionFaults | None = None,
+    environment: str = "thesis-kitchen",
 ) -> None:
-    """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds the thesis kitchen with
-    ``robot`` at ``base_pose`` (x [m], y [m], yaw [rad]) and ``items`` (the demo's mug: see
-    ``pycram sim-ros-bridge``), the head camera's object perception with ``perception_faults``
-    (none by default). Initialises the ROS node ``sim_ros_bridge`` (on wall time: see
-    :func:`_keep_wall_time`) and sets ``/use_sim_time`` for every other node.
+    """Run the bridge until the node is shut down (SIGINT/SIGTERM): builds ``environment`` (an
+    environment's name, :mod:`pycram.environments`; the thesis kitchen by default) with ``robot``
+    at ``base_pose`` (x [m], y [m], yaw [rad]; None: the environment's start pose) and ``items``
+    (the demo's mug: see ``pycram sim-ros-bridge``), the head camera's object perception with
+    ``perception_faults`` (none by default), and serves it under the robot's default ROS
+    configuration with its ``environment`` set to ``environment``. Initialises the ROS node
+    ``sim_ros_bridge`` (on wall time: see :func:`_keep_wall_time`) and sets ``/use_sim_time``
+    for every other node.
 
     ``publish_rate``: sensor topics and ``/clock`` per second of *simulated* time [Hz] (the
     world's ``sensor_rate``); ``detection_rate``: looks of the head camera per second of
@@ -640,13 +682,14 @@ def run_bridge(
 
     if publish_rate <= 0:
         raise ValueError(f"publish_rate must be > 0 [Hz of simulated time], not {publish_rate!r}")
-    config = robot_config(robot)
+    config = robot_config(robot).replace(environment=environment)
     rospy.init_node("sim_ros_bridge", disable_signals=False)
     _keep_wall_time()
     world = World(
         robot,
         list(items),
-        base_pose=cast(Vec3, tuple(base_pose)),
+        environment=environment,
+        base_pose=None if base_pose is None else cast(Vec3, tuple(base_pose)),
         realtime=realtime,
         sensor_rate=publish_rate,
         perception_faults=perception_faults,

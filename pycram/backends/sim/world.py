@@ -514,7 +514,7 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         from .believed_world import BelievedWorld
         from .prospection import SimProspection
 
-        believed = BelievedWorld(self.scene, belief, lambda: self._state)  # compiles outside the lock
+        believed = BelievedWorld.of_simulation(self.scene, belief, lambda: self._state)  # compiles outside the lock
         with self._lock:
             for known, prospection in self._believed_prospections:
                 if known is belief:

@@ -7,6 +7,12 @@ collision; each names the arm and grasp found. Layers: occupancy (with open draw
 a reach ring around the target, facing the furniture squarely, and the grasps that fit the
 heading. A target in a drawer is grasped over its walls (`RIM_CLEARANCE`); when nothing works
 with the torso as it is, higher named torso heights are tried.
+
+The grasps are the object type's (`pycram.world.objects.Grasp`), extended by grasps planned
+from the object's measured shape and pose (`pycram.reasoning.grasps`) where the type's do not
+cover it: an object lying on its side (planned grasps only), an upright box turned far from
+square to its furniture. A planned grasp is validated with the base facing the object and the
+tool turned to the grasp; its solution carries it (`BaseLocation.grasp_candidate`).
 """
 
 from __future__ import annotations
@@ -21,6 +27,16 @@ from typing import Any
 import numpy as np
 
 from pycram.designators.core import NoSolutionError
+from pycram.reasoning.grasps import (
+    MAX_TURN,
+    TURN_SCALE,
+    GraspOption,
+    GripperGeometry,
+    ObjectPose,
+    grasp_candidates,
+    grasp_options,
+)
+from pycram.reasoning.grasps import TOP_PENALTY as GRASP_TOP_PENALTY
 from pycram.world.environment import FURNITURE_TOPS, Container, Environment
 from pycram.world.objects import Grasp
 
@@ -28,10 +44,10 @@ from .costmap import Costmap, FloorGrid, angle_difference, ring_layer
 from .grasps import PHASES, grasp_sequence
 from .search import _ranked, _Tally
 from .solutions import BaseLocation
-from .standing import REACH_INSIDE, REACH_OUTSIDE, REACH_SIGMA, StandingSearch, _wrap
+from .standing import FACING_SCALE, REACH_INSIDE, REACH_OUTSIDE, REACH_SIGMA, StandingSearch, _wrap
 from .targets import Target
 
-__all__ = ["ReachVocabulary", "APPROACH_TOLERANCE", "RIM_CLEARANCE", "TOP_PENALTY"]
+__all__ = ["ReachVocabulary", "APPROACH_TOLERANCE", "RIM_CLEARANCE", "TOP_PENALTY", "RANK_SLACK", "COVERED_TURN"]
 
 #: A grasp's approach may deviate this much [rad] from the base heading.
 APPROACH_TOLERANCE = 0.45
@@ -40,6 +56,14 @@ APPROACH_TOLERANCE = 0.45
 RIM_CLEARANCE = 0.04
 #: Rank of a top grasp among horizontal ones (as if it deviated this much [rad]).
 TOP_PENALTY = 0.3
+#: An upright object's directional grasps of its type cover its pose while they fit a base
+#: heading turned at most this much [rad] from facing its furniture squarely (the facing layer's
+#: cost scale, `FACING_SCALE`: the types' grasps pick up the cereal box turned 30 deg,
+#: `tests/sim/test_actions.py`); beyond, planned grasps (`pycram.reasoning.grasps`) compete.
+COVERED_TURN = FACING_SCALE
+#: A cell is validated with the planned grasps (`pycram.reasoning.grasps`) ranked at most this
+#: much worse than the best grasp its cost counts (one `TURN_SCALE` of the tool's turn).
+RANK_SLACK = 1.0
 #: Approach side in the object's frame -> angle [rad] of that side.
 _SIDE_ANGLE = {"+x": 0.0, "-x": math.pi, "+y": math.pi / 2, "-y": -math.pi / 2}
 _POINT_GRASP = Grasp("side", 0.07, 0.0)
@@ -58,7 +82,13 @@ class ReachVocabulary(StandingSearch):
         grasps = self._grasps(target, desig.prop_value("grasp"))
         env = self.environment()
         drawer = self._drawer_around(target)
-        if drawer is not None:
+        pose = _object_pose(target)
+        # the tables' grasps are for objects standing upright: one lying on its side is grasped
+        # with planned grasps only
+        lying = pose is not None and not pose.is_upright and desig.prop_value("grasp") is None
+        if lying:
+            grasps = []
+        elif drawer is not None:
             grasps = self._over_the_rim(desig, target, grasps, drawer)
         elif desig.prop_value("grasp") is None:  # out in the open, a cup is taken by its side
             grasps = [g for g in grasps if not _body_from_the_top(g)] or grasps
@@ -66,6 +96,13 @@ class ReachVocabulary(StandingSearch):
         # the base may come closer to an open drawer than to the furniture
         occupancy = self._occupancy_with_drawers(env, grid, self._open_drawers(env), self._open_doors(env))
         facing = self._facing_yaws(env, target)
+        planned = self._planned_options(desig, target, pose, grasps, facing, drawer, action, arms)
+        if lying and not any(planned.values()):
+            raise self._fail(
+                desig,
+                f"{target.describe()} lies on its side and no planned grasp fits it (the grasps of its "
+                f"type are for it standing upright; see pycram.reasoning.grasps)",
+            )
         streams = []
         maps = {}
         for arm in arms:
@@ -78,7 +115,10 @@ class ReachVocabulary(StandingSearch):
             )
             if facing:
                 costmap.add("facing", self._facing_layer(yaw, facing))
-            costmap.add("grasp", self._grasp_layer(yaw, grasps, target))
+            layer = self._grasp_layer(yaw, grasps, target)
+            if planned[arm]:
+                layer = np.minimum(layer, _planned_layer(grid, yaw, planned[arm], self.geometry.reach_points[arm][1]))
+            costmap.add("grasp", layer)
             maps[arm] = costmap
             streams.append(_ranked(costmap, arms.index(arm), arm))
         self.last_costmaps = maps
@@ -97,21 +137,37 @@ class ReachVocabulary(StandingSearch):
             tucked = dict(self.geometry.tucked)
             raised = self.geometry.raised(arm)
 
-            options = []  # (grasp, base yaw, tool point, tool heading)
+            # (rank, grasp, base yaw, tool point, tool heading, planned candidate or None)
+            options: list[tuple[float, Grasp, float, tuple[float, float, float], float, Any]] = []
             for grasp, heading in self._grasp_options(grasps, target, natural):
                 yaw = natural if grasp.approach in ("side", "top") else _wrap(heading)
+                rank = _table_rank(grasp, heading, natural)
                 if grasp.approach != "top":
-                    options.append((grasp, yaw, self._grasp_point(target, grasp, yaw), yaw))
+                    options.append((rank, grasp, yaw, self._grasp_point(target, grasp, yaw), yaw, None))
                     continue
                 point, tool_heading = self._top_grasp(target, grasp, x, y)
-                options.append((grasp, yaw, point, tool_heading))
+                options.append((rank, grasp, yaw, point, tool_heading, None))
                 if grasp.radius == 0.0 and grasp.across != "radial":
                     # across an axis: the gripper turned half round grasps alike
-                    options.append((grasp, yaw, point, _wrap(tool_heading + math.pi)))
+                    options.append((rank, grasp, yaw, point, _wrap(tool_heading + math.pi), None))
+            if planned[arm] and pose is not None:
+                # planned grasps: the base faces the object, the tool turns to the grasp
+                left = self.geometry.reach_points[arm][1]
+                root = (x - left * math.sin(natural), y + left * math.cos(natural))  # the shoulder
+                gripper = self._gripper(arm)
+                for planned_grasp in grasp_candidates(pose, gripper, (x, y, natural), planned[arm], arm_root=root):
+                    g = planned_grasp
+                    options.append((g.score, g.grasp, natural, g.point, g.heading, g))
+                options.sort(key=lambda o: o[0])  # stable: the tables' grasps first on a tie
+                # the cell was ranked for its best grasp: one much worse is tried from the cells
+                # ranked for it (a left arm reaching across in front of a box to grasp its right
+                # side knocked it over, where the right arm coming from that side was ranked)
+                best = float(maps[arm].layers["grasp"][r, c])
+                options = [o for o in options if o[5] is None or o[0] <= best + RANK_SLACK]
 
             def sequences(configuration: dict[str, float]) -> tuple[BaseLocation | None, tuple[str, str | None]]:
                 failure: tuple[str, str | None] = ("no fitting grasp", None)
-                for grasp, yaw, point, heading in options:
+                for _, grasp, yaw, point, heading, candidate in options:
                     poses = grasp_sequence(self.geometry, point, heading, grasp.approach, action)
                     if drawer is not None:
                         poses = self._clear_of_the_rim(poses, grasp, drawer.rim_height, action)
@@ -123,7 +179,17 @@ class ReachVocabulary(StandingSearch):
                     if answer:
                         joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
                         tool = tuple(p for i, p in enumerate(poses) if not (margin and i == 2))
-                        location = BaseLocation(x, y, yaw, arm, grasp.approach, cost, joints=joints, tool_poses=tool)
+                        location = BaseLocation(
+                            x,
+                            y,
+                            yaw,
+                            arm,
+                            grasp.approach,
+                            cost,
+                            joints=joints,
+                            tool_poses=tool,
+                            grasp_candidate=candidate,
+                        )
                         return location, failure
                     failure = (f"unreachable for arm {arm!r}", answer.reason)
                 return None, failure
@@ -196,7 +262,68 @@ class ReachVocabulary(StandingSearch):
                 f"{why}; with the torso higher: {str(error).split(': ', 1)[-1]}", designator=desig
             ) from error
 
+    def _gripper(self, arm: str) -> GripperGeometry:
+        """The gripper of `arm` as grasp planning needs it (the robot's description)."""
+        return GripperGeometry(
+            self.geometry.max_openings[arm],
+            self.geometry.fingertip_reach,
+            self.geometry.top_grasp_clearance,
+            self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0],
+        )
+
+    def _planned_options(
+        self,
+        desig: Any,
+        target: Target,
+        pose: ObjectPose | None,
+        grasps: list[Grasp],
+        facing: list[float],
+        drawer: Container | None,
+        action: str,
+        arms: list[str],
+    ) -> dict[str, list[GraspOption]]:
+        """Per arm, the planned grasps (`pycram.reasoning.grasps`) that extend the object type's
+        grasps `grasps` for `target` where it is -- for grasping only, when no grasp was asked
+        for: every one for an object lying on its side (in a drawer: from the top only); for one
+        standing upright, only when its type's grasps do not cover its pose (`_table_covers`:
+        a box turned far from square to the furniture it stands on), and then no top grasp when
+        its type has one of its own. Empty lists otherwise."""
+        none: dict[str, list[GraspOption]] = {arm: [] for arm in arms}
+        if action != "grasp" or desig.prop_value("grasp") is not None or pose is None:
+            return none
+        if not self.geometry.max_openings:
+            return none
+        upright = pose.is_upright
+        if upright and (drawer is not None or self._table_covers(target, grasps, facing)):
+            return none
+        has_top = any(g.approach == "top" for g in grasps)
+        out = {}
+        for arm in arms:
+            options = grasp_options(pose, self.geometry.max_openings[arm])
+            if drawer is not None:  # over the drawer's walls
+                options = [o for o in options if o.approach == "top"]
+            elif upright and has_top:  # the type's own top grasp is tuned
+                options = [o for o in options if o.approach != "top"]
+            out[arm] = options
+        return out
+
+    def _table_covers(self, target: Target, grasps: list[Grasp], facing: list[float]) -> bool:
+        """Whether the grasps of an upright object's type (`grasps`) cover its pose: it stands on
+        no furniture top with edges to face, one of them takes it from any side, or one of its
+        directional grasps fits a base heading turned at most `COVERED_TURN` from facing the
+        furniture squarely."""
+        directional = [g for g in grasps if g.approach in _SIDE_ANGLE]
+        if not facing or not directional or any(g.approach == "side" for g in grasps):
+            return True
+        headings = [self._grasp_heading(g, target) for g in directional]
+        return any(angle_difference(h, f) <= COVERED_TURN for h in headings if h is not None for f in facing)
+
     def _grasps(self, target: Target, requested: Any) -> list[Grasp]:
+        """The grasps to consider: the object type's, those with the approach `requested`, or
+        the `Grasp` `requested` itself (a planned grasp an object is held with, to put it down
+        as it is held)."""
+        if isinstance(requested, Grasp):
+            return [requested]
         grasps = list(target.type.grasps) if target.type is not None else [_POINT_GRASP]
         if requested is not None:
             chosen = [g for g in grasps if g.approach == requested]
@@ -330,6 +457,46 @@ class ReachVocabulary(StandingSearch):
             return []
         now = prosp.joint_position(joint)
         return sorted(((n, h) for n, h in named.items() if h > now + 0.01), key=lambda o: o[1] - now)
+
+
+def _object_pose(target: Target) -> ObjectPose | None:
+    """`target` as grasp planning sees it (None when it is no object of a known type)."""
+    if target.kind != "object" or target.type is None:
+        return None
+    if target.orientation is None:
+        return ObjectPose.upright(target.type, target.position, target.yaw)
+    return ObjectPose(target.type, target.position, target.orientation)
+
+
+def _table_rank(grasp: Grasp, heading: float, natural: float) -> float:
+    """Rank of a type's grasp at a base heading `natural` [rad] among planned ones (their
+    `pycram.reasoning.grasps.GraspCandidate.score`): as in the grasp layer."""
+    if grasp.approach == "top":
+        return TOP_PENALTY
+    if grasp.approach == "side":
+        return 0.0
+    return (angle_difference(heading, natural) / APPROACH_TOLERANCE) ** 2
+
+
+def _planned_layer(grid: FloorGrid, yaw: np.ndarray, options: list[GraspOption], left: float) -> np.ndarray:
+    """Per cell (base heading `yaw` [rad]): the cost of the best planned grasp (`options`), as
+    `pycram.reasoning.grasps.grasp_candidates` ranks them -- a horizontal one by how far its tool
+    turns from the line from the arm's root (`left` [m] beside the base's centre) to the grasp
+    point (``(turn / TURN_SCALE) ** 2``; ``inf`` where it turns more than `MAX_TURN` from the
+    base's heading), one from any side 0, one from the top `GRASP_TOP_PENALTY`."""
+    best = np.full(yaw.shape, np.inf)
+    root_x, root_y = grid.x - left * np.sin(yaw), grid.y + left * np.cos(yaw)
+    for option in options:
+        if option.approach == "top":
+            best = np.minimum(best, GRASP_TOP_PENALTY)
+        elif option.heading is None:
+            best = np.minimum(best, 0.0)
+        else:
+            wrist = np.abs((yaw - option.heading + np.pi) % (2 * np.pi) - np.pi)
+            line = np.arctan2(option.point[1] - root_y, option.point[0] - root_x)
+            turn = np.abs((line - option.heading + np.pi) % (2 * np.pi) - np.pi)
+            best = np.minimum(best, np.where(wrist <= MAX_TURN, (turn / TURN_SCALE) ** 2, np.inf))
+    return best
 
 
 def _body_from_the_top(grasp: Grasp) -> bool:

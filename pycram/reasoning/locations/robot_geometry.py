@@ -42,6 +42,8 @@ class RobotGeometry:
     `fingertip_reach` [m]: how far the finger tips reach beyond the tool frame along the approach
     (``FINGERTIP_REACH``); a top grasp keeps them `top_grasp_clearance` [m]
     (``TOP_GRASP_CLEARANCE``) above the surface the object rests on (`top_grasp_height`).
+    `max_openings` per arm: the largest opening [m] of its gripper (``GRIPPERS[...]['max_opening']``;
+    grasp planning, `pycram.reasoning.grasps`).
     """
 
     name: str
@@ -61,6 +63,7 @@ class RobotGeometry:
     door_push: Mapping[str, Any] | None = None
     fingertip_reach: float = 0.0
     top_grasp_clearance: float = 0.0
+    max_openings: Mapping[str, float] = None  # type: ignore[assignment]
 
     @classmethod
     def from_description(cls, d: RobotDescription) -> RobotGeometry:
@@ -93,6 +96,7 @@ class RobotGeometry:
             door_push=d.DOOR_PUSH,
             fingertip_reach=float(d.FINGERTIP_REACH),
             top_grasp_clearance=float(d.TOP_GRASP_CLEARANCE),
+            max_openings={a: float(d.GRIPPERS[s["gripper"]]["max_opening"]) for a, s in d.ARMS.items()},
         )
 
     def top_grasp_height(self, bottom: float, wanted: float) -> float:

@@ -21,7 +21,9 @@ class BaseLocation:
     `torso` the named torso position the solution needs (None: the torso as it is; the actions
     carry objects with the torso up afterwards, `pycram.actions.pick_up.CARRY_TORSO`);
     `push` the face of a door the hand pushes from there (``'inside'``/``'outside'``; None: not
-    a push).
+    a push); `grasp_candidate` the planned grasp (`pycram.reasoning.grasps.GraspCandidate`) the
+    solution was validated for, when it was not one of the object type's grasps (then `grasp`
+    is its approach, ``'side'`` or ``'top'``, and `tool_poses` hold the orientations to reach).
     """
 
     x: float
@@ -35,6 +37,7 @@ class BaseLocation:
     tool_poses: tuple = field(default=(), repr=False, compare=False)
     torso: str | None = None
     push: str | None = None
+    grasp_candidate: Any = field(default=None, repr=False, compare=False)
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))

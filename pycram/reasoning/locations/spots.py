@@ -6,7 +6,8 @@ options] with `Spot`s on the interior surfaces of container ``c`` -- a drawer's 
 believes it open (``container_states``): moved out, only the part out from under the furniture
 (none while it is closed). Spots lie on a grid of
 `SPOT_RESOLUTION` [m], keep `SPOT_GAP` [m] from other objects and `SPOT_EDGE_MARGIN` [m] from the
-surface's edge, come nearest ``near`` (or the surface's centre) first and keep `SPACING` apart.
+surface's edge, come nearest ``near`` (or the surface's centre) first and keep `SPACING` apart on
+each surface (the shelves of a fridge, one above the other, each offer theirs).
 """
 
 from __future__ import annotations
@@ -141,11 +142,11 @@ class SpotVocabulary(CandidateSearch):
             )
 
         def spots() -> Iterator[Spot]:
-            given: list[tuple[float, float]] = []
+            given: dict[str, list[tuple[float, float]]] = {}  # per surface: shelves above each other
             for cost, x, y, z, name in candidates:
-                if any(math.hypot(x - gx_, y - gy_) < SPACING for gx_, gy_ in given):
+                if any(math.hypot(x - gx_, y - gy_) < SPACING for gx_, gy_ in given.get(name, ())):
                     continue
-                given.append((x, y))
+                given.setdefault(name, []).append((x, y))
                 yield Spot(x, y, z, name, container, None if own else _type_name(desig.prop_value("for")), cost)
 
         return spots()

@@ -26,7 +26,9 @@ class Target:
     `position` [m, map]: the object's centre (or the point); `type` its object type when known;
     `name` the name the world knows it by (for visibility), `yaw` [rad] its turn about z;
     `kind`: "object", "point", "place", "surface" or "container"; `thing` the environment part
-    for surfaces and containers.
+    for surfaces and containers; `orientation` (w, x, y, z) an object's orientation as measured,
+    when it is known (None: standing upright, turned by `yaw`; grasp planning,
+    `pycram.reasoning.grasps`, reads it).
     """
 
     position: tuple[float, float, float]
@@ -35,6 +37,7 @@ class Target:
     type: ObjectType | None = None
     yaw: float = 0.0
     thing: Any = None
+    orientation: tuple[float, float, float, float] | None = None
 
     def describe(self) -> str:
         if self.kind == "object":
@@ -73,6 +76,16 @@ def _yaw_of(orientation: Any) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
+def _quaternion(value: Any) -> tuple[float, float, float, float] | None:
+    try:
+        q = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        return None
+    if len(q) != 4 or not all(math.isfinite(v) for v in q) or not any(q):
+        return None
+    return (q[0], q[1], q[2], q[3])
+
+
 def _point(value: Any) -> tuple[float, float, float] | None:
     try:
         p = tuple(float(v) for v in value)
@@ -98,9 +111,13 @@ def _object_like(value: Any) -> Target | None:
     elif not isinstance(otype, ObjectType):
         otype = None
     yaw = getattr(value, "yaw", None)
+    measured = getattr(holder, "orientation", None)
+    if measured is None and holder is not value:
+        measured = getattr(value, "orientation", None)
     if yaw is None:
-        yaw = _yaw_of(getattr(holder, "orientation", None))
-    return Target(position, "object", getattr(value, "name", None), otype, float(yaw))
+        yaw = _yaw_of(measured)
+    orientation = _quaternion(measured)
+    return Target(position, "object", getattr(value, "name", None), otype, float(yaw), orientation=orientation)
 
 
 def as_target(value: Any, environment: Environment | None = None, known_objects: Sequence[KnownObject] = ()) -> Target:

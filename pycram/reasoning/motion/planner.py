@@ -106,12 +106,13 @@ class MotionPlanner(abc.ABC):
         held_object: str | None = None,
         exempt_object: str | None = None,
         clearance: float = 0.0,
+        object_clearance: float = 0.0,
         time_limit: float | None = None,
         seed: int = 0,
     ) -> MotionPlan:
         """Plan ``arm`` from ``start`` to ``goal`` with the robot at ``base_pose`` in prospection's
         world; the other joints as they are now or as in ``joint_configuration``. ``held_object``,
-        ``exempt_object`` and ``clearance`` [m] are those of
+        ``exempt_object``, ``clearance`` and ``object_clearance`` [m] are those of
         :meth:`~pycram.world.prospection.Prospection.configuration_checker`; with
         ``include_torso`` the torso joint is planned too (first in the configurations)."""
         limits = prospection.arm_joint_limits(arm, include_torso)
@@ -123,6 +124,7 @@ class MotionPlanner(abc.ABC):
             held_object=held_object,
             exempt_object=exempt_object,
             clearance=clearance,
+            object_clearance=object_clearance,
         ) as checker:
             return self.plan_with(checker, limits, start, goal, time_limit=time_limit, seed=seed)
 

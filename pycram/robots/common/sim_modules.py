@@ -59,6 +59,8 @@ __all__ = [
     "seen_objects",
     "shutdown_modules",
     "plan_arm_motions",
+    "HANDLE_PHASES",
+    "HANDLE_RADIUS",
 ]
 
 logger = logging.getLogger(__name__)
@@ -248,10 +250,10 @@ class ArmModule(SimProcessModule):
     prospection that plans, move directly (joint interpolation, as the simulator's ``move_arm`` /
     ``reach``).
 
-    Planning is off unless the module has a ``robot``: :func:`plan_arm_motions` switches it on for
-    every arm module of a robot (off by default while issue 32's integration is completed: with
-    it on, pick-and-place tests of deep and flat objects fail, see the module
-    :mod:`pycram.robots.common.arm_motion`).
+    Planning is off unless the module has a ``robot`` (the PR2's and the TIAGo's have theirs);
+    :func:`plan_arm_motions` switches it on or off for every arm module of a robot. After a stop
+    the head looks at the tool and one detection goes into the belief before the motion is
+    planned again.
 
     ``reach`` returns the reached tool ``Pose``; an unreachable target fails with reason
     ``'unreachable'``, a motion stopped by a contact with ``'collision'`` and one stopped by a
@@ -272,13 +274,25 @@ class ArmModule(SimProcessModule):
 
             try:
                 self._motions = ArmMotionPlanner(
-                    self.world, self.arm, lambda: self.robot, self._run_command, SimMotionFailed
+                    self.world, self.arm, lambda: self.robot, self._run_command, SimMotionFailed, look=_look_at
                 )
             except ImportError as missing:  # without the planning libraries: direct motions
                 logger.warning("%s: arm motions are not planned: %s", self.name, missing)
                 self.robot = None
                 return None
         return self._motions
+
+    def _at_a_handle(self, point: tuple[float, ...]) -> bool:
+        """Whether ``point`` [m, map] is within `HANDLE_RADIUS` of a container's handle as the
+        robot believes it (the environment's description, the belief's openings)."""
+        environment = getattr(self.world, "environment", None)
+        belief = getattr(self.robot, "belief", None)
+        states = dict(getattr(belief, "container_states", {}) or {})
+        for container in getattr(environment, "containers", ()):
+            handle = container.handle_position(float(states.get(container.name, 0.0)))
+            if math.dist(handle, point[:3]) <= HANDLE_RADIUS:
+                return True
+        return False
 
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
@@ -309,13 +323,22 @@ class ArmModule(SimProcessModule):
                     lambda: self.world.reach(self.arm, position, orientation, tolerance=tolerance), what, timeout=30.0
                 )
 
-            if planner is None:
+            if planner is None or (phase in HANDLE_PHASES and self._at_a_handle(position)):
                 return reach_directly()
             if grasped[1] is None:  # what lies at the target is what the hand goes for
                 tx, ty, tz = (float(v) for v in solution.get("target") or position)
                 grasped = (grasped[0], (tx, ty, tz))
             return planner.reach(position, orientation, tolerance, what, reach_directly, grasped, phase)
         check_command(self, solution, "move_arm", "reach")
+
+
+#: Reaching phases towards a container's handle that move directly (not planned), for now: a
+#: planned approach ends in another arm configuration than the direct one (the IK differs), from
+#: which the door's arc was out of reach (measured: the PR2's cupboard door, opened 38 of 69 deg).
+HANDLE_PHASES = ("pre_grasp", "grasp")
+#: A reaching target within this distance [m] of a container's handle (where the robot believes
+#: it: the container at its believed opening) goes for the handle.
+HANDLE_RADIUS = 0.15
 
 
 def plan_arm_motions(robot: Robot, on: bool = True) -> None:
@@ -327,6 +350,15 @@ def plan_arm_motions(robot: Robot, on: bool = True) -> None:
         if isinstance(module, ArmModule):
             module.robot = robot if on else None
             module._motions = None
+
+
+def _look_at(point: tuple[float, float, float]) -> None:
+    """Point the active robot's head at ``point`` [m, map] and detect once (into its belief)."""
+    from pycram.designators.motion import MotionDesignator
+    from pycram.execution.perform import perform
+
+    perform(MotionDesignator(type="pointing_head", coordinates=point))
+    perform(MotionDesignator(type="detecting"))
 
 
 def _object_of(designator: Any) -> tuple[str | None, tuple[float, float, float] | None]:

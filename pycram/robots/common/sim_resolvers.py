@@ -450,15 +450,18 @@ def known_objects_of(belief: Any) -> list:
     return known
 
 
-def make_location_generator(world: Any, description: Any, belief: Any) -> Callable[[Any], Any]:
-    """The location generator of the robot of `description` in the simulated `world`: the
-    general reasoning of :mod:`pycram.locations` (``to_reach``, ``to_see``, ``to_open``, ``on``,
-    ``in``), with prospection of the world the robot believes in (``world.prospection(belief)``)
-    and the objects of the robot's ``belief`` as known objects. Returns ``None`` for designators
-    outside that vocabulary."""
+def make_location_generator(
+    world: Any, description: Any, belief: Any, prospection: Callable[[], Any] | None = None
+) -> Callable[[Any], Any]:
+    """The location generator of the robot of `description` in `world` (a simulated world, or
+    any object with the environment's description as ``environment``): the general reasoning of
+    :mod:`pycram.locations` (``to_reach``, ``to_see``, ``to_open``, ``on``, ``in``), with
+    prospection of the world the robot believes in (`prospection()`; by default
+    ``world.prospection(belief)``) and the objects of the robot's ``belief`` as known objects.
+    Returns ``None`` for designators outside that vocabulary."""
     from pycram.reasoning.locations import LocationReasoner, RobotGeometry
 
-    def prospection() -> Any:
+    def of_world() -> Any:
         make = getattr(world, "prospection", None)
         if make is None:
             raise LookupError(f"{world!r} offers no prospection")
@@ -467,7 +470,7 @@ def make_location_generator(world: Any, description: Any, belief: Any) -> Callab
     reasoner = LocationReasoner(
         RobotGeometry.from_description(description),
         lambda: world.environment,
-        prospection,
+        prospection or of_world,
         lambda: known_objects_of(belief),
         container_states=lambda: dict(getattr(belief, "container_states", {})),
     )

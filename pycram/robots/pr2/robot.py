@@ -42,7 +42,9 @@ def make_robot(world: Any) -> sm.SimRobot:
     base_stop = robot.add_process_module("base_stop", sm.BaseStopModule(world, navigation))
     head = robot.add_process_module("head", sm.HeadModule(world))
     torso = robot.add_process_module("torso", sm.TorsoModule(world))
-    arms = {arm: robot.add_process_module(f"arm_{arm}", sm.ArmModule(world, arm)) for arm in description.ARMS}
+    arms = {
+        arm: robot.add_process_module(f"arm_{arm}", sm.ArmModule(world, arm, robot=robot)) for arm in description.ARMS
+    }
     grippers = {g: robot.add_process_module(f"gripper_{g}", sm.GripperModule(world, g)) for g in description.GRIPPERS}
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
     perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))

@@ -44,7 +44,7 @@ def make_robot(world: Any) -> sm.SimRobot:
     torso = robot.add_process_module("torso", sm.TorsoModule(world))
     (arm_name,) = description.ARMS
     (gripper_name,) = description.GRIPPERS
-    arm = robot.add_process_module(f"arm_{arm_name}", sm.ArmModule(world, arm_name))
+    arm = robot.add_process_module(f"arm_{arm_name}", sm.ArmModule(world, arm_name, robot=robot))
     gripper = robot.add_process_module(f"gripper_{gripper_name}", sm.GripperModule(world, gripper_name))
     sensors = robot.add_process_module("sensors", sm.SensorModule(world))
     perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
