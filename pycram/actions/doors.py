@@ -196,7 +196,13 @@ def _push_door(location: Any, belief: Any, container: Any, goal: float) -> float
     try:
         for pose in doors.push_sequence(container, contact, start, goal, side):
             try:
-                motion(type="reaching", arm=arm, target=list(pose.position), orientation=list(pose.orientation))
+                motion(
+                    type="reaching",
+                    arm=arm,
+                    target=list(pose.position),
+                    orientation=list(pose.orientation),
+                    contact=pose.phase == "push",
+                )
             except RECOVERABLE as error:
                 if getattr(unwrap(error), "reason", None) != "blocked":
                     raise

@@ -78,6 +78,8 @@ __all__ = [
     "CLEARANCES",
     "DIRECT_PHASES",
     "FIXTURE_EFFORT",
+    "HANDLE_PHASES",
+    "HANDLE_RADIUS",
     "MOVING",
     "OBJECT_CLEARANCE",
     "PERIOD",
@@ -115,6 +117,15 @@ TOLERATED_PENETRATION = 0.015
 #: was measured, and a box seen from one side is measured a few cm off its centre (measured: the
 #: TIAGo's cereal box, 2.6 cm; its forearm, planned to pass the believed box, hit the real one).
 OBJECT_CLEARANCE = 0.03
+#: Reaching phases towards or away from a container's handle that move directly (not planned),
+#: for now: a planned approach ends in another arm configuration than the direct one (the IK
+#: differs), from which the door's arc was out of reach (measured: the PR2's cupboard door, opened
+#: 38 of 69 deg); a planned retreat from the handle of a door just pushed shut pulled it open
+#: again (3.4 deg, the PR2's cupboard).
+HANDLE_PHASES = ("pre_grasp", "grasp", "retreat")
+#: A reaching target within this distance [m] of a container's handle (anywhere on the handle's
+#: way) goes for the handle.
+HANDLE_RADIUS = 0.15
 #: A gripper squeezing with more than this effort [N] while the belief puts no object in it holds a
 #: fixture (a handle): its arm's motions are contact motions, moved directly.
 FIXTURE_EFFORT = 1.0
@@ -234,10 +245,13 @@ class ArmMotionPlanner:
         direct: Callable[[], Any],
         grasped: Grasped = (None, None),
         phase: str | None = None,
+        contact: bool = False,
     ) -> Any:
         """Move the tool to ``position`` [m, map] (``orientation`` (w, x, y, z) or None); returns
         the reached tool pose; ``direct()`` runs it the direct way (always for the phases of
-        `DIRECT_PHASES`); ``grasped`` as in :meth:`move`."""
+        `DIRECT_PHASES`, for ``contact`` motions -- the tool meant to touch what it reaches, a
+        door it pushes -- and for `HANDLE_PHASES` towards a container's handle); ``grasped`` as in
+        :meth:`move`."""
         if phase in UNTOUCHED_PHASES:
             # the fingers keep off the object until the grasp itself: exempt on the way to the
             # pre-grasp pose, they swept a bowl 8 cm aside (measured: the TIAGo's, the bowl was then
@@ -247,6 +261,10 @@ class ArmMotionPlanner:
         try:
             if phase in DIRECT_PHASES:
                 raise _Direct(f"the {phase} phase")
+            if contact:
+                raise _Direct("a contact motion (the motion's contact)")
+            if phase in HANDLE_PHASES and self._at_a_handle(position):
+                raise _Direct(f"the {phase} phase towards a container's handle")
             self._still()
             prospection = self.prospection()
             held = self._held()
@@ -465,6 +483,20 @@ class ArmMotionPlanner:
             return name, None
         x, y, z = (float(v) for v in position[:3])
         return name, (x, y, z)
+
+    def _at_a_handle(self, point: Sequence[float]) -> bool:
+        """Whether ``point`` [m, map] is within `HANDLE_RADIUS` of a container's handle anywhere
+        on its way (the environment's description: the handle at 11 openings over the joint's
+        range -- the belief's opening may be stale while the hand moves the container)."""
+        belief = getattr(self._robot(), "belief", None)
+        environment = getattr(belief, "environment", None)
+        for container in getattr(environment, "containers", ()):
+            low, high = container.limits
+            for k in range(11):
+                handle = container.handle_position(low + (high - low) * k / 10)
+                if math.dist(handle, tuple(point)[:3]) <= HANDLE_RADIUS:
+                    return True
+        return False
 
     def _grips_fixture(self) -> None:
         """Raise `_Direct` when this arm's gripper squeezes something (its measured effort above

@@ -259,6 +259,7 @@ class RosPlannedArmModule(RosArmModule):
                 directly,
                 grasped,
                 phase,
+                bool(solution.get("contact")),
             )
         return super()._execute(designator)
 

@@ -59,8 +59,6 @@ __all__ = [
     "seen_objects",
     "shutdown_modules",
     "plan_arm_motions",
-    "HANDLE_PHASES",
-    "HANDLE_RADIUS",
 ]
 
 logger = logging.getLogger(__name__)
@@ -282,18 +280,6 @@ class ArmModule(SimProcessModule):
                 return None
         return self._motions
 
-    def _at_a_handle(self, point: tuple[float, ...]) -> bool:
-        """Whether ``point`` [m, map] is within `HANDLE_RADIUS` of a container's handle as the
-        robot believes it (the environment's description, the belief's openings)."""
-        environment = getattr(self.world, "environment", None)
-        belief = getattr(self.robot, "belief", None)
-        states = dict(getattr(belief, "container_states", {}) or {})
-        for container in getattr(environment, "containers", ()):
-            handle = container.handle_position(float(states.get(container.name, 0.0)))
-            if math.dist(handle, point[:3]) <= HANDLE_RADIUS:
-                return True
-        return False
-
     def _execute(self, designator: Any) -> Any:
         solution = designator.reference()
         cmd = solution.get("cmd")
@@ -323,22 +309,15 @@ class ArmModule(SimProcessModule):
                     lambda: self.world.reach(self.arm, position, orientation, tolerance=tolerance), what, timeout=30.0
                 )
 
-            if planner is None or (phase in HANDLE_PHASES and self._at_a_handle(position)):
+            if planner is None:
                 return reach_directly()
             if grasped[1] is None:  # what lies at the target is what the hand goes for
                 tx, ty, tz = (float(v) for v in solution.get("target") or position)
                 grasped = (grasped[0], (tx, ty, tz))
-            return planner.reach(position, orientation, tolerance, what, reach_directly, grasped, phase)
+            return planner.reach(
+                position, orientation, tolerance, what, reach_directly, grasped, phase, bool(solution.get("contact"))
+            )
         check_command(self, solution, "move_arm", "reach")
-
-
-#: Reaching phases towards a container's handle that move directly (not planned), for now: a
-#: planned approach ends in another arm configuration than the direct one (the IK differs), from
-#: which the door's arc was out of reach (measured: the PR2's cupboard door, opened 38 of 69 deg).
-HANDLE_PHASES = ("pre_grasp", "grasp")
-#: A reaching target within this distance [m] of a container's handle (where the robot believes
-#: it: the container at its believed opening) goes for the handle.
-HANDLE_RADIUS = 0.15
 
 
 def plan_arm_motions(robot: Robot, on: bool = True) -> None:

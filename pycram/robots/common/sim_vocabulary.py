@@ -151,6 +151,13 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                     form="any",
                     required=False,
                 ),
+                MotionKey(
+                    "contact",
+                    "True: the tool is meant to touch what it reaches (a door it pushes): moved "
+                    "directly, not planned (default: False)",
+                    form="any",
+                    required=False,
+                ),
             ),
         ),
         MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)", (fluent,)),
