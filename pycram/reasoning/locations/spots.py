@@ -6,8 +6,10 @@ options] with `Spot`s on the interior surfaces of container ``c`` -- a drawer's 
 believes it open (``container_states``): moved out, only the part out from under the furniture
 (none while it is closed). Spots lie on a grid of
 `SPOT_RESOLUTION` [m], keep `SPOT_GAP` [m] from other objects and `SPOT_EDGE_MARGIN` [m] from the
-surface's edge, come nearest ``near`` (or the surface's centre) first and keep `SPACING` apart on
-each surface (the shelves of a fridge, one above the other, each offer theirs).
+surface's edge, come nearest ``near`` (or the surface's centre; behind a door, out at the front:
+`FRONT_CENTRING`) first and keep `SPACING` apart on
+each surface; several surfaces (the shelves of a fridge, one above the other) take turns: each
+one's best spot, then each one's second, ...
 """
 
 from __future__ import annotations
@@ -30,6 +32,9 @@ __all__ = ["SpotVocabulary", "SPOT_RESOLUTION", "SPOT_GAP", "SPOT_EDGE_MARGIN", 
 
 #: Spots on surfaces: grid cell [m].
 SPOT_RESOLUTION = 0.02
+#: Inside a container behind a door, spots are ranked by how far out towards the opening they
+#: lie [m], plus this times their distance from the surface's centre [m] (centred among equals).
+FRONT_CENTRING = 0.2
 #: Free space [m] between a spot's object and the other objects.
 SPOT_GAP = 0.02
 #: Free space [m] between a spot's object and the surface's edge.
@@ -54,8 +59,9 @@ class SpotVocabulary(CandidateSearch):
         container = value if isinstance(value, Container) else env.container(value)
         if not container.interior:
             raise self._fail(desig, f"{container.name!r} has no surfaces inside")
-        if container.kind != "drawer":
-            return self._spots(desig, list(container.interior), container.name)
+        if container.kind != "drawer":  # behind a door: the spots nearest the opening first
+            front = container.opening_direction
+            return self._spots(desig, list(container.interior), container.name, front)
         # a drawer's inside as it is believed open: out from under the furniture, reachable from above
         q = float(self.container_states().get(container.name, 0.0))
         exposed = container.opened_interior(q)  # spots keep their margin from the cut edge too
@@ -88,7 +94,12 @@ class SpotVocabulary(CandidateSearch):
             raise ValueError(f"('for', {value!r}): need an object type, a known object or an object with a type")
         return target.type.footprint_radius, target.type.half_height, target.describe(), target.name
 
-    def _spots(self, desig: Any, surfaces: list[Surface], container: str | None) -> Iterator[Spot]:
+    def _spots(
+        self, desig: Any, surfaces: list[Surface], container: str | None, front: tuple[float, float] | None = None
+    ) -> Iterator[Spot]:
+        """Spots on `surfaces` (see the module docstring); without ``near``, those farthest along
+        ``front`` (a unit vector: a door's opening direction, towards the room) come first, else
+        those nearest each surface's centre."""
         known = list(self.known_objects())
         radius, half, what, own = self._object_size(desig.prop_value("for"), known)
         near = desig.prop_value("near")
@@ -131,6 +142,8 @@ class SpotVocabulary(CandidateSearch):
             else:
                 cx, cy, _ = surface.centroid
                 cost = np.hypot(gx - cx, gy - cy)
+                if front is not None:  # out at the front (reachable past the door), centred second
+                    cost = -(gx * front[0] + gy * front[1]) + FRONT_CENTRING * cost
             for i in np.flatnonzero(free.ravel()):
                 candidates.append((float(cost.ravel()[i]), float(gx.ravel()[i]), float(gy.ravel()[i]), z, surface.name))
         candidates.sort()
@@ -142,11 +155,24 @@ class SpotVocabulary(CandidateSearch):
             )
 
         def spots() -> Iterator[Spot]:
-            given: dict[str, list[tuple[float, float]]] = {}  # per surface: shelves above each other
+            # per surface, best first, `SPACING` apart; then the surfaces take turns (the fridge's
+            # shelves: each one's best spot before any shelf's second -- a place that tries the
+            # first few spots tried only the bottom shelf, out of reach)
+            given: dict[str, list[tuple[float, float, float, float]]] = {}
+            cells: dict[tuple[str, int, int], list[tuple[float, float]]] = {}  # spots by SPACING cell
             for cost, x, y, z, name in candidates:
-                if any(math.hypot(x - gx_, y - gy_) < SPACING for gx_, gy_ in given.get(name, ())):
+                i, j = int(math.floor(x / SPACING)), int(math.floor(y / SPACING))
+                near = (p for di in (-1, 0, 1) for dj in (-1, 0, 1) for p in cells.get((name, i + di, j + dj), ()))
+                if any(math.hypot(x - gx_, y - gy_) < SPACING for gx_, gy_ in near):
                     continue
-                given.setdefault(name, []).append((x, y))
+                cells.setdefault((name, i, j), []).append((x, y))
+                given.setdefault(name, []).append((x, y, z, cost))
+            turns = sorted(
+                (rank, cost, x, y, z, name)
+                for name, spots_on in given.items()
+                for rank, (x, y, z, cost) in enumerate(spots_on)
+            )
+            for _, cost, x, y, z, name in turns:
                 yield Spot(x, y, z, name, container, None if own else _type_name(desig.prop_value("for")), cost)
 
         return spots()
