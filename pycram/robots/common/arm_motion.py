@@ -24,9 +24,9 @@ arm motion:
 5. **looking and re-planning** -- after such a stop the head looks at the tool and one detection
    goes into the belief (the module's ``look``), the arm backs off along the way it came (to the
    last configuration prospection -- knowing now what it saw -- finds free, at least `BACK_OFF`
-   back), and the motion is planned again from there, from the world as prospection knows it then; at most `REPLANS`
-   times, then the stop's typed failure (``SimMotionFailed`` with reason ``'collision'`` or
-   ``'blocked'``). When prospection still sees nothing in the way (the re-plan is the straight
+   back), and the motion is planned again from there, from the world as prospection knows it
+   then; at most `REPLANS` times, then the stop's typed failure (``SimMotionFailed`` with
+   reason ``'collision'`` or ``'blocked'``). When prospection still sees nothing in the way (the re-plan is the straight
    line again: what was hit is not in the believed world even after the look) the motion goes
    on directly, as before planning existed.
 
@@ -42,19 +42,20 @@ A plan keeps `OBJECT_CLEARANCE` from believed objects (measured poses are a few 
 without such a path is planned again allowing touches, then tolerating shallow contacts
 (`TOLERATED_PENETRATION`, as location reasoning does when it validates a grasp): `CLEARANCES`.
 
-**Contact motions are not planned.** A motion whose start or goal touches something even then --
-the fingers closed round a handle, a hand pushing a door, a grasp whose fingers press on the
-counter -- has no collision-free path by definition; it is executed as before planning existed:
-the direct joint interpolation (``World.move_arm`` / ``World.reach``), which ends with
-``'blocked'`` when the arm cannot follow (the drawer at its stop). So is, for now, a motion for
-which the planner finds no path within its time limit (``'no_path'``: a narrow passage, or a goal
-walled in): the direct motion is watched by nothing but its end (``'blocked'``), as before; making
-``'no_path'`` a failure of its own is left until grasps and places are chosen with planning
-(issue 32, point 3), so that a refused motion has an alternative. The same holds when prospection's IK finds no
-solution for a tool pose (the simulator's own IK is tried, as before) and when the robot has no
-prospection that plans (``NotImplementedError``; the ROS robot has its own modules), and while
-the base or the torso moves (`MOVING`: a plan holds for the robot standing where it stands; the
-thesis demo raises the arm while the base drives up).
+**Contact motions are not planned.** A motion that touches on purpose has no collision-free path
+by definition; it is executed as before planning existed: the direct joint interpolation
+(``World.move_arm`` / ``World.reach``), which ends with ``'blocked'`` when the arm cannot follow
+(the drawer at its stop). Such are: a motion whose start touches something even tolerating shallow
+contacts; one whose gripper squeezes something the belief puts no object in (a handle:
+`FIXTURE_EFFORT`); a ``contact`` reach (a hand pushing a door); a `HANDLE_PHASES` reach near a
+container's handle; the `DIRECT_PHASES`. So is, for now, a motion for which the planner finds no
+path within its budget (``'no_path'``: a narrow passage, or a goal walled in): the direct motion is
+watched by nothing but its end (``'blocked'``), as before. The same holds when prospection's IK
+finds no solution for a tool pose (the simulator's own IK is tried, as before), when the robot has
+no prospection that plans (``NotImplementedError``), and while the base or the torso moves
+(`MOVING`: a plan holds for the robot standing where it stands; the thesis demo raises the arm
+while the base drives up). The ROS robot's arm modules use this planner too
+(:mod:`pycram.robots.common.ros_arm_motion`).
 
 **The torso is not planned** (``include_torso=False``): torso motions are the actions' explicit
 ``setting_torso`` motions, and the torso's lift is slow (0.05 m/s on the PR2): planning it with
@@ -266,6 +267,7 @@ class ArmMotionPlanner:
             if phase in HANDLE_PHASES and self._at_a_handle(position):
                 raise _Direct(f"the {phase} phase towards a container's handle")
             self._still()
+            self._grips_fixture()
             prospection = self.prospection()
             held = self._held()
             base = self.world.base_pose.get_value()
@@ -273,7 +275,6 @@ class ArmMotionPlanner:
             leaving = self._let_go(prospection, held) if exempt is None and phase not in UNTOUCHED_PHASES else None
             if leaving is not None:
                 grasped, exempt = leaving, leaving[0]
-            self._grips_fixture()
             self._not_in_contact(prospection, base, current, held, exempt)
             if orientation is None:
                 # the tool keeps its orientation, as the direct reach (a local solver) keeps it
