@@ -254,3 +254,22 @@ def test_a_drawer_pulled_out_beside_the_one_closed_is_seen_and_closed_too():
         closed = close_opened_containers()
         assert closed == ["drawer 1", "drawer 3"]
         assert opening_of(world, "drawer 1") < 0.03 and opening_of(world, "drawer 3") < 0.03
+
+
+def test_a_transport_into_the_closed_cupboard_opens_it_first():
+    """The target lies inside a container the robot does not believe open: the transport opens it
+    first, with its one hand still free (the TIAGo), and puts the mug on the cupboard's shelf."""
+    from action_helpers import rests_upright_at
+
+    from pycram.actions import Transport
+    from pycram.designator import LocationDesignator
+
+    with apartment_with("tiago", {"mug": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        assert opening_of(world, "cupboard") < math.radians(4)
+        target = LocationDesignator([("in", "cupboard"), ("for", "mug")])
+        obj, task = run_as_task(lambda: perform(Transport(ObjectDesignator(type="mug"), target)))
+        assert tasks_named(task, "opening cupboard")  # opened by the transport itself
+        assert rests_upright_at(world, "mug", "cupboard shelf", obj.pose[:2])
+        assert holding(world) == set()
