@@ -232,6 +232,8 @@ class ArmMotionPlanner:
         """Move the arm to the joint ``goal`` [rad or m]; ``direct()`` runs it the direct way;
         ``grasped``: the object being grasped (name, believed position [m, map]), if any."""
         try:
+            self._still()
+            self._grips_fixture()
             return self._planned(list(goal), what, grasped, PathGoal())
         except _Direct as why:
             logger.debug("%s: direct (%s)", what, why)
@@ -294,10 +296,7 @@ class ArmMotionPlanner:
             return self._planned(
                 list(ik.positions), what, grasped, goal, leaving=leaving is not None, straight=phase in STRAIGHT_PHASES
             )
-        except NotImplementedError as why:
-            logger.debug("%s: direct (%s)", what, why)
-            return direct()
-        except _Direct as why:
+        except (NotImplementedError, _Direct) as why:
             logger.debug("%s: direct (%s)", what, why)
             return direct()
 
@@ -315,8 +314,6 @@ class ArmMotionPlanner:
         or the direct motion, no detour."""
         from pycram.reasoning.motion import time_parameterize
 
-        self._still()
-        self._grips_fixture()
         prospection = self.prospection()
         limits = prospection.arm_joint_limits(self.arm)
         held = self._held()
@@ -461,14 +458,7 @@ class ArmMotionPlanner:
             return None
         base = self.world.base_pose.get_value()
         current = self._current()
-
-        def touching(exempt: str | None) -> list[tuple[str, str]]:
-            checker = _with_known_objects(partial(prospection.configuration_checker, self.arm, base), held, exempt)
-            try:
-                return list(checker.contacts(current))
-            finally:
-                checker.close()
-
+        touching = partial(self._contacts, prospection, base, current, held)
         try:
             names = {believed.name_of(other) for _, other in touching(None)}
             if len(names) != 1 or None in names:
@@ -514,6 +504,22 @@ class ArmMotionPlanner:
                 f"a contact motion: the {self.gripper} gripper squeezes something not an object ({effort:.1f} N)"
             )
 
+    def _contacts(
+        self,
+        prospection: Any,
+        base: Any,
+        q: Sequence[float],
+        held: Sequence[str],
+        exempt: str | None,
+        clearance: float = 0.0,
+    ) -> list[tuple[str, str]]:
+        """The pairs (arm part, obstacle) touching with the arm at ``q`` in prospection (closer
+        than ``clearance`` [m]), the held object moving with the hand and ``exempt`` allowed at
+        the fingers; ``ValueError`` when prospection knows none of the names."""
+        ask = partial(prospection.configuration_checker, self.arm, base, clearance=clearance)
+        with _with_known_objects(ask, held, exempt) as checker:
+            return list(checker.contacts(q))
+
     def _not_in_contact(
         self, prospection: Any, base: Any, current: Sequence[float], held: Sequence[str], exempt: str | None
     ) -> None:
@@ -522,17 +528,9 @@ class ArmMotionPlanner:
         IK for its goal is sought: such a goal touches too, and IK would try every seed for a
         free solution first (measured: 7-9 s per step of closing a drawer, under load)."""
         try:
-            checker = _with_known_objects(
-                partial(prospection.configuration_checker, self.arm, base, clearance=CLEARANCES[-1][0]),
-                held,
-                exempt,
-            )
+            contacts = self._contacts(prospection, base, current, held, exempt, clearance=CLEARANCES[-1][0])
         except ValueError:
             return
-        try:
-            contacts = checker.contacts(current)
-        finally:
-            checker.close()
         if contacts:
             raise _Direct(f"a contact motion: {contacts[0][0]} touches {contacts[0][1]}")
 
