@@ -308,12 +308,16 @@ class Prospection(abc.ABC):
         """The arm names :meth:`reachable` accepts."""
 
     @abc.abstractmethod
-    def in_collision(self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> bool:
+    def in_collision(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+    ) -> bool:
         """Would the robot at ``base_pose`` collide with the environment?
 
         The robot keeps its current joint positions except those in ``joint_configuration``
-        (joint name -> position [rad or m]). Raises ``ValueError`` for an unknown joint (the
-        message lists the valid ones) or a malformed pose.
+        (joint name -> position [rad or m]). The objects named in ``carried`` (objects the robot
+        holds) move with the base from where they are now -- rigidly, as the base drives with
+        them -- and count as parts of the robot. Raises ``ValueError`` for an unknown joint or
+        object (the message lists the valid ones) or a malformed pose.
         """
 
     @abc.abstractmethod

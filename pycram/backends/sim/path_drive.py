@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -24,7 +24,7 @@ from pycram.world.types import Outcome, Pose2D
 
 from .controllers import BaseDrive, Controller, fail, invalid_input
 from .engine import Engine
-from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, robot_parts
+from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, local_vertices, robot_parts
 from .prospection import SimProspection
 from .recording import StateSnapshot
 from .robot_model import BASE_JOINTS
@@ -50,17 +50,34 @@ class Navigation:
         self._state: np.ndarray | None = None
         self._outline = np.zeros(0)
         self._robot_parts = robot_parts(eng.scene)
+        self._item_points: dict[int, np.ndarray] = {}
         self._planner: PathPlanner | None = None
         self._robot_state = StateSnapshot.of(eng.data)
         # no tolerance: a drive fails on any contact
         self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=0.0)
 
     def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
-        """Whether the whole robot, in its configuration now, touches nothing of the environment
-        at a base pose (x, y, yaw): the 3D check behind the planner's outlines. Answers are
-        memoized per pose (to 1 mm / 1 mrad) for this state."""
+        """Whether the whole robot, in its configuration now and with the items its grippers
+        hold, touches nothing of the environment at a base pose (x, y, yaw): the 3D check behind
+        the planner's outlines. Answers are memoized per pose (to 1 mm / 1 mrad) for this state."""
         self._robot_state = StateSnapshot.of(eng.data)
-        return memoized_free(self._prospection)
+        return memoized_free(self._prospection, carried_items(eng))
+
+    def _parts(self, eng: Engine) -> list[dict[int, np.ndarray]]:
+        """The robot's parts (`robot_parts`), each arm's with the geoms of the item its gripper
+        holds now: a carried object is kept off the furniture as the arm holding it is."""
+        held = {g: item for g, item in ((name, gr.holding) for name, gr in eng.grippers.items()) if item}
+        if not held:
+            return self._robot_parts
+        parts = [dict(part) for part in self._robot_parts]
+        for k, spec in enumerate(eng.scene.description.ARMS.values(), start=1):
+            item = held.get(spec["gripper"])
+            for g in eng.item_part_geoms.get(item, ()) if item else ():
+                local = self._item_points.get(g)
+                if local is None:
+                    local = self._item_points[g] = local_vertices(eng.model, g, 100)
+                parts[k][g] = local
+        return parts
 
     def planner(self, eng: Engine, refresh_outline: bool = True) -> tuple[PathPlanner, bool]:
         """The planner of the current state, and whether it is new (something moved by more
@@ -76,7 +93,8 @@ class Navigation:
         if self._planner is not None and not moved and not refresh_outline:
             return self._planner, False
         bands = self.floor.bands(eng.model, eng.data)
-        outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, self._robot_parts) for top in bands}
+        parts = self._parts(eng)
+        outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, parts) for top in bands}
         # the robot's pose, to the cm
         key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
         if (
@@ -93,19 +111,25 @@ class Navigation:
         return self._planner, True
 
 
-def memoized_free(prospection: SimProspection) -> Callable[[float, float, float], bool]:
-    """(x, y, yaw) -> the robot touches nothing there (`prospection.in_collision`), memoized per
-    pose to 1 mm / 1 mrad (for one plan: the state must not change meanwhile)."""
+def memoized_free(prospection: SimProspection, carried: Sequence[str] = ()) -> Callable[[float, float, float], bool]:
+    """(x, y, yaw) -> the robot, with the items `carried` moving with it, touches nothing there
+    (`prospection.in_collision`), memoized per pose to 1 mm / 1 mrad (for one plan: the state
+    must not change meanwhile)."""
     memo: dict[tuple[int, int, int], bool] = {}
 
     def free(x: float, y: float, yaw: float) -> bool:
         key = (round(x * 1e3), round(y * 1e3), round(yaw * 1e3))
         answer = memo.get(key)
         if answer is None:
-            answer = memo[key] = not prospection.in_collision((x, y, yaw))
+            answer = memo[key] = not prospection.in_collision((x, y, yaw), carried=carried)
         return answer
 
     return free
+
+
+def carried_items(eng: Engine) -> list[str]:
+    """The items the robot's grippers hold now (simulator names), in the grippers' order."""
+    return [g.holding for g in eng.grippers.values() if g.holding]
 
 
 def navigation_of(eng: Engine) -> Navigation:

@@ -208,15 +208,19 @@ class SimProspection(Prospection):
                 d.qpos[joint_adr] = float(value)
         mujoco.mj_kinematics(self.model, d)
 
-    def _touching(self, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _touching(
+        self, d: mujoco.MjData, robot: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Collision detection on `d` (kinematics computed): contact geoms (g1, g2), whether g1
-        is the robot's one, and which contacts are robot-environment collisions."""
+        is the robot's one, and which contacts are robot-environment collisions (`robot`: the
+        mask of the robot's geoms, with those of objects it carries; default: the robot's own)."""
         mujoco.mj_collision(self.model, d)
         n = d.ncon
         geoms = d.contact.geom[:n]
         g1, g2 = geoms[:, 0], geoms[:, 1]
-        hit1 = self._is_robot[g1] & self._is_env[g2]
-        hit2 = self._is_robot[g2] & self._is_env[g1]
+        is_robot = self._is_robot if robot is None else robot
+        hit1 = is_robot[g1] & self._is_env[g2]
+        hit2 = is_robot[g2] & self._is_env[g1]
         return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -self.tolerance)
 
     def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
@@ -247,10 +251,38 @@ class SimProspection(Prospection):
             self._prepare(d, base_pose, joint_configuration)
             return self._contacts(d)
 
-    def in_collision(self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> bool:
+    def in_collision(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+    ) -> bool:
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
-            return bool(self._touching(d)[3].any())
+            robot = self._carry(d, base_pose, carried) if carried else None
+            return bool(self._touching(d, robot)[3].any())
+
+    def _carry(self, d: mujoco.MjData, base_pose: Any, carried: Sequence[str]) -> np.ndarray:
+        """Move the objects `carried` in `d` (prepared: the base at `base_pose`) with the base
+        from where the snapshot has it, rigidly; recompute kinematics. Returns the mask of the
+        robot's geoms with theirs."""
+        m = self.model
+        pose = as_base_pose(base_pose)
+        snap = self._snapshot()
+        x0, y0, yaw0 = (float(snap.qpos[a]) for a in self._base_qpos)
+        turn = pose.yaw - yaw0
+        c, s = math.cos(turn), math.sin(turn)
+        rotation = np.array([math.cos(turn / 2), 0.0, 0.0, math.sin(turn / 2)])
+        robot = self._is_robot.copy()
+        for name in carried:
+            body = self._object_body(name)
+            adr = int(m.jnt_qposadr[m.body_jntadr[body]])
+            px, py = float(snap.qpos[adr]) - x0, float(snap.qpos[adr + 1]) - y0
+            d.qpos[adr] = pose.x + c * px - s * py
+            d.qpos[adr + 1] = pose.y + s * px + c * py
+            quat = np.empty(4)
+            mujoco.mju_mulQuat(quat, rotation, np.asarray(snap.qpos[adr + 3 : adr + 7], float))
+            d.qpos[adr + 3 : adr + 7] = quat
+            robot[m.geom_bodyid == body] = True
+        mujoco.mj_kinematics(m, d)
+        return robot
 
     # ------------------------------------------------------------------ arm motion planning
     def arm_joint_limits(self, arm: str, include_torso: bool = False) -> JointLimits:

@@ -120,7 +120,8 @@ class OpenVocabulary(StandingSearch):
             x, y = maps[arm].xy(r, c)
             yaw = _wrap(math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm))
             prosp = self.prospection()
-            if prosp.in_collision((x, y, yaw), {**self.geometry.tucked, **pulled_out}):
+            arrival = self.arrival_configuration(prosp)
+            if prosp.in_collision((x, y, yaw), {**arrival, **pulled_out}, self.carried()):
                 return None, ("in collision", None)
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
@@ -148,7 +149,7 @@ class OpenVocabulary(StandingSearch):
                 home = prosp.reachable(arm, [(beyond, hold)], (x, y, yaw), configuration)
                 return answer if home or home.reason == "collision" else home
 
-            answer = reachable(self.geometry.tucked)
+            answer = reachable(arrival)
             if answer:
                 return (
                     BaseLocation(x, y, yaw, arm, handle_grasp, cost, joints=answer.solutions, tool_poses=tuple(poses)),
@@ -158,8 +159,8 @@ class OpenVocabulary(StandingSearch):
             for torso, height in self._other_torso_heights():
                 joint = self.geometry.torso_joint
                 assert joint is not None  # there are other torso heights only with a torso joint
-                configuration = {**self.geometry.tucked, joint: height}
-                if prosp.in_collision((x, y, yaw), {**configuration, **pulled_out}):
+                configuration = {**arrival, joint: height}
+                if prosp.in_collision((x, y, yaw), {**configuration, **pulled_out}, self.carried()):
                     continue
                 other = reachable(configuration)
                 if other:
@@ -224,10 +225,11 @@ class OpenVocabulary(StandingSearch):
             x, y = maps[arm].xy(r, c)
             natural = math.atan2(first[1] - y, first[0] - x) - self.geometry.reach_bearing(arm)
             prosp = self.prospection()
+            arrival = self.arrival_configuration(prosp)
             failure: tuple[str, str | None] = ("in collision", None)
             for offset in PUSH_YAW_OFFSETS:
                 yaw = _wrap(natural + offset)
-                if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+                if prosp.in_collision((x, y, yaw), arrival, self.carried()):
                     continue
                 solved, reason = self._reachable_along(prosp, arm, (x, y, yaw), poses, joint)
                 if reason is None:

@@ -134,8 +134,8 @@ class ReachVocabulary(StandingSearch):
                 math.atan2(target.position[1] - y, target.position[0] - x) - self.geometry.reach_bearing(arm)
             )
             prosp = self.prospection()
-            tucked = dict(self.geometry.tucked)
-            raised = self.geometry.raised(arm)
+            tucked = self.arrival_configuration(prosp)
+            raised = {**tucked, **(self.geometry.ready or {}).get(arm, {})}
 
             # (rank, grasp, base yaw, tool point, tool heading, planned candidate or None)
             options: list[tuple[float, Grasp, float, tuple[float, float, float], float, Any]] = []
@@ -196,7 +196,7 @@ class ReachVocabulary(StandingSearch):
 
             failure: tuple[str, str | None] = ("in collision at every other torso height", None)
             if torsos != "other":
-                if prosp.in_collision((x, y, natural), tucked):
+                if prosp.in_collision((x, y, natural), tucked, self.carried()):
                     return None, ("in collision", None)
                 if prosp.in_collision((x, y, natural), raised):
                     failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
@@ -210,7 +210,7 @@ class ReachVocabulary(StandingSearch):
             joint = self.geometry.torso_joint
             for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
-                if prosp.in_collision((x, y, natural), {**tucked, joint: height}) or prosp.in_collision(
+                if prosp.in_collision((x, y, natural), {**tucked, joint: height}, self.carried()) or prosp.in_collision(
                     (x, y, natural), {**raised, joint: height}
                 ):
                     continue

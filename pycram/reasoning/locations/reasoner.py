@@ -85,6 +85,7 @@ class LocationReasoner(ReachVocabulary, SeeVocabulary, OpenVocabulary, SpotVocab
         known_objects: Callable[[], Sequence[KnownObject]] = lambda: (),
         max_candidates: int = MAX_CANDIDATES,
         container_states: Callable[[], Mapping[str, float]] = dict,
+        holding: Callable[[], Mapping[str, str]] = dict,
     ) -> None:
         self.geometry = geometry
         self.environment = environment
@@ -92,6 +93,9 @@ class LocationReasoner(ReachVocabulary, SeeVocabulary, OpenVocabulary, SpotVocab
         self.known_objects = known_objects
         #: How far each container is believed open [m or rad] (perceived; missing: closed).
         self.container_states = container_states
+        #: The objects the robot's grippers hold now (believed), arm -> object name: those arms
+        #: arrive at a base pose as they are, with the objects (`arrival_configuration`, `carried`).
+        self.holding = holding
         self.max_candidates = max_candidates
 
     # ------------------------------------------------------------------ entry point

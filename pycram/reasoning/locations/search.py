@@ -82,6 +82,8 @@ class CandidateSearch:
     known_objects: Callable[[], Sequence[KnownObject]]
     #: How far each container is believed open [m or rad] (perceived; missing: closed).
     container_states: Callable[[], Mapping[str, float]]
+    #: The objects the robot's grippers hold now (believed): arm -> the object's name.
+    holding: Callable[[], Mapping[str, str]]
     #: Candidates checked with prospection per designator before giving up.
     max_candidates: int
     #: The costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
@@ -91,6 +93,23 @@ class CandidateSearch:
     def _base_radius(self) -> float:
         """The base's inscribed radius plus the clearance it keeps [m] (the occupancy inflation)."""
         return self.geometry.inscribed_radius + BASE_CLEARANCE
+
+    def arrival_configuration(self, prospection: Any) -> dict[str, float]:
+        """The robot's arms as they arrive at a base pose (joint name -> position [rad or m]):
+        every free arm tucked (its park configuration), every arm holding an object as it is now
+        (its carry configuration: the base drives with it so). A base pose is checked with this
+        configuration -- the one navigation will drive the robot to it in -- so that reasoning
+        never offers a pose the robot does not fit at as it comes."""
+        configuration = dict(self.geometry.tucked)
+        for arm in self.holding():
+            for joint in self.geometry.arm_joints.get(arm, ()):
+                configuration[joint] = float(prospection.joint_position(joint))
+        return configuration
+
+    def carried(self) -> list[str]:
+        """The names of the objects the robot holds now (believed), to check base poses with:
+        they arrive with the robot (`Prospection.in_collision`'s ``carried``)."""
+        return sorted(self.holding().values())
 
     def _fail(self, desig: Any, what: str) -> NoSolutionError:
         return NoSolutionError(f"Cannot resolve {desig!r}: {what}", designator=desig)

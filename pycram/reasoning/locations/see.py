@@ -45,9 +45,10 @@ class SeeVocabulary(CandidateSearch):
             x, y = costmap.xy(r, c)
             yaw = math.atan2(target.position[1] - y, target.position[0] - x)
             prosp = self.prospection()
-            if prosp.in_collision((x, y, yaw), self.geometry.tucked):
+            arrival = self.arrival_configuration(prosp)
+            if prosp.in_collision((x, y, yaw), arrival, self.carried()):
                 return None, ("in collision", None)
-            seen = prosp.visible(what, (x, y, yaw), 0.5, self.geometry.tucked)
+            seen = prosp.visible(what, (x, y, yaw), 0.5, arrival)
             if seen:
                 return BaseLocation(x, y, yaw, cost=cost, visible=seen.fraction), None
             if seen.in_view < 0.5:

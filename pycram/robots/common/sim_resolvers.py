@@ -450,6 +450,14 @@ def known_objects_of(belief: Any) -> list:
     return known
 
 
+def held_objects_by_arm(description: Any, belief: Any) -> dict[str, str]:
+    """arm -> the name of the object its gripper holds as `belief` has it (its ``in_hand``:
+    gripper -> object), for the arms of the robot of `description` that hold one."""
+    in_hand = dict(getattr(belief, "in_hand", {}) or {})
+    held = {arm: in_hand.get(spec["gripper"]) for arm, spec in description.ARMS.items()}
+    return {arm: obj.name for arm, obj in held.items() if obj is not None}
+
+
 def make_location_generator(
     world: Any, description: Any, belief: Any, prospection: Callable[[], Any] | None = None
 ) -> Callable[[Any], Any]:
@@ -473,6 +481,7 @@ def make_location_generator(
         prospection or of_world,
         lambda: known_objects_of(belief),
         container_states=lambda: dict(getattr(belief, "container_states", {})),
+        holding=lambda: held_objects_by_arm(description, belief),
     )
 
     def locations(desig: Any) -> Any:
