@@ -33,7 +33,18 @@ from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
 from pycram.execution.failures import GoalUnreachable, NavigationFailure, ObjectNotVisible, PathBlocked, PlanFailure
 
-from .core import RECOVERABLE, ActionParameterError, action_plan, arm_name, arms, attempt, make_action, motion, unwrap
+from .core import (
+    RECOVERABLE,
+    ActionParameterError,
+    action_plan,
+    arm_name,
+    arms,
+    attempt,
+    check_object_type,
+    make_action,
+    motion,
+    unwrap,
+)
 from .core import solutions as location_solutions
 from .search import search_for
 
@@ -58,8 +69,9 @@ NAVIGATION_ATTEMPTS = 3
 
 def Navigate(target: Any) -> ActionDesignator:
     """Drive the base to `target`: a base pose ((x [m], y [m], yaw [rad]), a `Pose2D`, a
-    `BaseLocation`) or a `LocationDesignator` (e.g. ``('to_see', cup)``), whose next solution
-    is tried when one cannot be driven to. Returns the reached base pose."""
+    `BaseLocation`), the name of a place of the environment (``'table north'``: its base pose)
+    or a `LocationDesignator` (e.g. ``('to_see', cup)``), whose next solution is tried when one
+    cannot be driven to. Returns the reached base pose."""
     return make_action("navigating", target=target)
 
 
@@ -87,13 +99,17 @@ def SetGripper(gripper: str, position: float) -> ActionDesignator:
 def Detect(object: Any = None) -> ActionDesignator:
     """Take one look with the head camera and update the belief; returns the believed objects
     seen (`PerceivedObject`), only those matching `object` (a type name or an object designator)
-    when given -- then none seen raises `ObjectNotVisible`."""
+    when given -- then none seen raises `ObjectNotVisible`. An object designator of an unknown
+    type raises `ActionParameterError` at once."""
+    check_object_type("detecting", object, names_too=True)
     return make_action("detecting", object=object)
 
 
 def Search(object: ObjectDesignator) -> ActionDesignator:
     """Find an object matching `object` (look around, then visit likely places); returns the
-    believed object. Raises `ObjectNotFound` naming where it looked."""
+    believed object. Raises `ObjectNotFound` naming where it looked. An unknown object type
+    raises `ActionParameterError` at once."""
+    check_object_type("searching", object)
     return make_action("searching", object=object)
 
 
@@ -114,6 +130,8 @@ def navigating(designator: ActionDesignator) -> Any:
     target = designator.prop_value("target")
     if target is None:
         raise ActionParameterError("navigating", "target", "missing: a base pose or a location designator")
+    if isinstance(target, str):
+        target = _place_pose(target)
     if not isinstance(target, LocationDesignator):
         try:
             return motion(type="moving", pose=target)
@@ -140,6 +158,21 @@ def navigating(designator: ActionDesignator) -> Any:
     if last is None:
         raise GoalUnreachable(f"{target!r} has no solution to drive to", designator, "no_solution", attempts)
     raise _navigation_failure(last, target, designator, attempts) from last
+
+
+def _place_pose(name: str) -> tuple[float, float, float]:
+    """The base pose (x [m], y [m], yaw [rad]) of the environment's place `name`;
+    `ActionParameterError` naming the places otherwise (and how to stand at a surface)."""
+    from pycram.execution.robot import current_robot
+
+    environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
+    places = {p.name: p for p in getattr(environment, "places", ())}
+    if name not in places:
+        hint = "a place of the environment"
+        if environment is not None and any(s.name == name for s in environment.all_surfaces()):
+            hint = f"a place, not a surface (to stand at {name!r}: LocationDesignator([('to_see', {name!r})]))"
+        raise ActionParameterError("navigating", "target", f"{name!r} is not {hint}", sorted(places))
+    return places[name].pose
 
 
 def _is_motion_failure(error: BaseException) -> bool:

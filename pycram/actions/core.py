@@ -39,10 +39,12 @@ from pycram.core.runtime.task_variables import TaskVariable
 from pycram.designators.action import ActionDesignator
 from pycram.designators.core import DesignatorError, NoSolutionError, PropertyError
 from pycram.designators.motion import MotionDesignator
+from pycram.designators.object import ObjectDesignator
 from pycram.execution.failures import PlanFailure
 from pycram.execution.perform import perform
 from pycram.execution.process_module import ProcessModuleError, ProcessModuleFailure
 from pycram.execution.robot import current_robot
+from pycram.world.objects import APPROACHES, OBJECT_TYPES
 
 __all__ = [
     "ACTION_PLANS",
@@ -50,6 +52,8 @@ __all__ = [
     "RECOVERABLE",
     "action_plan",
     "make_action",
+    "check_grasp",
+    "check_object_type",
     "resolve_action",
     "motion",
     "while_driving",
@@ -102,6 +106,29 @@ def make_action(action_type: str, **parameters: Any) -> ActionDesignator:
     properties = [("type", action_type)]
     properties += [(key, value) for key, value in parameters.items() if value is not None]
     return ActionDesignator(properties)
+
+
+def check_grasp(action: str, grasp: Any) -> str | None:
+    """`grasp` when it is None or an approach of `pycram.world.objects.APPROACHES`; otherwise
+    `ActionParameterError` naming the valid approaches (whether the object's type has that
+    grasp is decided when the object is known: `GraspFailed`, reason ``no_executable_grasp``)."""
+    if grasp is None:
+        return None
+    if not isinstance(grasp, str) or grasp not in APPROACHES:
+        raise ActionParameterError(action, "grasp", f"no grasp approach {grasp!r}", APPROACHES)
+    return grasp
+
+
+def check_object_type(action: str, wanted: Any, key: str = "object", names_too: bool = False) -> None:
+    """Refuse at once an object given by a type nobody knows: a type name (a string; with
+    `names_too` a string may also be a believed object's name, and is not checked) or an
+    object designator's ``type``. `ActionParameterError` names the known types
+    (`pycram.world.objects.OBJECT_TYPES`); anything else passes."""
+    type_name = wanted if isinstance(wanted, str) and not names_too else None
+    if isinstance(wanted, ObjectDesignator):
+        type_name = wanted.prop_value("type")
+    if isinstance(type_name, str) and type_name not in OBJECT_TYPES:
+        raise ActionParameterError(action, key, f"unknown object type {type_name!r}", sorted(OBJECT_TYPES))
 
 
 def resolve_action(designator: ActionDesignator) -> Any:

@@ -58,6 +58,8 @@ from .core import (
     arms,
     attempt,
     best_effort,
+    check_grasp,
+    check_object_type,
     gripper_of,
     gripper_opening,
     make_action,
@@ -104,8 +106,10 @@ CARRY_TORSO = "up"
 def PickUp(object: Any, arm: str | None = None, grasp: str | None = None) -> ActionDesignator:
     """Pick up `object` (an object designator, or a believed object) with `arm` (None: the
     reasoning chooses) and `grasp` (an approach such as ``'side'`` or ``'+y'``; None: any the
-    robot can execute). Returns a `Held`."""
-    return make_action("picking_up", object=object, arm=arm, grasp=grasp)
+    robot can execute). Returns a `Held`. An unknown grasp approach or object type raises
+    `ActionParameterError` at once."""
+    check_object_type("picking_up", object)
+    return make_action("picking_up", object=object, arm=arm, grasp=check_grasp("picking_up", grasp))
 
 
 def executable_grasps(type_name: str, requested: str | None = None) -> list[Grasp]:
@@ -135,6 +139,7 @@ def believed_object(action: str, wanted: Any) -> PerceivedObject:
         return wanted.object
     if isinstance(wanted, PerceivedObject):
         return wanted
+    check_object_type(action, wanted)
     if isinstance(wanted, str):
         wanted = ObjectDesignator(type=wanted)
     if not isinstance(wanted, ObjectDesignator):
@@ -414,7 +419,7 @@ def _pick_up(designator: ActionDesignator) -> Held:
     if wanted is None:
         raise ActionParameterError("picking_up", "object", "missing: what to pick up")
     arm = arm_name("picking_up", designator.prop_value("arm"))
-    requested_grasp = designator.prop_value("grasp")
+    requested_grasp = check_grasp("picking_up", designator.prop_value("grasp"))
     obj = believed_object("picking_up", wanted)
     grasps = executable_grasps(obj.type, requested_grasp)
     if not obj.properties.get("in"):

@@ -163,6 +163,19 @@ def _drive_watching(location: Any, held: Held) -> None:
         raise errors[0] if errors else PlanFailure("driving with the object did not succeed")
 
 
+def _look_over(spot: tuple[float, float, float]) -> None:
+    """Look at `spot` once (best effort): the base could not drive to a standing pose reasoning
+    offered, so the world differs from the belief there -- e.g. a door swung back since it was
+    opened. The look measures the containers in view and the objects there, and the next
+    standing pose is resolved against that belief."""
+    log.info("placing: no way to the standing pose; looking at %s again", _xyz(spot))
+    best_effort(
+        "looking at the spot",
+        lambda: motion(type="pointing_head", coordinates=list(spot)),
+        lambda: motion(type="detecting"),
+    )
+
+
 def _place_locations(held: Held, spot: tuple[float, float, float], point: list[float]) -> LocationDesignator:
     """Standing poses to put the held object at `spot`: for an object held from the top, the
     place sequence of that top grasp for the object standing at the spot (the tool keeps
@@ -229,8 +242,8 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
         reason, why = problem
         raise PlacingFailed(f"{obj.name} does not rest upright at {_xyz(spot)}: {why}", obj, reason)
     if obj.gone or math.dist(obj.pose[:2], spot[:2]) > PLACE_TOLERANCE:
-        where = "not seen" if obj.gone else f"seen at {_xyz(obj.pose)}"
-        raise PlacingFailed(f"{obj.name} does not rest at {_xyz(spot)}: {where}", obj)
+        where = "not seen there after letting go" if obj.gone else f"seen at {_xyz(obj.pose)}"
+        raise PlacingFailed(f"{obj.name} is not at its target {_xyz(spot)}: {where}", obj, "not_at_target")
     return obj
 
 
@@ -326,6 +339,8 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                             _lost_from_gripper(held, park=True)
                         if isinstance(cause, (ObjectSlipped, PlacingFailed)):
                             raise cause from error
+                        if getattr(cause, "reason", None) == "no_path":
+                            _look_over(spot)
                         if held.arm not in held_objects():  # let go already: nothing to retry with
                             raise PlacingFailed(
                                 f"{held.object.name} was let go at {_xyz(spot)}, then: {cause}",

@@ -31,7 +31,16 @@ from pycram.execution.robot import current_robot
 
 from .container_state import CLOSED, DOOR_CLOSED
 from .containers import Close, Open
-from .core import ActionParameterError, action_plan, arms, attempt, make_action
+from .core import (
+    ActionParameterError,
+    action_plan,
+    arm_name,
+    arms,
+    attempt,
+    check_grasp,
+    check_object_type,
+    make_action,
+)
 from .held import held_objects
 from .pick_up import PickUp, believed_object
 from .place import Place
@@ -46,12 +55,25 @@ OPEN_ABOVE = max(CLOSED, DOOR_CLOSED)
 TRANSPORT_ROUNDS = 3
 
 
-def Transport(object: Any, target: Any, arm: str | None = None, close_container: bool = False) -> ActionDesignator:
+def Transport(
+    object: Any, target: Any, arm: str | None = None, close_container: bool = False, grasp: str | None = None
+) -> ActionDesignator:
     """Bring `object` (an object designator, a believed object or a type name) to `target` (as
     for `Place`: a location designator, a `Spot`, a point or a surface's name) with `arm`
-    (None: chosen by the reasoning); with `close_container`, close the container it was taken
-    from when the transport opened it."""
-    return make_action("transporting", object=object, target=target, arm=arm, close_container=close_container)
+    (None: chosen by the reasoning) and `grasp` (as for `PickUp`: an approach such as
+    ``'side'`` or ``'top'``; None: any the robot can execute); with `close_container`, close
+    the container it was taken from when the transport opened it. An unknown grasp approach or
+    object type raises `ActionParameterError` at once, an arm the robot does not have when
+    performed."""
+    check_object_type("transporting", object)
+    return make_action(
+        "transporting",
+        object=object,
+        target=target,
+        arm=arm,
+        close_container=close_container,
+        grasp=check_grasp("transporting", grasp),
+    )
 
 
 def _open_containers() -> dict[str, float]:
@@ -89,7 +111,9 @@ def transporting(designator: ActionDesignator) -> Any:
     target = designator.prop_value("target")
     if wanted is None or target is None:
         raise ActionParameterError("transporting", "object" if wanted is None else "target", "missing")
-    arm = designator.prop_value("arm")
+    check_object_type("transporting", wanted)
+    arm = arm_name("transporting", designator.prop_value("arm"))
+    grasp = check_grasp("transporting", designator.prop_value("grasp"))
     opened_before = set(_open_containers())
     into = _target_container(target)
     if into is not None and into not in opened_before:
@@ -106,7 +130,7 @@ def transporting(designator: ActionDesignator) -> Any:
             close = (
                 bool(designator.prop_value("close_container")) and bool(container) and container not in opened_before
             )
-            held = perform(PickUp(obj, arm=arm))
+            held = perform(PickUp(obj, arm=arm, grasp=grasp))
             free = [a for a in arms() if a not in held_objects()]
             if close and free:  # a free hand closes it at once, standing there
                 _close(container, free[0], obj)

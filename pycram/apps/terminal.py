@@ -1,16 +1,25 @@
 """What the terminal front ends of the demo and the scenarios share (`pycram demo`): one rich
 console on standard error for the live progress line and the log records, the plan's task tree
-as `pycram show` draws it, and the pictures of a recorded run.
+as `pycram show` draws it, the pictures of a recorded run, and how failures are told.
+
+Failures are told short unless asked otherwise (`set_verbose`, the CLI's ``--verbose``): what
+failed, why and what to try in at most two lines (`failure_text`, after
+`pycram.failures.failure_summary`), and each failed task of the tree with the first line of
+what really failed -- without the nested "Cannot resolve ..." layers. Verbose, the whole
+message and every cause are shown; the trace database always keeps them whole.
 
 Every function here is for people watching a run; none of them changes what a plan does.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 from pathlib import Path
 from typing import Any
+
+from pycram.execution.failures import SUMMARY_LINE, failure_chain, failure_summary, innermost_clause
 
 __all__ = [
     "STOP_PICTURE_SIZE",
@@ -19,7 +28,15 @@ __all__ = [
     "task_tree_display",
     "write_run_pictures",
     "write_stop_pictures",
+    "set_verbose",
+    "is_verbose",
+    "failure_text",
+    "run_failure_text",
+    "failure_hint",
 ]
+
+#: Whether failures are told in full (`set_verbose`).
+_VERBOSE = [False]
 
 #: The offscreen size [px] a world needs for `write_stop_pictures` (the scene picture's views).
 STOP_PICTURE_SIZE = (1200, 900)
@@ -46,10 +63,83 @@ def log_to_terminal() -> None:
         demo_log.propagate = False
 
 
+def set_verbose(verbose: bool) -> None:
+    """Tell failures in full (True: every message whole, every cause) or short (False, the
+    default: `failure_text`)."""
+    _VERBOSE[0] = bool(verbose)
+
+
+def is_verbose() -> bool:
+    """Whether failures are told in full (`set_verbose`)."""
+    return _VERBOSE[0]
+
+
+def failure_text(error: BaseException | str, verbose: bool | None = None) -> str:
+    """How a terminal tells a failure: short (at most two lines of at most `SUMMARY_LINE`
+    characters: what failed, why, what to try -- `pycram.failures.failure_summary`; a message
+    given as text: its first line, cut) unless `verbose` (None: `is_verbose()`), then in full:
+    the message, then every cause in the chain, one per line, innermost last."""
+    verbose = is_verbose() if verbose is None else verbose
+    if isinstance(error, str):
+        if verbose:
+            return error
+        first = error.strip().split("\n", 1)[0]
+        return first if len(first) <= SUMMARY_LINE else first[: SUMMARY_LINE - 1].rstrip() + "…"
+    if not verbose:
+        return failure_summary(error)
+    lines = [f"{type(error).__name__}: {error}"]
+    lines += [f"  caused by {type(e).__name__}: {e}" for e in list(failure_chain(error))[1:]]
+    attempts = getattr(error, "attempts", None) or []
+    lines += [f"  attempt {i}: {a}" for i, a in enumerate(attempts, 1)]
+    return "\n".join(lines)
+
+
+def run_failure_text(message: str, plan_task: Any = None) -> str:
+    """The failure of a run for its last line: the exception of the plan's task told by
+    `failure_text` when `message` ("Type: ...") is about it, else `message` told."""
+    error = getattr(plan_task, "exception", None)
+    if isinstance(error, BaseException) and message.startswith(f"{type(error).__name__}:"):
+        return failure_text(error)
+    return failure_text(message)
+
+
+def failure_hint(type_name: str | None, reason: str | None = None) -> str:
+    """What to try after a typed failure known by its class name (`pycram.failures`) and
+    reason: its hint ("" for a name that is no typed failure)."""
+    from pycram.execution import failures
+
+    cls = getattr(failures, type_name or "", None)
+    if not isinstance(cls, type) or not issubclass(cls, (failures.PlanFailure, failures.SimulationFault)):
+        return ""
+    if issubclass(cls, failures.PlanFailure):
+        return cls.hints.get(reason or "", cls.default_hint)
+    return cls.default_hint
+
+
+def _short_errors(records: list) -> list:
+    """`records` with each task's error cut to the first line of what really failed (no
+    "Cannot resolve ..." layers, at most `SUMMARY_LINE` characters), unless verbose."""
+    if is_verbose():
+        return records
+    out = []
+    for r in records:
+        message = getattr(r, "error_message", None)
+        fields = {f.name for f in dataclasses.fields(r)} if dataclasses.is_dataclass(r) else set()
+        if message and "error_message" in fields and not isinstance(r, type):
+            short = innermost_clause(message)
+            if len(short) > SUMMARY_LINE:
+                short = short[: SUMMARY_LINE - 1].rstrip() + "…"
+            r = dataclasses.replace(r, error_message=short)
+        out.append(r)
+    return out
+
+
 def task_tree_display(plan_task: Any, run_id: Any, url: str | None, tree_text: str = "") -> Any:
     """The plan's task tree for the terminal: as `pycram show` draws it (repeated head motions
     on one line, with the blocking process-module executions when the run was recorded as
-    `run_id`), or `tree_text` when the trace extra is not installed."""
+    `run_id`), or `tree_text` when the trace extra is not installed. Unless verbose
+    (`set_verbose`), each failure shows the first line of what really failed (`pycram show`
+    shows the whole message)."""
     if plan_task is None:
         return "(the plan did not start)"
     try:
@@ -60,7 +150,7 @@ def task_tree_display(plan_task: Any, run_id: Any, url: str | None, tree_text: s
     records = records_from_task(plan_task)
     if run_id is not None:
         records += _recorded_executions(run_id, url, records)
-    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", records)
+    tree, _ = task_tree("[bold]Task tree[/bold] [grey50](times: simulated clock)[/grey50]", _short_errors(records))
     return tree
 
 

@@ -71,10 +71,23 @@ def demo_command(
         "apartment (objects on counters and in a closed drawer); set-table-open: the same, every object "
         "starting on an open surface.",
     ),
+    env: str | None = typer.Option(
+        None,
+        "--env",
+        help="The environment: apartment, thesis-kitchen, procedural:SEED (a generated apartment) or "
+        "file:PATH.toml [default: the scenario's own]. A scenario written for one environment refuses others.",
+    ),
     faults: str = typer.Option(
         "",
         "--faults",
         help="set-table only: comma-separated faults drawn from the seed: moved, taken, stuck, obstacle, missed.",
+    ),
+    verbose: bool = typer.Option(
+        False,
+        "--verbose",
+        "-v",
+        help="Tell a failure in full (every message and cause) instead of in two lines; `pycram show RUN` "
+        "always has the whole of it.",
     ),
     until: float | None = typer.Option(
         None,
@@ -91,6 +104,9 @@ def demo_command(
     Exit code: 0 on success (or, with --until, once the pictures of that moment are written);
     1 when the plan failed; 2 for bad options; 130 / 143 when stopped by SIGINT / SIGTERM.
     A recorded run can be run again with `pycram replay RUN`."""
+    from pycram.apps.terminal import set_verbose
+
+    set_verbose(verbose)
     try:
         check_until(until)
     except ValueError as error:
@@ -117,6 +133,9 @@ def demo_command(
     )
     if until is not None:
         common["until"] = until
+    environment = _environment_option(env, scenario)
+    if environment is not None:
+        common["environment"] = environment
     if scenario != "thesis":
         code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
         raise typer.Exit(int(code or 0))
@@ -138,3 +157,29 @@ def demo_command(
         **common,
     )
     raise typer.Exit(int(code or 0))
+
+
+def _environment_option(env: str | None, scenario: str) -> str | None:
+    """`pycram demo --env`: the environment to pass to the scenario's front end (None: its own);
+    exits with code 2 for a name `load` does not read, or an environment the scenario is not
+    written for when its front end takes no ``environment`` keyword."""
+    if env is None:
+        return None
+    from pycram.apps.experiments.scenarios import accepts_keyword, get_scenario
+    from pycram.environments import DEFAULT_ENVIRONMENT, check_name
+
+    try:
+        name = check_name(env)
+    except KeyError as e:
+        fail(f"--env: {str(e).strip(chr(34) + chr(39))}", code=2)
+    own: str | None = DEFAULT_ENVIRONMENT  # the thesis demo's
+    takes = False
+    if scenario != "thesis":
+        entry = get_scenario(scenario)
+        own, takes = entry.environment, accepts_keyword(entry.load_demo(), "environment")
+    if takes:
+        return name
+    if name != own:
+        where = f"the {own} only" if own else "one environment"
+        fail(f"--env: scenario {scenario} is written for {where} (it takes no other environment yet), not {name}", 2)
+    return None

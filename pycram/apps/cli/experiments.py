@@ -36,6 +36,13 @@ def experiment_command(
         help=f"Robots, comma-separated: {','.join(robot_names())} [default: {DEFAULT_ROBOT}].",
     ),
     seeds: str | None = typer.Option(None, "--seeds", help="Seeds: a range 1-200, a list 1,5,9 or both (1,5,10-20)."),
+    env: str | None = typer.Option(
+        None,
+        "--env",
+        help="Environments, comma-separated, each run in each: apartment, procedural:1-50 (generated apartments; "
+        "ranges and lists of seeds as for --seeds), file:PATH.toml [default: the scenario's own]. Only scenarios "
+        "that take an 'environment' keyword run outside their own.",
+    ),
     faults: list[str] | None = typer.Option(
         None,
         "--faults",
@@ -109,7 +116,15 @@ def experiment_command(
         except store.ExperimentNotFound as e:
             fail(str(e), code=2)
     options = dict(
-        scenario=scenario, robots=robot, seeds=seeds, faults=faults, name=name, resume=resume, db=db, stepping=stepping
+        scenario=scenario,
+        robots=robot,
+        seeds=seeds,
+        faults=faults,
+        name=name,
+        resume=resume,
+        db=db,
+        stepping=stepping,
+        environments=env,
     )
     with contextlib.ExitStack() as session:
         try:
@@ -139,6 +154,7 @@ def _run_experiment(
 
     from pycram.apps.experiments import report, store
     from pycram.apps.experiments.runner import ExperimentInputError, RayUnavailable, run_experiment
+    from pycram.apps.terminal import failure_text
     from pycram.core.interrupts import StopSignals
 
     record = prepared.record
@@ -148,7 +164,8 @@ def _run_experiment(
     err.print(
         f"{verb} {record.id} ({escape(record.name)}): scenario {escape(record.scenario)}, "
         f"robots {escape(','.join(record.robots))}, {len(record.seeds)} seeds, "
-        f"{len(record.variants)} variant(s): {total} runs, {prepared.done_before} recorded before, "
+        + (f"{len(record.environments)} environments, " if record.environments else "")
+        + f"{len(record.variants)} variant(s): {total} runs, {prepared.done_before} recorded before, "
         f"{len(prepared.todo)} to run on {where}"
     )
     counts = {"ok": 0, "failed": 0}
@@ -207,7 +224,7 @@ def _run_experiment(
     if raised:
         err.print(
             f"[red]{len(raised)} runs raised an error[/red] (e.g. {escape(raised[0].robot)} seed {raised[0].seed}: "
-            f"{escape(raised[0].error or '')}); `pycram experiment --resume {record.id}` runs them again"
+            f"{escape(failure_text(raised[0].error or ''))}); `pycram experiment --resume {record.id}` runs them again"
         )
     left = total - len(runs)
     if outcome.interrupted or left:

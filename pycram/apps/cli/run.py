@@ -44,6 +44,7 @@ def run_command(
     from pycram.core.interrupts import StopSignals
     from pycram.core.macros import format_script_error, run_script
     from pycram.core.runtime import end_thread_root
+    from pycram.execution.failures import SimulationFault
 
     recorder = None
     if record_flag(record):
@@ -68,7 +69,7 @@ def run_command(
         except BaseException as e:
             if not (stop.requested or isinstance(e, KeyboardInterrupt)):
                 outcome, error, code, ended = "failed", e, 1, e
-                if not isinstance(e, Exception):
+                if not isinstance(e, (Exception, SimulationFault)):  # a broken simulation is a failure too
                     raise
                 sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
             else:

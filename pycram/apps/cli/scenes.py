@@ -15,17 +15,24 @@ from pycram.apps.cli.app import (
     console,
     fail,
 )
+from pycram.environments import ENVIRONMENT_HELP
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
 #: The objects `pycram scene` places by default (a breakfast).
 _SCENE_OBJECTS = "cup,bowl,spoon,cereal,milk,plate"
 #: The scene options `pycram scene` and `pycram costmap` share.
-_SceneEnvOption = typer.Option("apartment", "--env", help="Environment: apartment or thesis-kitchen.")
+_SceneEnvOption = typer.Option("apartment", "--env", help=f"Environment: {ENVIRONMENT_HELP}.")
 _SceneSeedOption = typer.Option(0, "--seed", help="Random seed of the scene (same seed, same scene).")
 _SceneObjectsOption = typer.Option(
     _SCENE_OBJECTS, "--objects", help="Comma-separated object types to place at random ('' for none)."
 )
 _SceneRobotOption = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP)
+_SceneSupportsOption = typer.Option(
+    "",
+    "--supports",
+    help="Comma-separated surface names the objects may start on, e.g. 'counter,table' ('': any surface or "
+    "container inside that fits them).",
+)
 
 
 @app.command("scene")
@@ -34,6 +41,7 @@ def scene_command(
     seed: int = _SceneSeedOption,
     objects: str = _SceneObjectsOption,
     robot: str = _SceneRobotOption,
+    supports: str = _SceneSupportsOption,
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
     costmap: str = typer.Option(
         "",
@@ -46,7 +54,8 @@ def scene_command(
     ),
 ) -> None:
     """A labelled picture of a scene: plan and overview with surfaces, containers and objects
-    (with --belief: what the robot perceived from where it stands beside what is).
+    (with --belief: what the robot perceived from where it stands beside what is). With
+    --supports the objects start only on the surfaces named (as `World(supports=...)`).
 
     With --costmap: the costmap layers of a location designator over the floor plan and the
     poses it chose (or why there are none)."""
@@ -55,14 +64,21 @@ def scene_command(
         from pycram.backends.sim import World
     except ModuleNotFoundError as e:
         fail(f"`pycram scene` needs the 'sim' and 'db' extras (pip install 'pycram[all]'): {e}")
+    from pycram.environments import KitchenFileError
     from pycram.world.scenes import PlacementError
 
     types = [t.strip() for t in objects.split(",") if t.strip()]
     try:
         world = World(
-            robot, environment=env, seed=seed, objects=types or None, offscreen_size=VIEW_SIZE, stepping="lockstep"
+            robot,
+            environment=env,
+            seed=seed,
+            objects=types or None,
+            supports=[n.strip() for n in supports.split(",") if n.strip()] or None,
+            offscreen_size=VIEW_SIZE,
+            stepping="lockstep",
         )
-    except (KeyError, PlacementError) as e:
+    except (KeyError, PlacementError, KitchenFileError) as e:
         fail(str(e).strip("'\""))
     if costmap:
         _costmap_picture(world, robot, costmap, output, f"{env} · seed {seed} · {robot} · {costmap}")
@@ -111,7 +127,9 @@ def costmap_command(
     output: Path = typer.Option(Path("costmap.png"), "--output", "-o", help="PNG file to write."),
 ) -> None:
     """The costmap layers of a location designator over the floor plan, and the poses it chose."""
-    scene_command(env=env, seed=seed, objects=objects, robot=robot, output=output, costmap=location, belief=False)
+    scene_command(
+        env=env, seed=seed, objects=objects, robot=robot, supports="", output=output, costmap=location, belief=False
+    )
 
 
 def _belief_picture(world: Any, robot_name: str, output: Path, title: str) -> Path:

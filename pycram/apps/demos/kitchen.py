@@ -33,6 +33,7 @@ from pycram.apps.run_options import check_stepping, check_until
 from pycram.apps.terminal import (
     STOP_PICTURE_SIZE,
     log_to_terminal,
+    run_failure_text,
     stderr_console,
     task_tree_display,
     write_run_pictures,
@@ -652,6 +653,7 @@ def main(
     rests on cooker #1, or the run was stopped at `until` and its pictures written; 130 / 143:
     stopped by SIGINT / SIGTERM; 2: bad options; 1: failed)."""
     from rich.console import Console
+    from rich.markup import escape as markup_escape
 
     from pycram.core.interrupts import StopSignals
 
@@ -698,5 +700,6 @@ def main(
         return result.exit_code
     colour = "green" if result.exit_code == 0 else "yellow" if result.interrupted else "red"
     verdict = "SUCCESS" if result.exit_code == 0 else "INTERRUPTED" if result.interrupted else "FAILURE"
-    console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {result.message}")
+    told = result.message if result.exit_code == 0 else run_failure_text(result.message, result.plan_task)
+    console.print(f"[bold {colour}]{verdict}[/bold {colour}]: {markup_escape(told)}", soft_wrap=True)
     return result.exit_code

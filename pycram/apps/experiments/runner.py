@@ -42,7 +42,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from pycram.apps.experiments.scenarios import RunInterrupted, Scenario, UnknownScenario, get_scenario
+from pycram.apps.experiments.scenarios import (
+    RunInterrupted,
+    Scenario,
+    UnknownScenario,
+    accepts_keyword,
+    get_scenario,
+)
 from pycram.apps.run_options import check_stepping
 from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 from pycram.world.robot_registry import DEFAULT_ROBOT
@@ -56,6 +62,8 @@ __all__ = [
     "ExperimentOutcome",
     "RunKey",
     "parse_seeds",
+    "parse_environments",
+    "MAX_ENVIRONMENTS",
     "parse_list",
     "parse_variants",
     "prepare_experiment",
@@ -69,7 +77,11 @@ __all__ = [
 #: At most this many seeds per experiment (a typo like 1-2000000 is refused, not started).
 MAX_SEEDS = 100_000
 
-#: A run of an experiment: (robot, seed, variant key — sorted fault names joined by ",").
+#: At most this many environments per experiment (`--env procedural:1-50`).
+MAX_ENVIRONMENTS = 10_000
+
+#: A run of an experiment: (robot, seed, variant column — sorted fault names joined by ",", and
+#: with `--env` the run's environment after "@": `pycram.apps.experiments.store.run_variant`).
 RunKey = tuple[str, int, str]
 
 
@@ -103,6 +115,44 @@ def parse_seeds(text: str) -> list[int]:
         for seed in range(first, last + 1):
             seeds[seed] = None
     return list(seeds)
+
+
+def parse_environments(text: str) -> list[str]:
+    """Environment names from a comma-separated list in which ``procedural:`` takes seeds and
+    ranges as `parse_seeds` does: "procedural:1-50", "apartment,procedural:3",
+    "procedural:1,5,10-12" (numbers after a ``procedural:`` entry continue it). In the order
+    given, without repeats; each is checked (`pycram.environments.check_name`). Raises
+    `ExperimentInputError` naming the valid names."""
+    from pycram.environments import PROCEDURAL_PREFIX, check_name
+
+    names: dict[str, None] = {}
+    hint = "e.g. procedural:1-50, apartment,procedural:3 or file:kitchen.toml"
+    procedural = False  # whether a bare number continues a procedural: entry
+    for part in (p.strip() for p in str(text).split(",")):
+        if not part:
+            continue
+        spec = part[len(PROCEDURAL_PREFIX) :] if part.startswith(PROCEDURAL_PREFIX) else part
+        numbers = re.fullmatch(r"(\d+)\s*-\s*(\d+)", spec) or re.fullmatch(r"(\d+)", spec)
+        if part.startswith(PROCEDURAL_PREFIX) or (procedural and numbers is not None):
+            procedural = True
+            if numbers is None:
+                raise ExperimentInputError(f"bad --env {text!r}: {part!r} is not procedural:SEED or a range; {hint}")
+            first = int(numbers.group(1))
+            last = int(numbers.group(2)) if numbers.lastindex == 2 else first
+            if last < first:
+                raise ExperimentInputError(f"bad --env {text!r}: {part!r} ends before it starts; {hint}")
+            if len(names) + (last - first + 1) > MAX_ENVIRONMENTS:
+                raise ExperimentInputError(f"bad --env {text!r}: more than {MAX_ENVIRONMENTS} environments")
+            names.update((f"{PROCEDURAL_PREFIX}{seed}", None) for seed in range(first, last + 1))
+            continue
+        procedural = False
+        try:
+            names[check_name(part)] = None
+        except KeyError as e:
+            raise ExperimentInputError(f"bad --env {text!r}: {str(e).strip(chr(34) + chr(39))}") from None
+    if not names:
+        raise ExperimentInputError(f"bad --env {text!r}: no environment given; {hint}")
+    return list(names)
 
 
 def parse_list(text: str) -> list[str]:
@@ -183,6 +233,7 @@ def prepare_experiment(
     command: str | None = None,
     check_only: bool = False,
     stepping: str | None = None,
+    environments: str | None = None,
 ) -> PreparedExperiment:
     """Check the input and create the experiment in the database, or find the one to resume.
 
@@ -191,7 +242,9 @@ def prepare_experiment(
     experiment when the options match. With `check_only`, only checks: nothing is created and
     the result's `record` is the experiment to resume or None. `stepping` ("lockstep", the default
     for a new experiment, or "free") is how its simulations keep time with the plans; a resumed
-    experiment keeps its own. Raises `ExperimentInputError` for bad input,
+    experiment keeps its own. `environments` (`parse_environments`: "procedural:1-50", ...) runs
+    every robot, seed and variant in each of them; a scenario that takes no ``environment``
+    keyword runs in its own only. Raises `ExperimentInputError` for bad input,
     `pycram.trace.db.TraceDatabaseError` when the database cannot be used.
     """
     from pycram.apps.experiments import store
@@ -241,6 +294,19 @@ def prepare_experiment(
         variants = [tuple(v) for v in existing.variants]
     else:
         variants = parse_variants([], known)
+    if environments is not None:
+        environment_list = parse_environments(environments)
+    elif existing is not None:
+        environment_list = list(existing.environments)
+    else:
+        environment_list = []
+    _check_environments(entry, environment_list)
+    if existing is not None and list(existing.environments) != environment_list:
+        raise ExperimentInputError(
+            f"experiment {existing.id} ({existing.name}) was recorded with --env "
+            f"{','.join(existing.environments) or 'none (the scenario own)'}; these environments differ (leave "
+            "--env out to resume it, or choose another --name)"
+        )
     if existing is not None and stepping is not None and stepping != existing.stepping:
         raise ExperimentInputError(
             f"experiment {existing.id} ({existing.name}) was recorded with --stepping {existing.stepping}, not "
@@ -269,10 +335,31 @@ def prepare_experiment(
             variants,
             command,
             stepping or DEFAULT_STEPPING,
+            environment_list,
         )
     done = store.finished_keys(db, record.id)
     todo = [key for key in record.keys() if key not in done]
     return PreparedExperiment(record, entry, db, todo, len(done), existing is not None)
+
+
+def _check_environments(entry: Scenario, environments: list[str]) -> None:
+    """Refuse environments a scenario cannot run in: one that takes no ``environment`` keyword
+    runs only in the environment it is written for."""
+    if not environments:
+        return
+    try:
+        takes = entry.takes_environment()
+    except UnknownScenario as e:
+        raise ExperimentInputError(str(e)) from None
+    if takes:
+        return
+    others = [e for e in environments if e != entry.environment]
+    if others:
+        own = f"written for the {entry.environment} only" if entry.environment else "not told which environment"
+        raise ExperimentInputError(
+            f"--env: scenario {entry.name} is {own} (its function takes no 'environment' keyword), so it cannot "
+            f"run in {', '.join(others[:3])}{' ...' if len(others) > 3 else ''}"
+        )
 
 
 def _variants_text(variants: Iterable[Iterable[str]]) -> str:
@@ -290,11 +377,15 @@ def execute_run(
     db: str | None,
     record: bool = True,
     stepping: str = DEFAULT_STEPPING,
+    environment: str | None = None,
 ) -> dict[str, Any]:
     """Run the scenario named `scenario` once and return its result (JSON-serialisable).
 
     `stepping` is passed on to a scenario that takes it (every built-in one does); one that does
     not is run as it is, and refused (an error result) unless `stepping` is the default.
+    `environment` (None: the scenario's own) is passed on as the ``environment`` keyword; a
+    scenario that does not take it runs only in the environment it is written for (else an
+    error result). The result says `environment`.
 
     Runs in a worker: the scenario is looked up by name or import path. An exception of the
     scenario becomes a result with `error` set and its type as the failure cause;
@@ -307,11 +398,17 @@ def execute_run(
         os.environ["PYCRAM_RECORD"] = "0"
     started = time.monotonic()
     try:
-        function = get_scenario(scenario).load()
+        entry = get_scenario(scenario)
+        function = entry.load()
+        extra: dict[str, Any] = {}
+        if environment is not None and accepts_keyword(function, "environment"):
+            extra["environment"] = environment
+        elif environment is not None and environment != entry.environment:
+            raise ValueError(f"scenario {scenario} takes no 'environment' argument: it cannot run in {environment}")
         if _takes_stepping(function):
-            result = dict(function(robot, seed, faults, db_url=db, pictures=False, stepping=stepping))
+            result = dict(function(robot, seed, faults, db_url=db, pictures=False, stepping=stepping, **extra))
         elif stepping == DEFAULT_STEPPING:
-            result = dict(function(robot, seed, faults, db_url=db, pictures=False))
+            result = dict(function(robot, seed, faults, db_url=db, pictures=False, **extra))
         else:
             raise ValueError(f"scenario {scenario} takes no 'stepping' argument: it cannot run with {stepping!r}")
     except KeyboardInterrupt:
@@ -333,6 +430,8 @@ def execute_run(
     result.setdefault("robot", robot)
     result.setdefault("seed", seed)
     result.setdefault("faults", sorted(faults))
+    if environment is not None:
+        result.setdefault("environment", environment)
     result.setdefault("wall_time", time.monotonic() - started)
     result["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     clean: dict[str, Any] = json.loads(json.dumps(result, default=str))
@@ -420,13 +519,24 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
+    from pycram.apps.experiments.store import split_variant
+
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_worker_init)
     futures: dict[Any, RunKey] = {}
     try:
         for key in prepared.todo:
+            variant, environment = split_variant(key[2])
             future = pool.submit(
-                execute_run, prepared.scenario.spec, key[0], key[1], key[2], prepared.db, True, prepared.stepping
+                execute_run,
+                prepared.scenario.spec,
+                key[0],
+                key[1],
+                variant,
+                prepared.db,
+                True,
+                prepared.stepping,
+                environment,
             )
             futures[future] = key
         pending = set(futures)
@@ -538,10 +648,16 @@ def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: 
             "write: the runs' traces are not recorded (their results are); use PostgreSQL (--db "
             "postgresql://...) to record them"
         )
+    from pycram.apps.experiments.store import split_variant
+
     task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
     refs: dict[Any, RunKey] = {}
     for key in prepared.todo:
-        refs[task.remote(prepared.scenario.spec, key[0], key[1], key[2], prepared.db, record, prepared.stepping)] = key
+        variant, environment = split_variant(key[2])
+        ref = task.remote(
+            prepared.scenario.spec, key[0], key[1], variant, prepared.db, record, prepared.stepping, environment
+        )
+        refs[ref] = key
     cancelled = False
     while refs:
         ready, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0.25, fetch_local=True)

@@ -11,7 +11,10 @@ success), `sim_time` and `wall_time` [s], `robot`, `seed` and `faults`; optional
 (per object: `placed`, `failure`, `reason`) and `trace_run_id` (the run's id in the trace
 database when the scenario recorded it into `db_url`). A scenario raises `ValueError` for a
 robot or fault it does not know, and `RunInterrupted` when a signal stopped it (such a run is
-not finished: a resumed experiment runs it again).
+not finished: a resumed experiment runs it again). A scenario that can run in more than one
+environment takes an ``environment`` keyword too (an environment name, see
+`pycram.environments.load`: ``apartment``, ``procedural:SEED``, ``file:PATH``) and puts it into
+its result as `environment`; `pycram experiment --env` and `pycram demo --env` pass it.
 
 Scenarios are registered by name, either as a callable or lazily as an import path
 `"package.module:function"` that is imported only when the scenario is used (so a scenario
@@ -24,6 +27,7 @@ when it was registered only in the driver.
 from __future__ import annotations
 
 import importlib
+import inspect
 import logging
 import time
 from collections.abc import Callable
@@ -48,6 +52,7 @@ __all__ = [
     "get_scenario",
     "demo_scenario_names",
     "thesis_scenario",
+    "accepts_keyword",
 ]
 
 #: The signature of a scenario: `(robot, seed, faults, db_url, pictures) -> result dict`.
@@ -88,6 +93,15 @@ class Scenario:
     robots: tuple[str, ...] = ROBOTS
     description: str = ""
     demo: str | None = None
+    #: The environment the scenario is written for (None: it does not say). A scenario whose
+    #: function takes an ``environment`` keyword runs in others too (`takes_environment`).
+    environment: str | None = None
+
+    def takes_environment(self) -> bool:
+        """Whether the scenario's function takes an ``environment`` keyword (an environment
+        name: ``apartment``, ``procedural:SEED``, ``file:PATH``), so that `pycram experiment
+        --env` can choose where it runs."""
+        return accepts_keyword(self.load(), "environment")
 
     def load(self) -> ScenarioFunction:
         """The scenario's function (importing its module for an import path).
@@ -143,17 +157,21 @@ def register_scenario(
     robots: tuple[str, ...] = ROBOTS,
     description: str = "",
     demo: str | None = None,
+    environment: str | None = None,
 ) -> Scenario:
     """Register (or replace) the scenario `name`: a callable, or an import path
     `"module:function"` imported when the scenario is first used; `demo`: the import path of its
-    terminal front end for `pycram demo --scenario NAME` (see `Scenario`). Returns the entry."""
+    terminal front end for `pycram demo --scenario NAME` (see `Scenario`); `environment`: the
+    environment it is written for. Returns the entry."""
     if not name or ":" in name:
         raise ValueError(f"a scenario name must be non-empty and contain no ':', not {name!r}")
     if isinstance(target, str) and ":" not in target:
         raise ValueError(f"a scenario's import path reads 'package.module:function', not {target!r}")
     if demo is not None and ":" not in demo:
         raise ValueError(f"a scenario's demo import path reads 'package.module:function', not {demo!r}")
-    entry = Scenario(name, target, tuple(faults) if faults is not None else None, tuple(robots), description, demo)
+    entry = Scenario(
+        name, target, tuple(faults) if faults is not None else None, tuple(robots), description, demo, environment
+    )
     SCENARIOS[name] = entry
     return entry
 
@@ -186,6 +204,15 @@ def get_scenario(spec: str) -> Scenario:
         entry = Scenario(spec, spec)
     entry.load()  # fail here, in the driver, rather than in every worker
     return entry
+
+
+def accepts_keyword(function: Any, name: str) -> bool:
+    """Whether `function` takes the keyword argument `name` (or any keyword: ``**kwargs``)."""
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == name or p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters)
 
 
 def _import_target(path: str, name: str) -> ScenarioFunction:
@@ -311,16 +338,19 @@ register_scenario(
     thesis_scenario,
     faults=THESIS_FAULTS,
     description="the thesis demo: fetch the item in the kitchen and place it on cooker #1",
+    environment="thesis-kitchen",
 )
 register_scenario(
     "set-table",
     "pycram.apps.scenarios.set_table:run_set_table",
     demo="pycram.apps.scenarios.set_table.display:main",
     description="set the table for breakfast in the apartment, objects on counters and in a drawer (issue 17)",
+    environment="apartment",
 )
 register_scenario(
     "set-table-open",
     "pycram.apps.scenarios.set_table:run_set_table_on_open_surfaces",
     demo="pycram.apps.scenarios.set_table.display:main_on_open_surfaces",
     description="set the table, every object starting on an open surface (none in a closed drawer)",
+    environment="apartment",
 )

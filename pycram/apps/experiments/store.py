@@ -37,6 +37,9 @@ __all__ = [
     "RunRecord",
     "ExperimentNotFound",
     "variant_key",
+    "ENVIRONMENT_SEPARATOR",
+    "run_variant",
+    "split_variant",
     "create_experiment",
     "find_experiment",
     "finished_keys",
@@ -55,6 +58,23 @@ def variant_key(faults: frozenset[str] | list[str] | tuple[str, ...]) -> str:
     return ",".join(sorted(set(faults)))
 
 
+#: In the `variant` column of a run of an experiment with environments (`pycram experiment
+#: --env`), the variant key and the run's environment are joined by this: "moved,taken@procedural:3"
+#: (fault names never contain it). Runs of experiments without environments store the variant key.
+ENVIRONMENT_SEPARATOR = "@"
+
+
+def run_variant(variant: str, environment: str | None) -> str:
+    """The `variant` column of a run: the variant key, with the environment when there is one."""
+    return variant if environment is None else f"{variant}{ENVIRONMENT_SEPARATOR}{environment}"
+
+
+def split_variant(column: str) -> tuple[str, str | None]:
+    """(variant key, environment or None) of a run's `variant` column (see `run_variant`)."""
+    variant, separator, environment = column.partition(ENVIRONMENT_SEPARATOR)
+    return (variant, environment if separator else None)
+
+
 @dataclass(frozen=True)
 class ExperimentRecord:
     """A recorded experiment: its id, name, scenario spec, robots, seeds and variants (each a
@@ -71,13 +91,18 @@ class ExperimentRecord:
     #: How its simulations kept time with the plans ("lockstep" or "free"); experiments recorded
     #: before PyCRAM stored it ran free.
     stepping: str = "free"
+    #: The environments its runs run in (`pycram experiment --env`): every robot, seed and
+    #: variant in each; empty: the scenario's own environment.
+    environments: tuple[str, ...] = ()
 
     def keys(self) -> list[tuple[str, int, str]]:
-        """Every run of the experiment as (robot, seed, variant key), in the order they run:
-        per variant, per robot, by seed."""
+        """Every run of the experiment as (robot, seed, variant column: the variant key, with the
+        environment when the experiment has environments, see `run_variant`), in the order they
+        run: per variant, per environment, per robot, by seed."""
         return [
-            (robot, seed, variant_key(variant))
+            (robot, seed, run_variant(variant_key(variant), environment))
             for variant in self.variants
+            for environment in (self.environments or (None,))
             for robot in self.robots
             for seed in self.seeds
         ]
@@ -89,7 +114,7 @@ class RunRecord:
 
     robot: str
     seed: int
-    variant: str
+    variant: str  # the variant key (fault names), without the environment
     status: str
     success: bool
     failure_causes: list[str] = field(default_factory=list)
@@ -98,6 +123,8 @@ class RunRecord:
     trace_run_id: int | None = None
     error: str | None = None
     result: dict[str, Any] = field(default_factory=dict)
+    #: The environment it ran in, for experiments with environments (`pycram experiment --env`).
+    environment: str | None = None
 
 
 def _now() -> _dt.datetime:
@@ -119,6 +146,7 @@ def _experiment_from_row(row: Any) -> ExperimentRecord:
         status=row.status,
         created_at=row.created_at,
         stepping=_info(row.info).get("stepping", "free"),
+        environments=tuple(_info(row.info).get("environments", ())),
     )
 
 
@@ -160,9 +188,13 @@ def create_experiment(
     variants: list[tuple[str, ...]],
     command: str | None = None,
     stepping: str = "lockstep",
+    environments: list[str] | tuple[str, ...] = (),
 ) -> ExperimentRecord:
-    """Record a new experiment whose runs simulate with `stepping`; raises `TraceDatabaseError`
-    (also when the name is taken)."""
+    """Record a new experiment whose runs simulate with `stepping`, in `environments` (empty:
+    the scenario's own); raises `TraceDatabaseError` (also when the name is taken)."""
+    info: dict[str, Any] = {"stepping": stepping}
+    if environments:
+        info["environments"] = list(environments)
     engine = _engine(url)
     values = {
         "name": name,
@@ -175,7 +207,7 @@ def create_experiment(
         "status": "running",
         "host": socket.gethostname(),
         "command": command if command is not None else " ".join(sys.argv),
-        "info": json.dumps({"stepping": stepping}),
+        "info": json.dumps(info),
     }
     try:
         with engine.begin() as conn:
@@ -280,7 +312,7 @@ def run_records(url: str | None, experiment_id: int) -> list[RunRecord]:
         RunRecord(
             robot=r.robot,
             seed=r.seed,
-            variant=r.variant,
+            variant=split_variant(r.variant)[0],
             status=r.status,
             success=bool(r.success),
             failure_causes=json.loads(r.failure_causes or "[]"),
@@ -289,6 +321,7 @@ def run_records(url: str | None, experiment_id: int) -> list[RunRecord]:
             trace_run_id=r.trace_run_id,
             error=r.error,
             result=json.loads(r.result or "{}"),
+            environment=split_variant(r.variant)[1],
         )
         for r in rows
     ]

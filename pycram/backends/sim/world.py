@@ -61,6 +61,7 @@ from .interventions import Interventions
 from .items import ItemSpec
 from .motion_commands import MotionCommands
 from .perception import PerceptionFaults
+from .physics_faults import PhysicsWatchdog
 from .recording import FrameRecorder, StateSnapshot
 from .recording_commands import RecordingCommands
 from .render import Renderers
@@ -178,6 +179,9 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         #: Joint position of every container by name [m for drawers, rad for doors], 0 when closed.
         self.container_states = Fluent(eng.furniture.positions(eng.data), name="container_states")
         self.camera_image = Fluent(None, name="camera_image")
+        #: The `SimulationFault` that broke the physics, None while it is sound (`physics_faults`).
+        self.physics_fault = Fluent(None, name="physics_fault")
+        self._watchdog = PhysicsWatchdog(eng, self.environment)
         #: the latest state copied by the simulation thread, for prospection (never its MjData)
         self._state = StateSnapshot.of(eng.data)
         self._prospection: SimProspection | None = None
@@ -303,6 +307,7 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
                     continue
                 t0 = clock()
                 self._drain_inbox()
+                self._watchdog.apply(self)
                 t1 = clock()
                 t = eng.time
                 for channel, (ctrl, _handle) in list(self._active.items()):

@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pycram.core.fluent import Fluent
-from pycram.execution.failures import MotionFailure, NavigationFailure
+from pycram.execution.failures import MotionFailure, NavigationFailure, SimulationFault
 from pycram.execution.module_support import (
     cancel_running_handle,
     check_command,
@@ -119,14 +119,17 @@ class SimProcessModule(ProcessModule):
         """
         if not (isinstance(timeout, (int, float)) and math.isfinite(timeout) and timeout > 0):
             raise ValueError(f"{command}: the time-out must be a positive number of seconds, got {timeout!r}")
+        _raise_physics_fault(self.world)
         handle = start()
         self._handle = handle
         if not handle.result.wait_for(timeout):
             self._handle = None
             handle.cancel()
+            _raise_physics_fault(self.world)
             raise SimMotionFailed(command, "timeout", f"did not end within {timeout:.1f} s of simulated time")
         outcome = handle.result.get_value()
         self._handle = None
+        _raise_physics_fault(self.world)  # the world's physics broke: no command means anything now
         if not outcome.succeeded:
             message = outcome.message
             if describe_failure is not None:
@@ -137,6 +140,14 @@ class SimProcessModule(ProcessModule):
 
     def _cancel(self, designator: Any) -> None:
         cancel_running_handle(self, designator)
+
+
+def _raise_physics_fault(world: Any) -> None:
+    """Raise the world's `SimulationFault` once more, if its physics broke (see
+    :mod:`pycram.backends.sim.physics_faults`); a plan's recoveries let it pass."""
+    fault = getattr(getattr(world, "physics_fault", None), "get_value", lambda: None)()
+    if isinstance(fault, SimulationFault):
+        raise fault.again()
 
 
 class NavigationModule(SimProcessModule):

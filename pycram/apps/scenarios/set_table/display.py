@@ -49,9 +49,17 @@ def main(
 
     from rich.console import Console
     from rich.live import Live
+    from rich.markup import escape
 
     from pycram.apps.scenarios.set_table.plan import current_object, objects_done
-    from pycram.apps.terminal import log_to_terminal, stderr_console, task_tree_display, write_run_pictures
+    from pycram.apps.terminal import (
+        failure_hint,
+        failure_text,
+        log_to_terminal,
+        stderr_console,
+        task_tree_display,
+        write_run_pictures,
+    )
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
@@ -126,7 +134,7 @@ def main(
         mark = (
             "[green]placed[/green]"
             if obj.placed
-            else f"[red]missing[/red] ({obj.failure or 'not at its place'}: {obj.reason})"
+            else f"[red]missing[/red] ({obj.failure or 'not at its place'}: {escape(failure_text(obj.reason))})"
         )
         console.print(f"  {name}: {mark}", highlight=False)
     if result.faults_injected:
@@ -144,7 +152,11 @@ def main(
     if result.success:
         console.print("[bold green]SUCCESS[/bold green]: the table is set, every drawer closed")
         return 0
-    console.print(f"[bold red]FAILURE[/bold red]: {result.summary()}", highlight=False)
+    console.print(f"[bold red]FAILURE[/bold red]: {escape(failure_text(result.summary()))}", highlight=False)
+    failed = [o.failure for o in result.objects.values() if o.failure]
+    first = result.error.split(":")[0] if result.error else (failed[0] if failed else None)
+    if failure_hint(first):
+        console.print(f"  try: {escape(failure_hint(first))}", highlight=False)
     return 1
 
 
