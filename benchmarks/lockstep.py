@@ -15,7 +15,10 @@ Each run prints its simulated time, its wall time, the speed (sim / wall) and th
 share of physics alone, and a second table says where the wall time of each lock-step run
 went (`World.time_spent()`: physics, controllers, starting commands -- IK, path planning,
 perception's rendering --, publishing sensors, recording, and the plan's own code while the
-world stood still; "other" is outside the loop: building the scene, closing); lock-step runs
+world stood still; "other" is outside the loop: building the scene, closing; "loop overhead" is
+the simulation loop's own work besides `mj_step`, as a share of that work without "plan": what
+the simulation thread pays per step, which depends far less on how loaded the machine is than
+the time spent handing the turn to plan threads and back); lock-step runs
 also print their fingerprint, which repeats run after run
 (free-running ones differ). The target of issue 31: a set-table run at >= 70 % of physics
 alone in lock-step.
@@ -24,6 +27,14 @@ alone in lock-step.
         [--physics 60] [--skip-set-table] [--throughput 8]
 
 Numbers depend on the machine's load; run it on an otherwise idle machine for the record.
+
+Measured (2-core machine, 2026-11-27; docs/simulator.md "What it costs" has the whole story):
+idle, before the second pass of cuts: set-table 61-62 % of physics alone (PR2), 61-65 %
+(TIAGo), thesis demo 36-43 %. The second pass (outlines in one pass, sensor values built when
+read, cached servo and contact lookups) changed no fingerprint; beside 2-4 busy processes, as
+alternating pairs before/after: PR2 set-table 43-49 % -> 53-54 % of physics alone, loop
+overhead ~28 % -> ~21 %; thesis demo (PR2) loop overhead ~43 % -> ~35 %. The target of 70 % is
+not shown.
 """
 
 from __future__ import annotations
@@ -161,6 +172,7 @@ def main() -> None:
     breakdown = Table(title="where the wall time of the lock-step runs went (World.time_spent, % of the run's wall)")
     for column in ("robot", "run", "physics", "controllers", "commands", "sensors", "recording", "plan", "other"):
         breakdown.add_column(column, justify="left" if column in ("robot", "run") else "right")
+    breakdown.add_column("loop overhead", justify="right")
     table = Table(
         title="lock-step vs free-running (sim / wall: x real time; physics alone: x real time of `mj_step` "
         "on copies of the run's states; share: the run's speed / physics alone)"
@@ -181,7 +193,11 @@ def main() -> None:
                     if stepping == "lockstep" and _SPENT and wall > 0:
                         shares = {part: 100 * seconds / wall for part, seconds in _SPENT.items()}
                         other = 100 - sum(shares.values())
-                        breakdown.add_row(robot, name, *(f"{shares[p]:.0f} %" for p in _SPENT), f"{other:.0f} %")
+                        busy = sum(seconds for part, seconds in _SPENT.items() if part != "plan")
+                        overhead = 100 * (busy - _SPENT["physics"]) / busy if busy > 0 else 0.0
+                        breakdown.add_row(
+                            robot, name, *(f"{shares[p]:.0f} %" for p in _SPENT), f"{other:.0f} %", f"{overhead:.0f} %"
+                        )
                     table.add_row(
                         robot,
                         name,

@@ -136,7 +136,8 @@ class BaseDrive(Controller):
         contacts = eng.base_contacts()
         if contacts:
             return fail("collision", f"base touches {contacts[0][1]}", eng.base_pose())
-        x, y, yaw = eng.q("base_x"), eng.q("base_y"), eng.q("base_yaw")
+        qpos = eng.data.qpos
+        x, y, yaw = (float(qpos[i]) for i in eng.base_qpos)  # BASE_JOINTS: x, y, yaw
         lag = math.hypot(rx - x, ry - y)
         if lag > self.max_lag or abs(ryaw - yaw) > 0.15:
             return fail("blocked", f"base is {lag:.3f} m behind its reference", eng.base_pose())
@@ -308,6 +309,8 @@ class HeadPointing(Controller):
             return refused
         self.dofs = [eng.scene.joint_dof(j) for j in self.joints]
         self.jids = [eng.scene.joint_id(j) for j in self.joints]
+        self.qadr = [eng.scene.joint_qpos(j) for j in self.joints]
+        self.ranges = [tuple(float(v) for v in eng.model.jnt_range[jid]) for jid in self.jids]
         self.jacr = np.zeros((3, eng.model.nv))
         self.t0 = eng.time
         self.good_since: float | None = None
@@ -342,15 +345,14 @@ class HeadPointing(Controller):
             dq = np.linalg.solve(normal, J.T @ err)
         else:
             dq = np.linalg.lstsq(J, err, rcond=1e-3)[0]
-        wanted = np.array([eng.q(j) for j in self.joints]) + dq
+        wanted = d.qpos[self.qadr] + dq
         if self._previous is not None and t > self._previous[0]:
             rate = (wanted - self._previous[1]) / (t - self._previous[0])
             self._velocity += self.FEED_FORWARD_GAIN * (rate - self._velocity)
         self._previous = (t, wanted)
-        for j, jid, goal, velocity in zip(self.joints, self.jids, wanted, self._velocity):
-            lo, hi = m.jnt_range[jid]
+        for j, (lo, hi), goal, velocity in zip(self.joints, self.ranges, wanted.tolist(), self._velocity.tolist()):
             inside = lo < goal < hi
-            eng.set_target_ff(j, float(np.clip(goal, lo, hi)), float(velocity) if inside else 0.0)
+            eng.set_target_ff(j, min(max(goal, lo), hi), velocity if inside else 0.0)
         if not self.track:
             if angle <= self.tol:
                 if self.good_since is None:

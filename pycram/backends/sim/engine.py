@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import cast
+from collections.abc import Callable
+from typing import Any, Generic, TypeVar, cast
 
 import mujoco
 import numpy as np
@@ -26,6 +27,53 @@ ASIDE_DISTANCE = 1.5
 #: A closing gripper grasps an item only while its fingers are at least this far apart [m]:
 #: fully closed fingers have nothing between them, whatever touches their outsides.
 MIN_GRASP_OPENING = 0.003
+#: Up to this many geoms, `Engine.base_contacts` looks contacts up in a table of geom pairs.
+PAIR_TABLE_GEOMS = 2048
+
+
+_T = TypeVar("_T")
+
+
+class Deferred(Generic[_T]):
+    """A value computed on its first call, `make(*args)`, from arguments copied when it was made:
+    a sensor value that the simulation thread publishes at the cost of a few array copies and
+    that is built (dicts, poses) only if somebody reads it (`Fluent.get_value` calls a callable
+    value). Every call returns the same object; two threads calling it first at the same time
+    both compute it (from the same copies: equal values)."""
+
+    __slots__ = ("_make", "_args", "_value", "_done")
+
+    def __init__(self, make: Callable[..., _T], *args: Any) -> None:
+        self._make, self._args = make, args
+        self._done = False
+
+    def __call__(self) -> _T:
+        if not self._done:
+            self._value = self._make(*self._args)
+            self._done = True  # after the value: a reader that sees it done sees the value
+        return self._value
+
+
+def _joint_states(stamp: float, names: list[str], positions: np.ndarray, velocities: np.ndarray) -> JointStates:
+    return JointStates(stamp, dict(zip(names, positions.tolist())), dict(zip(names, velocities.tolist())))
+
+
+def _poses(names: list[str], positions: np.ndarray, orientations: np.ndarray) -> dict[str, Pose]:
+    """Poses by name from rows of positions [m] and orientations (w, x, y, z)."""
+    return {
+        n: Pose(cast(Vec3, tuple(p)), cast(Quat, tuple(q)))
+        for n, p, q in zip(names, positions.tolist(), orientations.tolist())
+    }
+
+
+def _site_poses(names: list[str], positions: np.ndarray, rotations: np.ndarray) -> dict[str, Pose]:
+    """Poses by name from rows of positions [m] and rotation matrices (9 numbers, row-major)."""
+    quat = np.zeros(4)
+    out = {}
+    for name, position, rotation in zip(names, positions, rotations):
+        mujoco.mju_mat2Quat(quat, rotation)
+        out[name] = Pose(cast(Vec3, tuple(position.tolist())), cast(Quat, tuple(quat.tolist())))
+    return out
 
 
 class Gripper:
@@ -107,12 +155,13 @@ class Engine:
         self.grippers = {name: Gripper(self, name, g) for name, g in desc.GRIPPERS.items()}
         self.camera = scene.camera(HEAD_CAMERA)
         self.tool_sites = {arm: scene.site(tool_site(arm)) for arm in desc.ARMS}
+        self._tool_index = (list(self.tool_sites), np.array(list(self.tool_sites.values()), dtype=np.int64))
         self.item_bodies = {it.name: scene.body(it.name) for it in scene.items}
         self._item_names = list(self.item_bodies)
         self._item_ids = np.array([self.item_bodies[n] for n in self._item_names], dtype=np.int64)
         self._quat = np.zeros(4)  # scratch of `site_pose` (the simulation thread only)
-        self._base_mask: np.ndarray | None = None  # see `base_contacts`
-        self._environment_mask: np.ndarray = np.zeros(0, bool)
+        self._base_pairs: np.ndarray | None = None  # see `base_contacts`
+        self._actuators: dict[str, int] = {}  # joint name -> its servo's index (`actuator`)
         self.item_geoms = {
             it.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, it.name) for it in scene.items
         }
@@ -171,9 +220,17 @@ class Engine:
     def q(self, joint: str) -> float:
         return float(self.data.qpos[self.scene.joint_qpos(joint)])
 
+    def actuator(self, joint: str) -> int:
+        """Index of the position servo driving `joint` (`Scene.actuator`, looked up once per
+        name: controllers ask every control tick)."""
+        aid = self._actuators.get(joint)
+        if aid is None:
+            aid = self._actuators[joint] = self.scene.actuator(joint)
+        return aid
+
     def set_target(self, joint: str, value: float) -> None:
         """Command the position servo of `joint` to `value` [m or rad]."""
-        self.data.ctrl[self.scene.actuator(joint)] = value
+        self.data.ctrl[self.actuator(joint)] = value
 
     def set_target_ff(self, joint: str, position: float, velocity: float) -> None:
         """Command `joint` to track `position` while moving at `velocity` (velocity feed-forward).
@@ -181,13 +238,13 @@ class Engine:
         A position servo pushes kp (ctrl - q) - kv qdot; offsetting ctrl by kv/kp * velocity turns
         that into kp (position - q) + kv (velocity - qdot), so the joint does not lag behind.
         """
-        aid = self.scene.actuator(joint)
+        aid = self.actuator(joint)
         kp = self.model.actuator_gainprm[aid, 0]
         kv = -self.model.actuator_biasprm[aid, 2]
         self.data.ctrl[aid] = position + kv / kp * velocity
 
     def target(self, joint: str) -> float:
-        return float(self.data.ctrl[self.scene.actuator(joint)])
+        return float(self.data.ctrl[self.actuator(joint)])
 
     def hold(self, joints: list[str]) -> None:
         """Command each joint's servo to its current position (stop)."""
@@ -200,12 +257,12 @@ class Engine:
         return Pose2D(x, y, math.atan2(math.sin(yaw), math.cos(yaw)))
 
     def joint_states(self) -> JointStates:
+        return self.deferred_joint_states()()
+
+    def deferred_joint_states(self) -> Deferred[JointStates]:
+        """`joint_states` now, built when first read (the positions and velocities copied now)."""
         names, qadr, dadr = self._joint_index
-        return JointStates(
-            self.time,
-            dict(zip(names, self.data.qpos[qadr].tolist())),
-            dict(zip(names, self.data.qvel[dadr].tolist())),
-        )
+        return Deferred(_joint_states, self.time, names, self.data.qpos[qadr], self.data.qvel[dadr])
 
     def gripper_state(self, name: str) -> GripperState:
         """Opening [m], held item and effort [N] at the finger tips of gripper `name`."""
@@ -219,11 +276,17 @@ class Engine:
 
     def item_poses(self) -> dict[str, Pose]:
         """Every item's `item_pose`, by name (one read of the state)."""
-        names = self._item_names
-        if not names:
-            return {}
-        positions, orientations = self.data.xpos[self._item_ids].tolist(), self.data.xquat[self._item_ids].tolist()
-        return {n: Pose(cast(Vec3, tuple(p)), cast(Quat, tuple(q))) for n, p, q in zip(names, positions, orientations)}
+        return self.deferred_item_poses()()
+
+    def deferred_item_poses(self) -> Deferred[dict[str, Pose]]:
+        """`item_poses` now, built when first read (the items' poses copied now)."""
+        ids = self._item_ids
+        return Deferred(_poses, self._item_names, self.data.xpos[ids], self.data.xquat[ids])
+
+    def deferred_tool_poses(self) -> Deferred[dict[str, Pose]]:
+        """The `site_pose` of each arm's tool site (`tool_sites`) now, by arm, built when first read."""
+        names, ids = self._tool_index
+        return Deferred(_site_poses, names, self.data.site_xpos[ids], self.data.site_xmat[ids])
 
     def site_pose(self, site: int) -> Pose:
         quat = self._quat
@@ -231,22 +294,44 @@ class Engine:
         return Pose(cast(Vec3, tuple(self.data.site_xpos[site].tolist())), cast(Quat, tuple(quat.tolist())))
 
     def base_contacts(self) -> list[tuple[str, str]]:
-        """Pairs (robot geom, environment geom) of base links touching the environment."""
-        if self.data.ncon == 0:
+        """Pairs (robot geom, environment geom) of base links touching the environment.
+
+        Asked every control tick while the base drives: one lookup per contact in a table of
+        the geom pairs that count (built on first use), names only for the few that touch."""
+        ncon = self.data.ncon
+        if ncon == 0:
             return []
-        if self._base_mask is None:  # geom id -> is a base geom / an environment geom
-            self._base_mask = np.zeros(self.model.ngeom, bool)
-            self._base_mask[list(self.scene.base_geoms)] = True
-            self._environment_mask = np.zeros(self.model.ngeom, bool)
-            self._environment_mask[list(self.scene.environment_geoms)] = True
+        if self._base_pairs is None:
+            self._base_pairs = self._base_pair_table()
         contact = self.data.contact
-        g1, g2, touching = contact.geom1, contact.geom2, contact.dist <= 0.0
-        base, env = self._base_mask, self._environment_mask
+        geom = contact.geom[:ncon]
+        pairs = self._base_pairs
+        if pairs.ndim == 2:
+            counted = pairs[geom[:, 0], geom[:, 1]]
+        else:  # per geom: 1 base, 2 environment
+            counted = (pairs[geom[:, 0]] | pairs[geom[:, 1]]) == 3
+        if not counted.any():
+            return []
         out = []
-        for i in np.flatnonzero(touching & ((base[g1] & env[g2]) | (base[g2] & env[g1]))).tolist():
-            a, b = (int(g1[i]), int(g2[i])) if base[g1[i]] and env[g2[i]] else (int(g2[i]), int(g1[i]))
-            out.append((self.model.geom(a).name, self.model.geom(b).name))
+        base_geoms = self.scene.base_geoms
+        for i in np.flatnonzero(counted & (contact.dist[:ncon] <= 0.0)).tolist():
+            g1, g2 = int(geom[i, 0]), int(geom[i, 1])
+            robot, other = (g1, g2) if g1 in base_geoms else (g2, g1)
+            out.append((self.model.geom(robot).name, self.model.geom(other).name))
         return out
+
+    def _base_pair_table(self) -> np.ndarray:
+        """For `base_contacts`: a table (geom, geom) -> one is a base geom and the other an
+        environment geom (ngeom^2 bytes, up to `PAIR_TABLE_GEOMS` geoms), else per geom 1 for
+        a base geom, 2 for an environment geom."""
+        n = self.model.ngeom
+        kind = np.zeros(n, np.int8)
+        kind[list(self.scene.base_geoms)] = 1
+        kind[list(self.scene.environment_geoms)] = 2
+        if n > PAIR_TABLE_GEOMS:
+            return kind
+        base, env = kind == 1, kind == 2
+        return np.outer(base, env) | np.outer(env, base)
 
     # --- grasping -------------------------------------------------------------------------
     def _touching_items(self, g: Gripper, either: bool = False) -> set[str]:

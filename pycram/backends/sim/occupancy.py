@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import mujoco
@@ -282,20 +283,48 @@ def body_outline(
     """The outline on the floor, in the base frame, of the robot as it stands in `data`: one
     convex footprint per part of `robot_parts` (the base's first, always including the base
     geoms), counting only the parts of the geoms below `below` [m]."""
+    return body_outlines(scene, data, [below], parts)[below]
+
+
+def body_outlines(
+    scene: Scene, data: mujoco.MjData, belows: Sequence[float], parts: list[dict[int, np.ndarray]]
+) -> dict[float, list[Footprint]]:
+    """`body_outline` for each height of `belows` [m], the same footprints at a fraction of the
+    cost: each geom's points are placed once, and a part's outline is taken once for all the
+    heights that keep the same points of each of its geoms."""
     model = scene.model
     mount = scene.body(scene.description.ROOT_LINK)
     rot, pos = data.xmat[mount].reshape(3, 3), data.xpos[mount]
-    out = []
+    out: dict[float, list[Footprint]] = {below: [] for below in belows}
+    heights = np.asarray(belows, float)
     for k, part in enumerate(parts):
-        pts = []
+        # each geom's points, and how many of them are below each height (all: the base's own)
+        placed, counts = [], []
         for g, local in part.items():
             verts = geom_vertices(model, data, g, local)
-            if not (k == 0 and g in scene.base_geoms):
-                verts = verts[verts[:, 2] <= below]
-            if len(verts):
-                pts.append(planar_extremes(((verts - pos) @ rot)[:, :2]))
-        if pts:
-            hull = convex_hull(planar_extremes(np.vstack(pts)))
-            if len(hull) >= 3:
-                out.append(Footprint(tuple((float(x), float(y)) for x, y in hull)))
+            whole = k == 0 and g in scene.base_geoms
+            placed.append((g, verts, whole))
+            counts.append(
+                np.full(len(heights), len(verts)) if whole else np.searchsorted(np.sort(verts[:, 2]), heights, "right")
+            )
+        kept_per_height = np.array(counts).T.tolist() if counts else [[] for _ in belows]
+        extremes: dict[tuple[int, int], np.ndarray] = {}  # (geom, points kept) -> their extremes
+        hulls: dict[tuple[int, ...], Footprint | None] = {}  # points kept per geom -> the outline
+        for below, kept_list in zip(belows, kept_per_height):
+            kept = tuple(kept_list)
+            if kept not in hulls:
+                pts = []
+                for (g, verts, whole), n in zip(placed, kept):
+                    if not n:
+                        continue
+                    ext = extremes.get((g, n))
+                    if ext is None:
+                        chosen = verts if whole else verts[verts[:, 2] <= below]
+                        ext = extremes[(g, n)] = planar_extremes(((chosen - pos) @ rot)[:, :2])
+                    pts.append(ext)
+                hull = convex_hull(planar_extremes(np.vstack(pts))) if pts else np.zeros((0, 2))
+                hulls[kept] = Footprint(tuple((float(x), float(y)) for x, y in hull)) if len(hull) >= 3 else None
+            footprint = hulls[kept]
+            if footprint is not None:
+                out[below].append(footprint)
     return out

@@ -16,6 +16,7 @@ random generator seeded per world so that runs repeat.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any, cast
 
@@ -143,7 +144,7 @@ def _major_axis(points: np.ndarray, top: float) -> float | None:
 def measure_detections(
     ids: np.ndarray,
     depth: np.ndarray,
-    rgb: np.ndarray,
+    rgb: np.ndarray | Callable[[], np.ndarray],
     view: CameraView,
     objects: dict[str, tuple[str, list[int]]],
     environment: Environment,
@@ -153,8 +154,9 @@ def measure_detections(
     min_pixels: int = MIN_PIXELS,
 ) -> list[Detection]:
     """The detections in one look: `ids` geom ids per pixel (-1: none), `depth` [m] and `rgb`
-    images of the same camera; `objects` maps each object to (type, its geoms). Most visible
-    first."""
+    images of the same camera (`rgb` may be a function that renders it: called only when an
+    object is in view, at most once); `objects` maps each object to (type, its geoms). Most
+    visible first."""
     types = [type_name for type_name, _ in objects.values()]
     last = int(max((max(g) for _, g in objects.values() if g), default=0))
     lookup = np.full(last + 2, -1, np.int64)  # geom id -> object index; the extra last entry: none
@@ -170,6 +172,8 @@ def measure_detections(
             continue
         if faults.miss_probability and rng.random() < faults.miss_probability:
             continue
+        if callable(rgb):
+            rgb = rgb()
         detection = _measure(view, types[index], points, rgb[rows, cols], environment, container_states)
         if faults.pose_noise:
             noisy = tuple(float(v) for v in np.asarray(detection.position) + rng.normal(0.0, faults.pose_noise, 3))

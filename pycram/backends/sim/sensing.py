@@ -134,7 +134,10 @@ class Sensing(CommandQueue):
 
         renderers = self._get_perception_renderers()
         ids, depth = renderers.segmentation_and_depth(eng.data, HEAD_CAMERA, width, height)
-        rgb = renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
+
+        def rgb() -> np.ndarray:  # rendered only if an object is in view (its colour is measured)
+            return renderers.rgb(eng.data, HEAD_CAMERA, width, height, shadows=False)
+
         cam = eng.camera
         view = view_of(eng.data.cam_xpos[cam], eng.data.cam_xmat[cam], float(eng.model.cam_fovy[cam]), depth, max_range)
         objects = {it.name: (it.type, eng.item_part_geoms[it.name]) for it in self.scene.items}

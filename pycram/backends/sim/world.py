@@ -8,7 +8,9 @@ The simulation thread is the only thread that touches MuJoCo. Other threads
   control tick of `control_period` [s], and also right after a command ends): `base_pose`,
   `joint_states`, `gripper_openings[g]`, `gripper_states[g]`, `tool_poses`, `item_poses`,
   `container_states` (joint position of each drawer and door), `sim_time`, and `camera_image`
-  (on request).
+  (on request). `joint_states`, `tool_poses`, `item_poses` and `container_states` are built
+  when first read, from the state copied when they were published (`engine.Deferred`): what
+  a reader gets is the same, and a value nobody reads costs the simulation a few array copies.
 
 While it runs, the world's `ManualClock` is the active PyCRAM clock: `pycram.sleep` and fluent
 time-outs follow simulated time. Headless it runs as fast as it can; `realtime=True` paces it to
@@ -54,7 +56,7 @@ from pycram.world.scenes import random_scene
 from pycram.world.types import Outcome, Pose, Pose2D
 
 from .controllers import Controller
-from .engine import Engine
+from .engine import Deferred, Engine
 from .errors import UnknownNameError
 from .handle import CommandHandle
 from .interventions import Interventions
@@ -88,6 +90,11 @@ TIME_SPENT_PARTS = ("physics", "controllers", "commands", "sensors", "recording"
 #: Worlds not closed yet: closed at interpreter exit, so that no simulation or recorder thread
 #: is still inside MuJoCo (or the GL driver) while the interpreter and its libraries shut down.
 _LIVE_WORLDS: weakref.WeakSet[World] = weakref.WeakSet()
+
+
+def _joint_positions(addresses: dict[str, int], qpos: np.ndarray) -> dict[str, float]:
+    """Name -> qpos[address] (a container's joint position [m or rad])."""
+    return {n: float(qpos[a]) for n, a in addresses.items()}
 
 
 @atexit.register
@@ -306,7 +313,8 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
                     self._serve_held()  # the next step would pass `hold`: stand still, serve commands
                     continue
                 t0 = clock()
-                self._drain_inbox()
+                if not self._inbox.empty():  # (most ticks: nothing was sent)
+                    self._drain_inbox()
                 self._watchdog.apply(self)
                 t1 = clock()
                 t = eng.time
@@ -472,26 +480,31 @@ class World(MotionCommands, Sensing, RecordingCommands, Interventions):
         self.clock.advance_to(self._engine.time + 1e9)
 
     def _tool_poses(self) -> dict[str, Pose]:
-        eng = self._engine
-        return {arm: eng.site_pose(s) for arm, s in eng.tool_sites.items()}
+        return self._engine.deferred_tool_poses()()
 
     def _item_poses(self) -> dict[str, Pose]:
         return self._engine.item_poses()
 
     def _publish(self) -> None:
+        """Set every sensor fluent to the state now (simulation thread). The values that often
+        go unread -- `joint_states`, `tool_poses`, `item_poses`, `container_states` -- are
+        published as `Deferred`: the few arrays they need are copied now and the value is built
+        when first read, so a reader still sees this tick's state and an unread one costs a
+        copy; the others are built at once (the relays and callbacks on them read them anyway)."""
         eng = self._engine
-        self._state = StateSnapshot.of(eng.data)  # first: whoever a fluent wakes sees this state
+        data = eng.data
+        self._state = state = StateSnapshot.of(data)  # first: whoever a fluent wakes sees this state
         self.sim_time.set_value(eng.time)
         self.base_pose.set_value(eng.base_pose())
-        self.joint_states.set_value(eng.joint_states())
+        self.joint_states.set_value(eng.deferred_joint_states())
         for g in eng.grippers:
-            state = eng.gripper_state(g)
-            self.gripper_states[g].set_value(state)
-            self.gripper_openings[g].set_value(state.opening)
-        self.tool_poses.set_value(self._tool_poses())
-        self.item_poses.set_value(self._item_poses())
+            gripper = eng.gripper_state(g)
+            self.gripper_states[g].set_value(gripper)
+            self.gripper_openings[g].set_value(gripper.opening)
+        self.tool_poses.set_value(eng.deferred_tool_poses())
+        self.item_poses.set_value(eng.deferred_item_poses())
         if eng.furniture.containers:
-            self.container_states.set_value(eng.furniture.positions(eng.data))
+            self.container_states.set_value(Deferred(_joint_positions, eng.furniture.qpos, state.qpos))
 
     # ------------------------------------------------------------------ prospection
     def prospection(self, belief: Any = None) -> SimProspection:
