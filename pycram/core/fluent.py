@@ -10,7 +10,15 @@ value is `None`. Operators build fluent networks::
 
 Guarantees (unlike the thesis implementation):
 
-* every waiter wakes on a change (`notify_all`), not just one;
+* every waiter wakes on a change (`notify_all`), not just one -- except when no wait on the
+  fluent can end: a pulse that leaves `get_value()` None wakes nobody if the runtime knows
+  reading it runs no code of yours (a plain value, a network built by the operators from such
+  fluents, a pulse fluent), since every waiter would only find None and wait again. A fluent
+  whose value is your own callable wakes its waiters on every pulse. (In lock-step a woken
+  thread takes a turn while the simulation stands still: a watcher such as
+  `(opening < 0.01).wait_for()` no longer costs one hand-over per sensor publication.)
+  Waits on a fluent are `wait_for` and `whenever` only: they end exactly when the value is
+  not None;
 * parents hold their children (networks, pulse fluents) weakly: a loop that builds `(f < 3)`
   a million times keeps memory flat;
 * `<=` and `>=` work; comparisons and arithmetic with a `None` input yield `None` (not
@@ -78,6 +86,7 @@ class Fluent:
         "_handle_missed",
         "_callbacks",
         "_changes_only",
+        "_inputs",
         "__weakref__",
     )
 
@@ -91,6 +100,8 @@ class Fluent:
         self._live = 0  # number of children after the last pruning of dead references
         self._pulses = 0
         self._handle_missed = Behavior.NEVER
+        # a network's own value function and the fluents it reads (see `_network`, `_pure`)
+        self._inputs: tuple[Callable[[], Any], tuple[Fluent, ...]] | None = None
 
     # -- identity ---------------------------------------------------------------------------------
 
@@ -158,8 +169,10 @@ class Fluent:
         return ChangeCallback(self, callback)
 
     def pulse(self) -> None:
-        """Wake every waiter on this fluent and on the networks and pulse fluents built from it,
-        then call the `on_change` callbacks (also if waking raised `Evaporated`)."""
+        """Wake every waiter on this fluent and on the networks and pulse fluents built from it
+        (not those of a fluent whose value is None for sure: their waits cannot end, see
+        `_none_for_sure`), then call the `on_change` callbacks (also if waking raised
+        `Evaporated`)."""
         try:
             for ref in self._children:
                 child = ref()
@@ -168,11 +181,44 @@ class Fluent:
                         child._pulses += 1
                     child.pulse()
             cv = self._cv
-            if cv is not None:
+            if cv is not None and not self._none_for_sure():
                 notify_waiters(cv)  # may raise Evaporated (where an asynchronous one was due)
         finally:
             if self._callbacks:
                 self._run_callbacks()
+
+    def _none_for_sure(self) -> bool:
+        """Whether no wait on this fluent can end now: its value is None and reading it runs no
+        code but the runtime's (`_pure`), so it is None in every thread. Then a pulse need not
+        wake the waiters (each would find None and wait again).
+
+        No wake-up is lost: every waiter tests `get_value() is not None` under the condition's
+        lock before it blocks, and every change of a pure value is followed by a pulse of the
+        fluent (a network is pulsed by each of its inputs' pulses) that reads the value after
+        the change. If that reads None, the value was None after the change; the change that
+        last makes it not None is followed by a pulse that reads not None and wakes them."""
+        try:
+            return self._pure() and self.get_value() is None
+        except Exception:  # noqa: BLE001 - a value that cannot be computed: the waiters find out
+            return False
+
+    def _pure(self) -> bool:
+        """Whether reading the value runs no code but the runtime's: a value that is no
+        callable, a pulse fluent, or a network built by the operators over such fluents (the
+        same in every thread, without side effects)."""
+        get_value = type(self).get_value
+        if get_value is not Fluent.get_value:
+            return get_value is _PulseFluent.get_value
+        value = self._value
+        if not callable(value):
+            return True
+        inputs = self._inputs
+        if inputs is None or inputs[0] is not value:  # a callable of the user's
+            return False
+        for fluent in inputs[1]:
+            if not fluent._pure():
+                return False
+        return True
 
     def _run_callbacks(self) -> None:
         runner = current_runner()
@@ -205,6 +251,8 @@ class Fluent:
             children.append(ref)
 
     def _condition(self) -> threading.Condition:
+        """The condition `wait_for` waits on. Wait on it only for `get_value() is not None`: a
+        pulse that leaves the value None may wake nobody (see `_none_for_sure`)."""
         cv = self._cv
         if cv is None:
             with _create_lock:
@@ -256,6 +304,9 @@ class Fluent:
         self.add_child(fluent)
         if isinstance(other, Fluent):
             other.add_child(fluent)
+            fluent._inputs = (value, (self, other))
+        else:
+            fluent._inputs = (value, (self,))
         return fluent
 
     def _compare(self, op: Callable[[Any, Any], Any], other: Any, none_safe: bool = False) -> Fluent:

@@ -194,7 +194,12 @@ class JointPath(Controller):
                 if column.min() < lo - 1e-3 or column.max() > hi + 1e-3:
                     return fail("invalid", f"{j} leaves [{lo:.3f}, {hi:.3f}] on the path")
         self.qadr = np.array([eng.scene.joint_qpos(j) for j in self.joints])
+        # the joints' servos and their velocity feed-forward gains kv / kp (`Engine.set_target_ff`),
+        # read once: nothing changes a servo's gains during a run
+        self.actuators = np.array([eng.actuator(j) for j in self.joints], int)
+        self.feed_forward = -m.actuator_biasprm[self.actuators, 2] / m.actuator_gainprm[self.actuators, 0]
         self.masks = _masks(eng, self.arm)
+        self._roles: tuple[str | None, np.ndarray] | None = None  # see `_geom_roles`
         self.gripper = eng.grippers[desc.ARMS[self.arm]["gripper"]]
         self.exempt = np.zeros(m.ngeom, bool)
         if self.exempt_item is not None:
@@ -249,8 +254,8 @@ class JointPath(Controller):
                 eng, "blocked", f"{self.joints[worst]} is {lag[worst]:.3f} from its reference on the path", elapsed
             )
         position, velocity = self._reference(elapsed)
-        for j, p, v in zip(self.joints, position.tolist(), velocity.tolist()):
-            eng.set_target_ff(j, p, v)
+        # `Engine.set_target_ff` for every joint at once (the same arithmetic, element-wise)
+        eng.data.ctrl[self.actuators] = position + self.feed_forward * velocity
         self.commanded = position
         if elapsed >= self.times[-1]:
             errors = np.abs(q - self.positions[-1])
@@ -281,17 +286,16 @@ class JointPath(Controller):
         if d.ncon == 0:
             return set()
         masks = self.masks
-        moving = masks.arm.copy()
-        held = self.gripper.holding
-        if held is not None:
-            moving[eng.item_part_geoms[held]] = True
-        obstacle = (masks.environment | _item_mask(eng)) & ~moving
+        roles = self._geom_roles(eng)
         contact = d.contact[: d.ncon]
         g1, g2, dist = contact.geom1, contact.geom2, contact.dist
-        hits = ((moving[g1] & obstacle[g2]) | (moving[g2] & obstacle[g1])) & (dist <= 0.0)
+        first = roles[g1]
+        hits = np.flatnonzero(((first ^ roles[g2]) == _PAIR) & (dist <= 0.0))  # a moving geom and an obstacle
+        if not hits.size:
+            return set()
         out: set[tuple[int, int]] = set()
-        for i in np.flatnonzero(hits).tolist():
-            a, b = (int(g1[i]), int(g2[i])) if moving[g1[i]] and obstacle[g2[i]] else (int(g2[i]), int(g1[i]))
+        for i in hits.tolist():
+            a, b = (int(g1[i]), int(g2[i])) if first[i] == _MOVING else (int(g2[i]), int(g1[i]))
             if self.exempt[b] and masks.gripper[a]:
                 continue  # the object being grasped, at the fingers
             if masks.environment[b]:
@@ -301,6 +305,25 @@ class JointPath(Controller):
                 continue  # touching an object without pushing it (yet)
             out.add((a, b))
         return out
+
+    def _geom_roles(self, eng: Engine) -> np.ndarray:
+        """Each geom's role in a contact, by geom: `_MOVING` (the arm, the object its gripper
+        holds), `_OBSTACLE` (the environment, the other objects) or 0. Built again only when
+        what the gripper holds changes (most motions: never), not every tick."""
+        held = self.gripper.holding
+        cached = self._roles
+        if cached is not None and cached[0] == held:
+            return cached[1]
+        masks = self.masks
+        moving = masks.arm.copy()
+        if held is not None:
+            moving[eng.item_part_geoms[held]] = True
+        obstacle = (masks.environment | _item_mask(eng)) & ~moving
+        roles = np.zeros(len(moving), np.int8)
+        roles[moving] = _MOVING
+        roles[obstacle] = _OBSTACLE
+        self._roles = (held, roles)
+        return roles
 
     def _moved(self, eng: Engine, geom: int) -> bool:
         """Whether the item of ``geom`` moved more than ``item_displacement`` [m] or turned more
@@ -323,6 +346,11 @@ class JointPath(Controller):
         m = eng.model
         return [(_geom_name(m, a), _geom_name(m, b)) for a, b in sorted(now - self.allowed)]
 
+
+#: Roles of a geom in `JointPath._geom_roles`: the two differ in each bit, so a pair of a moving
+#: geom and an obstacle is the one whose roles' exclusive or is `_PAIR`.
+_MOVING, _OBSTACLE = 1, 2
+_PAIR = _MOVING ^ _OBSTACLE
 
 _ITEMS: weakref.WeakKeyDictionary[Engine, np.ndarray] = weakref.WeakKeyDictionary()
 

@@ -511,6 +511,14 @@ def notify_waiters(condition: threading.Condition) -> None:
     Raises `Evaporated` only where an asynchronous one was about to land anyway.
     """
     runner = current_runner()
+    if runner.task is None and not runner._injected:
+        # A thread without a task (a simulation's thread, a sensor driver): nothing can inject
+        # an asynchronous `Evaporated` into it (`Runner.interrupt` only reaches a task's
+        # thread, and only the thread itself gives its runner a task), so the guard below is
+        # not needed.
+        with condition:
+            condition.notify_all()
+        return
     token = runner.enter_runtime()
     try:
         with condition:

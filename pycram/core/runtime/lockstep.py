@@ -360,6 +360,15 @@ class Condition(threading.Condition):
     `notify`, for waits that may be lock-step."""
 
     def notify_all(self) -> None:
+        if not self._waiters:  # type: ignore[attr-defined]
+            # Nobody waits: nothing to count or wake (most pulses of a simulation's sensor
+            # fluents). Read with this condition's lock held (checked below), so no wake-up is
+            # lost: a waiter enqueues itself in `wait()` before it releases the lock, and it
+            # tested its predicate under the same lock, after the notifier changed the value
+            # or before the notifier could take the lock.
+            if not self._is_owned():  # type: ignore[attr-defined]
+                raise RuntimeError("cannot notify on un-acquired lock")
+            return
         clock = current_clock()
         if isinstance(clock, LockstepClock):
             clock.notified(self)
