@@ -45,9 +45,13 @@ def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] |
     """Reach phase `phase` of a sequence: the `index`-th validated tool pose of `location` when
     it has them (top grasps: the tool's orientation matters), else `point` with the phase's
     offset along the base's heading. `grasping`: the believed object being grasped (it may touch
-    the fingers on the way: the motion's ``object``), None for none."""
+    the fingers on the way: the motion's ``object``), None for none. The arm's joints validated
+    for that pose (`location.joints`) go along as IK's first guess (the motion's ``joints``)."""
     poses = getattr(location, "tool_poses", ())
     extra = {} if grasping is None else {"object": grasping}
+    validated = getattr(location, "joints", ())
+    if len(validated) > index:
+        extra["joints"] = list(validated[index])
     if location.grasp == "top" and len(poses) > index:
         position, orientation = poses[index]
         motion(type="reaching", arm=arm, target=list(position), orientation=list(orientation), phase=phase, **extra)

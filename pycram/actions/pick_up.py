@@ -193,7 +193,6 @@ def _let_go_and_retract(
         retreat,
         lambda: motion(type="setting_arm_configuration", arm=arm, configuration="carry"),
     )
-    back_away("a failed grasp")
 
 
 def _arm_to_drive(arm: str, configuration: str) -> None:

@@ -55,7 +55,7 @@ from .core import (
     solutions,
     unwrap,
 )
-from .handling import _look_again, _pose_text, _reach, _xyz, back_away, carry_configuration
+from .handling import _look_again, _pose_text, _reach, _xyz, carry_configuration
 from .held import Held, fingers_yaw, held_objects
 
 __all__ = [
@@ -204,6 +204,9 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
         # set before driving -- the arm raised to carry stands over the table at the goal, and with
         # the torso still low the robot would not fit there (measured: TIAGo, goal_in_collision)
         motion(type="setting_torso", position=torso)
+    arrival = getattr(location, "arrival", ())
+    if arrival:  # validated with the object lifted clear of the furniture there
+        motion(type="setting_arm_joints", arm=arm, positions=list(arrival))
     _drive_watching(location, held)
     if gripper_opening(gripper) < held.held_opening:
         raise ObjectSlipped(f"{obj.name} is no longer in the {gripper} gripper", obj)
@@ -237,7 +240,6 @@ def _place_at(location: Any, held: Held, spot: tuple[float, float, float], point
         motion(type="setting_arm_configuration", arm=arm, configuration="park")
         _look_again(obj, spot)
         problem = None if obj.gone else resting_problem(obj, lying)
-    back_away(f"putting down {obj.name}")
     if problem is not None:
         reason, why = problem
         raise PlacingFailed(f"{obj.name} does not rest upright at {_xyz(spot)}: {why}", obj, reason)

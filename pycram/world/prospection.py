@@ -309,9 +309,14 @@ class Prospection(abc.ABC):
 
     @abc.abstractmethod
     def in_collision(
-        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+        self,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        carried: Sequence[str] = (),
+        objects: bool = False,
     ) -> bool:
-        """Would the robot at ``base_pose`` collide with the environment?
+        """Would the robot at ``base_pose`` collide with the environment (and, with ``objects``,
+        with an object of the world)?
 
         The robot keeps its current joint positions except those in ``joint_configuration``
         (joint name -> position [rad or m]). The objects named in ``carried`` (objects the robot
@@ -410,6 +415,13 @@ class Prospection(abc.ABC):
         :meth:`configuration_checker`."""
         with self.configuration_checker(arm, base_pose, joint_configuration, **options) as checker:
             return checker.is_free(q)
+
+    def tool_pose(self, arm: str, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> ToolPose:
+        """Where the tool frame of ``arm`` is (map frame: position [m], orientation (w, x, y, z))
+        with the robot at ``base_pose`` and its joints as they are but those in
+        ``joint_configuration``. Raises ``ValueError`` for an unknown arm or joint,
+        ``NotImplementedError`` when this prospection does not support it."""
+        raise NotImplementedError(f"{type(self).__name__} does not provide tool_pose")
 
     def solve_ik(
         self,

@@ -43,7 +43,7 @@ class ScriptedProspection:
         self.collides, self.unreachable = collides, unreachable
         self.asked = 0
 
-    def in_collision(self, pose, configuration=None, carried=()):
+    def in_collision(self, pose, configuration=None, carried=(), objects=False):
         self.asked += 1
         return self.collides(pose)
 

@@ -255,7 +255,7 @@ def test_a_prospection_without_planning_says_so():
     class Minimal(Prospection):
         arms = ("right",)
 
-        def in_collision(self, base_pose, joint_configuration=None, carried=()):
+        def in_collision(self, base_pose, joint_configuration=None, carried=(), objects=False):
             return False
 
         def collisions(self, base_pose, joint_configuration=None):

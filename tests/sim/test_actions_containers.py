@@ -273,3 +273,27 @@ def test_a_transport_into_the_closed_cupboard_opens_it_first():
         assert tasks_named(task, "opening cupboard")  # opened by the transport itself
         assert rests_upright_at(world, "mug", "cupboard shelf", obj.pose[:2])
         assert holding(world) == set()
+
+
+def test_a_transport_into_a_drawer_pulls_it_out_far_enough_for_the_object():
+    """The TIAGo's first pull leaves drawer 2 out 18 cm from its start pose -- open, as `Open`
+    counts it, yet no room out from under the furniture for a 16 cm spoon: the transport pulls it
+    out further before it fetches the spoon (actions benchmark, seed 32003)."""
+    from pycram.actions import Transport
+    from pycram.designator import LocationDesignator
+    from pycram.world.objects import object_type
+
+    with apartment_with("tiago", {"spoon": TABLE}) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        target = LocationDesignator([("in", "drawer 2"), ("for", "spoon")])
+        obj, task = run_as_task(lambda: perform(Transport(ObjectDesignator(type="spoon"), target)))
+        assert len(tasks_named(task, "opening drawer 2")) == 2, "one pull, then one further"
+        assert obj.properties.get("in") == "drawer 2"
+        # in the drawer as it is pulled out: on its bottom's height, where it was believed put down
+        pose = world.item_poses.get_value()["spoon"]
+        bottom = world.environment.surface("drawer 2 inside").height
+        assert abs(pose.position[2] - object_type("spoon").half_height - bottom) < 0.03, pose
+        assert math.dist(pose.position[:2], obj.pose[:2]) < 0.05
+        assert obj.properties.get("in") == "drawer 2"
+        assert holding(world) == set()

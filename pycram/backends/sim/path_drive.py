@@ -16,6 +16,7 @@ import logging
 import math
 from collections.abc import Callable, Sequence
 
+import mujoco
 import numpy as np
 
 from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
@@ -24,7 +25,8 @@ from pycram.world.types import Outcome, Pose2D
 
 from .controllers import BaseDrive, Controller, fail, invalid_input
 from .engine import Engine
-from .occupancy import FloorMap, base_footprint, body_outline, build_floor_map, local_vertices, robot_parts
+from .occupancy import FloorMap, base_footprint, body_outlines, build_floor_map, local_vertices, robot_parts
+from .occupancy import _add as rasterize
 from .prospection import SimProspection
 from .recording import StateSnapshot
 from .robot_model import BASE_JOINTS
@@ -48,9 +50,18 @@ class Navigation:
         self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
         self.footprint: Footprint = base_footprint(eng.scene, eng.data)
         self._state: np.ndarray | None = None
+        # `FloorMap.movable_state`'s indices as arrays: the state is compared every control tick
+        self._mocap = np.asarray(self.floor.mocap_ids, dtype=np.int64)
+        self._qpos = np.asarray(self.floor.qpos_addresses, dtype=np.int64)
         self._outline = np.zeros(0)
+        # the occupied cells by band (`FloorMap.bands`) of the movable state `_bands_of`
+        self._bands: dict[float, np.ndarray] = {}
+        self._bands_of: np.ndarray | None = None
         self._robot_parts = robot_parts(eng.scene)
         self._item_points: dict[int, np.ndarray] = {}
+        # each item's position's qpos addresses (x, y, z), in `eng.item_qpos`'s order
+        self._items = list(eng.item_qpos)
+        self._item_qpos = np.array([[a, a + 1, a + 2] for a in eng.item_qpos.values()], dtype=np.int64).reshape(-1, 3)
         self._planner: PathPlanner | None = None
         self._robot_state = StateSnapshot.of(eng.data)
         # no tolerance: a drive fails on any contact
@@ -58,8 +69,9 @@ class Navigation:
 
     def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
         """Whether the whole robot, in its configuration now and with the items its grippers
-        hold, touches nothing of the environment at a base pose (x, y, yaw): the 3D check behind
-        the planner's outlines. Answers are memoized per pose (to 1 mm / 1 mrad) for this state."""
+        hold, touches nothing of the environment and no other item at a base pose (x, y, yaw):
+        the 3D check behind the planner's outlines. Answers are memoized per pose (to 1 mm /
+        1 mrad) for this state."""
         self._robot_state = StateSnapshot.of(eng.data)
         return memoized_free(self._prospection, carried_items(eng))
 
@@ -79,6 +91,32 @@ class Navigation:
                 parts[k][g] = local
         return parts
 
+    def movable_state(self, data: mujoco.MjData) -> np.ndarray:
+        """`FloorMap.movable_state` of `data` (the same numbers, a few microseconds)."""
+        return np.concatenate(
+            (data.mocap_pos[self._mocap].ravel(), data.mocap_quat[self._mocap].ravel(), data.qpos[self._qpos])
+        )
+
+    def _items_state(self, eng: Engine) -> np.ndarray:
+        """The positions of the items no gripper holds (x, y, z each [m]; zeros for held ones):
+        what moves the items' cells on the floor map."""
+        positions = eng.data.qpos[self._item_qpos]  # a copy (fancy indexing)
+        for item in carried_items(eng):
+            positions[self._items.index(item)] = 0.0
+        return positions.ravel()
+
+    def _with_items(self, eng: Engine, bands: dict[float, np.ndarray]) -> dict[float, np.ndarray]:
+        """`bands` with the cells of every item no gripper holds, each in the band of its top:
+        the robot keeps what stands on a counter or a table off the arms' and the held
+        objects' outlines as it would a box of that height (a base's 3D obstacle layer sees
+        them). Read-only from here."""
+        held = set(carried_items(eng))
+        for item in self._items:
+            if item not in held:
+                for g in eng.item_part_geoms[item]:
+                    rasterize(bands, self.floor, eng.model, eng.data, g)
+        return dict(sorted(bands.items()))
+
     def planner(self, eng: Engine, refresh_outline: bool = True) -> tuple[PathPlanner, bool]:
         """The planner of the current state, and whether it is new (something moved by more
         than `MOVED` since the planner was built; smaller motions, e.g. a door settling, do not
@@ -88,13 +126,16 @@ class Navigation:
         Each height band of obstacles is kept off by the outline of the robot as it stands
         (arms included) below that band's top: the base alone keeps off a counter whose top
         the arms reach over, the whole robot keeps off walls and tall boxes."""
-        state = self.floor.movable_state(eng.data)
+        state = np.concatenate((self.movable_state(eng.data), self._items_state(eng)))
         moved = self._state is None or float(np.abs(state - self._state).max(initial=0.0)) > MOVED
         if self._planner is not None and not moved and not refresh_outline:
             return self._planner, False
-        bands = self.floor.bands(eng.model, eng.data)
+        if self._bands_of is None or not np.array_equal(state, self._bands_of):
+            self._bands, self._bands_of = self._with_items(eng, self.floor.bands(eng.model, eng.data)), state
+        bands = self._bands
         parts = self._parts(eng)
-        outlines = {top: body_outline(eng.scene, eng.data, top + 0.02, parts) for top in bands}
+        below = body_outlines(eng.scene, eng.data, [top + 0.02 for top in bands], parts)
+        outlines = {top: below[top + 0.02] for top in bands}
         # the robot's pose, to the cm
         key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
         if (
@@ -112,16 +153,16 @@ class Navigation:
 
 
 def memoized_free(prospection: SimProspection, carried: Sequence[str] = ()) -> Callable[[float, float, float], bool]:
-    """(x, y, yaw) -> the robot, with the items `carried` moving with it, touches nothing there
-    (`prospection.in_collision`), memoized per pose to 1 mm / 1 mrad (for one plan: the state
-    must not change meanwhile)."""
+    """(x, y, yaw) -> the robot, with the items `carried` moving with it, touches nothing there,
+    neither the environment nor another item (`prospection.in_collision`), memoized per pose to
+    1 mm / 1 mrad (for one plan: the state must not change meanwhile)."""
     memo: dict[tuple[int, int, int], bool] = {}
 
     def free(x: float, y: float, yaw: float) -> bool:
         key = (round(x * 1e3), round(y * 1e3), round(yaw * 1e3))
         answer = memo.get(key)
         if answer is None:
-            answer = memo[key] = not prospection.in_collision((x, y, yaw), carried=carried)
+            answer = memo[key] = not prospection.in_collision((x, y, yaw), carried=carried, objects=True)
         return answer
 
     return free

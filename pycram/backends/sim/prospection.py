@@ -26,7 +26,7 @@ import queue
 import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, cast
 
 import mujoco
 import numpy as np
@@ -209,18 +209,20 @@ class SimProspection(Prospection):
         mujoco.mj_kinematics(self.model, d)
 
     def _touching(
-        self, d: mujoco.MjData, robot: np.ndarray | None = None
+        self, d: mujoco.MjData, robot: np.ndarray | None = None, obstacles: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Collision detection on `d` (kinematics computed): contact geoms (g1, g2), whether g1
-        is the robot's one, and which contacts are robot-environment collisions (`robot`: the
-        mask of the robot's geoms, with those of objects it carries; default: the robot's own)."""
+        is the robot's one, and which contacts are robot-obstacle collisions (`robot`: the mask
+        of the robot's geoms, with those of objects it carries; default: the robot's own;
+        `obstacles`: the mask of the obstacles' geoms, default: the environment's)."""
         mujoco.mj_collision(self.model, d)
         n = d.ncon
         geoms = d.contact.geom[:n]
         g1, g2 = geoms[:, 0], geoms[:, 1]
         is_robot = self._is_robot if robot is None else robot
-        hit1 = is_robot[g1] & self._is_env[g2]
-        hit2 = is_robot[g2] & self._is_env[g1]
+        is_obstacle = self._is_env if obstacles is None else obstacles
+        hit1 = is_robot[g1] & is_obstacle[g2]
+        hit2 = is_robot[g2] & is_obstacle[g1]
         return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -self.tolerance)
 
     def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
@@ -252,35 +254,50 @@ class SimProspection(Prospection):
             return self._contacts(d)
 
     def in_collision(
-        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+        self,
+        base_pose: Any,
+        joint_configuration: Mapping[str, float] | None = None,
+        carried: Sequence[str] = (),
+        objects: bool = False,
     ) -> bool:
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
-            robot = self._carry(d, base_pose, carried) if carried else None
-            return bool(self._touching(d, robot)[3].any())
+            robot = self._carry(d, base_pose, carried) if carried else self._is_robot
+            obstacles = self._is_env
+            if objects:  # every object but the carried ones is an obstacle too
+                obstacles = (self._is_env | self._object_geoms()) & ~robot
+            return bool(self._touching(d, robot, obstacles)[3].any())
 
     def _carry(self, d: mujoco.MjData, base_pose: Any, carried: Sequence[str]) -> np.ndarray:
-        """Move the objects `carried` in `d` (prepared: the base at `base_pose`) with the base
-        from where the snapshot has it, rigidly; recompute kinematics. Returns the mask of the
-        robot's geoms with theirs."""
+        """Move the objects `carried` in `d` (prepared: base and joints as asked, kinematics
+        computed) with the hand that holds them -- the arm whose tool frame is nearest to the
+        object in the snapshot -- as they sit in it now: with the base when the arm keeps its
+        joints, with the tool when the arm moves too. Recomputes kinematics. Returns the mask of
+        the robot's geoms with the carried objects'."""
         m = self.model
-        pose = as_base_pose(base_pose)
-        snap = self._snapshot()
-        x0, y0, yaw0 = (float(snap.qpos[a]) for a in self._base_qpos)
-        turn = pose.yaw - yaw0
-        c, s = math.cos(turn), math.sin(turn)
-        rotation = np.array([math.cos(turn / 2), 0.0, 0.0, math.sin(turn / 2)])
-        robot = self._is_robot.copy()
-        for name in carried:
-            body = self._object_body(name)
-            adr = int(m.jnt_qposadr[m.body_jntadr[body]])
-            px, py = float(snap.qpos[adr]) - x0, float(snap.qpos[adr + 1]) - y0
-            d.qpos[adr] = pose.x + c * px - s * py
-            d.qpos[adr + 1] = pose.y + s * px + c * py
-            quat = np.empty(4)
-            mujoco.mju_mulQuat(quat, rotation, np.asarray(snap.qpos[adr + 3 : adr + 7], float))
-            d.qpos[adr + 3 : adr + 7] = quat
-            robot[m.geom_bodyid == body] = True
+        with self._data() as now:  # the snapshot as it is: where each object sits in its hand
+            snap = self._snapshot()
+            now.qpos[:] = snap.qpos
+            now.mocap_pos[:] = snap.mocap_pos
+            now.mocap_quat[:] = snap.mocap_quat
+            mujoco.mj_kinematics(m, now)
+            robot = self._is_robot.copy()
+            for name in carried:
+                body = self._object_body(name)
+                adr = int(m.jnt_qposadr[m.body_jntadr[body]])
+                position = np.asarray(now.qpos[adr : adr + 3], float)
+                arm = min(self._arms.values(), key=lambda a: float(np.linalg.norm(now.site_xpos[a.site] - position)))
+                rot_then = now.site_xmat[arm.site].reshape(3, 3)
+                rot_now = d.site_xmat[arm.site].reshape(3, 3)
+                # the object's position and orientation in the tool frame, then placed at the tool now
+                local = rot_then.T @ (position - now.site_xpos[arm.site])
+                d.qpos[adr : adr + 3] = d.site_xpos[arm.site] + rot_now @ local
+                turn = np.empty(4)
+                mujoco.mju_mat2Quat(turn, (rot_now @ rot_then.T).ravel())
+                quat = np.empty(4)
+                mujoco.mju_mulQuat(quat, turn, np.asarray(now.qpos[adr + 3 : adr + 7], float))
+                d.qpos[adr + 3 : adr + 7] = quat
+                robot[m.geom_bodyid == body] = True
         mujoco.mj_kinematics(m, d)
         return robot
 
@@ -425,6 +442,17 @@ class SimProspection(Prospection):
             self._geom_name,
             lambda: self._planning_pool.put((planning, d)),
         )
+
+    def tool_pose(self, arm: str, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> ToolPose:
+        if arm not in self._arms:
+            raise ValueError(f"unknown arm {arm!r} of {self.scene.robot}; valid arms: {list(self._arms)}")
+        site = self._arms[arm].site
+        with self._data() as d:
+            self._prepare(d, base_pose, joint_configuration)
+            quat = np.empty(4)
+            mujoco.mju_mat2Quat(quat, d.site_xmat[site])
+            position = cast(tuple[float, float, float], tuple(float(v) for v in d.site_xpos[site]))
+            return ToolPose(position, cast(tuple[float, float, float, float], tuple(float(v) for v in quat)))
 
     def solve_ik(
         self,

@@ -121,7 +121,7 @@ class OpenVocabulary(StandingSearch):
             yaw = _wrap(math.atan2(middle[1] - y, middle[0] - x) - self.geometry.reach_bearing(arm))
             prosp = self.prospection()
             arrival = self.arrival_configuration(prosp)
-            if prosp.in_collision((x, y, yaw), {**arrival, **pulled_out}, self.carried()):
+            if prosp.in_collision((x, y, yaw), {**arrival, **pulled_out}, self.carried(), objects=True):
                 return None, ("in collision", None)
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
@@ -160,7 +160,7 @@ class OpenVocabulary(StandingSearch):
                 joint = self.geometry.torso_joint
                 assert joint is not None  # there are other torso heights only with a torso joint
                 configuration = {**arrival, joint: height}
-                if prosp.in_collision((x, y, yaw), {**configuration, **pulled_out}, self.carried()):
+                if prosp.in_collision((x, y, yaw), {**configuration, **pulled_out}, self.carried(), objects=True):
                     continue
                 other = reachable(configuration)
                 if other:
@@ -229,7 +229,7 @@ class OpenVocabulary(StandingSearch):
             failure: tuple[str, str | None] = ("in collision", None)
             for offset in PUSH_YAW_OFFSETS:
                 yaw = _wrap(natural + offset)
-                if prosp.in_collision((x, y, yaw), arrival, self.carried()):
+                if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
                     continue
                 solved, reason = self._reachable_along(prosp, arm, (x, y, yaw), poses, joint)
                 if reason is None:

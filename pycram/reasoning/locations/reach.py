@@ -196,23 +196,29 @@ class ReachVocabulary(StandingSearch):
 
             failure: tuple[str, str | None] = ("in collision at every other torso height", None)
             if torsos != "other":
-                if prosp.in_collision((x, y, natural), tucked, self.carried()):
-                    return None, ("in collision", None)
+                lifted: tuple[float, ...] = ()
+                if prosp.in_collision((x, y, natural), tucked, self.carried(), objects=True):
+                    # an object held in `arm` may come lifted clear of the furniture
+                    lifted = self._lifted_arrival(prosp, arm, (x, y, natural), tucked) if action == "place" else ()
+                    if not lifted:
+                        return None, ("in collision", None)
                 if prosp.in_collision((x, y, natural), raised):
                     failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
                     if torsos == "current":
                         return None, failure
                 else:
                     found, failure = sequences(raised)
+                    if found is not None and lifted:
+                        found = replace(found, arrival=lifted)
                     if found is not None or torsos == "current":
                         return found, (None if found is not None else failure)
             # the target lies low or high for the torso as it is: another torso height
             joint = self.geometry.torso_joint
             for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
-                if prosp.in_collision((x, y, natural), {**tucked, joint: height}, self.carried()) or prosp.in_collision(
-                    (x, y, natural), {**raised, joint: height}
-                ):
+                if prosp.in_collision(
+                    (x, y, natural), {**tucked, joint: height}, self.carried(), objects=True
+                ) or prosp.in_collision((x, y, natural), {**raised, joint: height}):
                     continue
                 other, why = sequences({**raised, joint: height})
                 if other is not None:

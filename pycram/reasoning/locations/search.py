@@ -26,7 +26,7 @@ from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation
 from .targets import KnownObject, Target, as_target
 
-__all__ = ["CandidateSearch", "MAX_CANDIDATES", "SPACING", "FAILED_SPACING", "BASE_CLEARANCE"]
+__all__ = ["CandidateSearch", "MAX_CANDIDATES", "SPACING", "FAILED_SPACING", "BASE_CLEARANCE", "LIFT_STEP"]
 
 #: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
 #: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
@@ -68,6 +68,11 @@ class _Tally:
         return f"{self.tried} candidates: " + ", ".join(parts) if parts else f"{self.tried} candidates"
 
 
+#: Lifting a held object clear of the furniture to arrive at a base pose: the tool goes up in
+#: steps of this much [m] until the robot fits there (or the arm reaches no higher).
+LIFT_STEP = 0.05
+
+
 class CandidateSearch:
     """The inputs of location reasoning and the search over ranked candidates (base of the
     vocabularies; `LocationReasoner` sets the inputs, see its docstring)."""
@@ -105,6 +110,33 @@ class CandidateSearch:
             for joint in self.geometry.arm_joints.get(arm, ()):
                 configuration[joint] = float(prospection.joint_position(joint))
         return configuration
+
+    def _lifted_arrival(
+        self, prosp: Any, arm: str, base: tuple[float, float, float], configuration: Mapping[str, float]
+    ) -> tuple[float, ...]:
+        """Joint positions [rad] of `arm` (holding an object) that lift its tool straight up
+        from where `configuration` has it, in steps of `LIFT_STEP`, until the robot at `base`
+        with what it carries touches nothing (`Prospection.in_collision` with the objects);
+        empty when no lift within the arm's reach does. A tall object held from the top hangs
+        below the counter's top in the carry configuration: lifted, it comes over the counter."""
+        if arm not in self.holding() or prosp.in_collision(base, configuration, objects=True):
+            return ()  # nothing held, or the robot itself is in the way: lifting will not help
+        try:
+            tool = prosp.tool_pose(arm, base, configuration)
+        except NotImplementedError:
+            return ()
+        joints = self.geometry.arm_joints[arm]
+        x, y, z = tool.position
+        step = 1
+        while True:
+            goal = ((x, y, z + step * LIFT_STEP), tool.orientation)
+            answer = prosp.solve_ik(arm, goal, base, configuration, avoid_collisions=False)
+            if not answer:
+                return ()  # out of the arm's reach: higher is out of reach too
+            lifted = {**configuration, **dict(zip(joints, answer.positions))}
+            if not prosp.in_collision(base, lifted, self.carried(), objects=True):
+                return tuple(float(v) for v in answer.positions)
+            step += 1
 
     def carried(self) -> list[str]:
         """The names of the objects the robot holds now (believed), to check base poses with:

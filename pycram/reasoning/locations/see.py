@@ -46,7 +46,7 @@ class SeeVocabulary(CandidateSearch):
             yaw = math.atan2(target.position[1] - y, target.position[0] - x)
             prosp = self.prospection()
             arrival = self.arrival_configuration(prosp)
-            if prosp.in_collision((x, y, yaw), arrival, self.carried()):
+            if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
                 return None, ("in collision", None)
             seen = prosp.visible(what, (x, y, yaw), 0.5, arrival)
             if seen:

@@ -23,7 +23,9 @@ class BaseLocation:
     `push` the face of a door the hand pushes from there (``'inside'``/``'outside'``; None: not
     a push); `grasp_candidate` the planned grasp (`pycram.reasoning.grasps.GraspCandidate`) the
     solution was validated for, when it was not one of the object type's grasps (then `grasp`
-    is its approach, ``'side'`` or ``'top'``, and `tool_poses` hold the orientations to reach).
+    is its approach, ``'side'`` or ``'top'``, and `tool_poses` hold the orientations to reach);
+    `arrival` the joint positions [rad] `arm` must hold to come to this pose (an object held
+    lifted clear of the furniture there; empty: as the arm is).
     """
 
     x: float
@@ -38,6 +40,7 @@ class BaseLocation:
     torso: str | None = None
     push: str | None = None
     grasp_candidate: Any = field(default=None, repr=False, compare=False)
+    arrival: tuple = field(default=(), repr=False, compare=False)
 
     def __iter__(self) -> Any:  # (x, y, yaw) like any base pose
         return iter((self.x, self.y, self.yaw))

@@ -326,7 +326,15 @@ class ArmModule(SimProcessModule):
                 tx, ty, tz = (float(v) for v in solution.get("target") or position)
                 grasped = (grasped[0], (tx, ty, tz))
             return planner.reach(
-                position, orientation, tolerance, what, reach_directly, grasped, phase, bool(solution.get("contact"))
+                position,
+                orientation,
+                tolerance,
+                what,
+                reach_directly,
+                grasped,
+                phase,
+                bool(solution.get("contact")),
+                solution.get("joints"),
             )
         check_command(self, solution, "move_arm", "reach")
 

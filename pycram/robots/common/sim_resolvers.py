@@ -308,6 +308,8 @@ def make_motion_resolver(world: Any, description: Any) -> Callable[[Any], list]:
                         ("tolerance", tolerance),
                         ("phase", phase),
                         ("target", target),
+                        ("contact", bool(desig.prop_value("contact"))),
+                        ("joints", _joint_guess(desig.prop_value("joints"), d.ARMS[arm]["joints"])),
                     ]
                 )
             )
@@ -448,6 +450,17 @@ def known_objects_of(belief: Any) -> list:
         position = cast(Vec3, tuple(float(v) for v in obj.pose[:3]))
         known.append(KnownObject(obj.name, obj.type, position, float(getattr(obj, "yaw", 0.0)), radius, half_height))
     return known
+
+
+def _joint_guess(value: Any, joints: Sequence[str]) -> tuple[float, ...] | None:
+    """`reaching`'s ``joints`` as a tuple of one position per joint of the arm (None when not
+    given). Raises ``ValueError`` naming the arm's joints for a wrong count."""
+    if value is None:
+        return None
+    positions = tuple(float(v) for v in value)
+    if len(positions) != len(joints):
+        raise ValueError(f"reaching: joints must give {len(joints)} positions {tuple(joints)}, got {len(positions)}")
+    return positions
 
 
 def held_objects_by_arm(description: Any, belief: Any) -> dict[str, str]:

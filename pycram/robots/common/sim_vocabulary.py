@@ -158,6 +158,13 @@ def motion_types(world: Any, description: Any) -> dict[str, MotionType]:
                     form="any",
                     required=False,
                 ),
+                MotionKey(
+                    "joints",
+                    "the arm's joint positions [rad] found for this tool pose before (e.g. validated "
+                    "by location reasoning): the first guess of the arm's IK (default: none)",
+                    form="numbers",
+                    required=False,
+                ),
             ),
         ),
         MotionType("subscribing_pose", "make a fluent follow the base pose (Pose2D, map)", (fluent,)),

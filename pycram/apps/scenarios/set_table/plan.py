@@ -15,8 +15,7 @@ For each place setting, in order:
 * it is brought: ``Transport(found, point)`` -- pick up, place, with the action library's
   recoveries inside (next standing pose, perceiving again, searching again when the object was
   taken). When the robot has an arm to spare once it holds this object (from its description
-  and `held_objects()`: the PR2, never the one-armed TIAGo), the next object is believed, low
-  (`CARRY_ALONG_HEIGHT`) and no other object stands near the way to it (`CARRY_CLEARANCE`),
+  and `held_objects()`: the PR2, never the one-armed TIAGo) and the next object is believed,
   the robot picks this one up, picks the next one
   up with the free arm (``PickUp(next, arm=free)``, abandoned by ``pursue`` as soon as the
   next one is believed gone: no searching with full hands) and puts it at its setting, then
@@ -84,7 +83,6 @@ from pycram.execution.perform import perform
 from pycram.execution.process_module import ProcessModuleError
 from pycram.execution.robot import current_robot
 from pycram.world.belief import PerceivedObject
-from pycram.world.objects import object_type
 
 __all__ = [
     "PlaceSetting",
@@ -98,8 +96,6 @@ __all__ = [
     "ROUND_TIME_BUDGET",
     "ROUNDS",
     "RESCAN_DISTANCE",
-    "CARRY_CLEARANCE",
-    "CARRY_ALONG_HEIGHT",
     "current_object",
     "WORLD_FAILURES",
     "objects_done",
@@ -126,13 +122,6 @@ RESCAN_DISTANCE = 1.0
 #: another one open).
 CLOSING_PASSES = 3
 
-#: Carrying one object to fetch a second: the second may be at most this tall [m] (the held
-#: object sticks out ahead over the furniture's front and knocked a 0.2 m milk carton over as
-#: the other arm reached for it: PR2 seeds 112, 115, 117 of 100-123).
-CARRY_ALONG_HEIGHT = 0.12
-#: Carrying one object to fetch a second: no other object may stand closer than this [m] to
-#: the way between the two (the held object sweeps over the furniture's front).
-CARRY_CLEARANCE = 0.5
 
 #: The object type being brought now (None between objects), for people watching and for the
 #: simulated person of the scenario's faults.
@@ -448,32 +437,12 @@ def _bring_along(partner_object: PerceivedObject, arm: str, other: PlaceSetting)
     perform(Place(held, other.point, arm=held.arm))
 
 
-def _segment_distance(p: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
-    """The distance [m] of point `p` from the segment `a`-`b` (2D)."""
-    ax, ay = a
-    dx, dy = b[0] - ax, b[1] - ay
-    length2 = dx * dx + dy * dy
-    t = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / length2))
-    return math.hypot(p[0] - (ax + t * dx), p[1] - (ay + t * dy))
-
-
-def _clear_to_carry(first: PerceivedObject, second: PerceivedObject, others: list[str]) -> bool:
-    """Whether the robot may go from `first` to `second` with `first` in its hand: `second` is
-    no taller than `CARRY_ALONG_HEIGHT`, and no believed object of the `others` types (still to
-    be brought) stands within `CARRY_CLEARANCE` of the way between them. A held object sticks
-    out ahead of the base over the furniture's front, where it sweeps over what stands there
-    (measured: milk cartons knocked over, PR2 seeds 107, 112, 115, 117)."""
-    belief = _belief()
-    if belief is None or first.pose is None or second.pose is None:
-        return False
-    if 2 * object_type(second.type).half_height > CARRY_ALONG_HEIGHT:
-        return False  # the held object sweeps over it where the other arm reaches for it
-    a, b = (first.pose[0], first.pose[1]), (second.pose[0], second.pose[1])
-    for obj in belief.present():
-        if obj.type in others and obj is not first and obj is not second and obj.pose is not None:
-            if _segment_distance((obj.pose[0], obj.pose[1]), a, b) < CARRY_CLEARANCE:
-                return False
-    return True
+def _clear_to_carry(first: PerceivedObject, second: PerceivedObject) -> bool:
+    """Whether the robot may go from `first` to `second` with `first` in its hand: both are
+    believed where they stand. Whether the held object fits on the way and at the standing pose
+    is for navigation and location reasoning to say (they check base poses with the held object
+    and keep it off the objects standing around)."""
+    return _belief() is not None and first.pose is not None and second.pose is not None
 
 
 def _carry_two(
@@ -481,7 +450,6 @@ def _carry_two(
     outcome: SettingOutcome,
     partner: SettingOutcome,
     record: PlanRecord,
-    still_wanted: Callable[[], list[str]],
 ) -> Any:
     """Pick up `found` (for `outcome`'s setting); with an arm to spare, `partner`'s object
     believed and the way to it clear (`_clear_to_carry`), bring the partner's object with that
@@ -492,7 +460,7 @@ def _carry_two(
     held: Held = perform(PickUp(found))
     free = [arm for arm in arms() if arm not in held_objects()]
     partner_object = believed(other.type)
-    if free and partner_object is not None and _clear_to_carry(found, partner_object, still_wanted()):
+    if free and partner_object is not None and _clear_to_carry(found, partner_object):
         current_object.set_value(other.type)
         log.info("set table: the %s in the %s arm; the %s with the %s arm", setting.type, held.arm, other.type, free[0])
         try:
@@ -519,7 +487,6 @@ def _bring(
     outcome: SettingOutcome,
     partner: SettingOutcome | None,
     record: PlanRecord,
-    still_wanted: Callable[[], list[str]],
 ) -> None:
     """Transport rounds for one setting, each bounded by the time budget; in the first round,
     `partner` (the next setting) may be brought along with an arm to spare."""
@@ -536,7 +503,7 @@ def _bring(
                     log.info("set table: the %s is no longer held (%s); fetching it again", setting.type, empty)
             found = find(setting.type, record)
             if round_number == 1 and partner is not None and not partner.placed and _arms_to_spare() >= 2:
-                return _carry_two(found, outcome, partner, record, still_wanted)
+                return _carry_two(found, outcome, partner, record)
             return perform(Transport(found, setting.point))
 
         state = with_timeout(ROUND_TIME_BUDGET, transport, errors, name=f"bring the {setting.type}")
@@ -578,7 +545,7 @@ def set_table(settings: list[PlaceSetting], record: PlanRecord | None = None) ->
             partner = next((o for o in outcomes[index + 1 :] if not o.placed), None)
             current_object.set_value(outcome.setting.type)
             log.info("set table: bringing the %s to %s", outcome.setting.type, outcome.setting.point)
-            _bring(outcome, partner, record, still_wanted)
+            _bring(outcome, partner, record)
             current_object.set_value(None)
             if outcome.placed:
                 objects_done.set_value(objects_done.get_value() + 1)
