@@ -42,7 +42,13 @@ __all__ = [
 log = logging.getLogger("pycram.replay")
 
 #: The scenarios a recorded run can be replayed for (`pycram demo --scenario`).
-REPLAYABLE_SCENARIOS = ("thesis", "set-table", "set-table-open")
+REPLAYABLE_SCENARIOS = ("thesis", "set-table", "set-table-open", "clear-table", "put-away", "serve")
+#: The household tasks of the suite among them, by name -> the module holding their `TASK`.
+_TASKS = {
+    "clear-table": "pycram.apps.scenarios.clear_table.driver",
+    "put-away": "pycram.apps.scenarios.put_away.driver",
+    "serve": "pycram.apps.scenarios.serve.driver",
+}
 
 
 class CannotReplay(ValueError):
@@ -170,6 +176,27 @@ def rerun(
                 )
                 task, poses, trajectory = result.plan_task, result.final_poses, result.trajectory
                 stop_folder = result.stop_folder
+            elif scenario in _TASKS:
+                import importlib
+
+                from pycram.apps.scenarios.common.driver import run_task
+
+                pictures = bool(options.get("pictures", True))
+                objects = options.get("objects")
+                done, task = run_task(
+                    importlib.import_module(_TASKS[scenario]).TASK,
+                    replay["robot"],
+                    int(replay["seed"]),
+                    frozenset(options.get("faults", ())),
+                    environment=replay.get("environment"),
+                    objects=tuple(objects) if objects is not None else None,
+                    output=folder if pictures else None,
+                    stepping=replay["stepping"],
+                    until=until,
+                    until_folder=folder,
+                )
+                poses, trajectory = done.final_poses, done.trajectory
+                stop_folder = done.stop_folder
             else:
                 from pycram.apps.scenarios.set_table.driver import run_scenario
 

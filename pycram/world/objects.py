@@ -84,6 +84,9 @@ class ObjectType:
     the surface kinds such objects are put on or in ("counter", "table", "cupboard", "drawer",
     "shelf" -- a fridge's), most likely first: a search opens the containers whose insides are
     of an earlier kind first (cups are kept in drawers, then in a cupboard, before the fridge).
+    `stored_in` are the kinds of container insides such objects are *put away* in, best first
+    (`STORED_IN`: milk cold on a fridge's "shelf", cereal dry in the "cupboard", cups in a
+    "drawer"); empty for a type that is not put away.
     """
 
     name: str
@@ -94,6 +97,7 @@ class ObjectType:
     grasps: tuple[Grasp, ...]
     found_on: tuple[str, ...] = ("counter", "table", "drawer", "cupboard", "shelf")
     description: str = ""
+    stored_in: tuple[str, ...] = ()
 
     @property
     def half_height(self) -> float:
@@ -183,6 +187,22 @@ def shape_parts(shape: str, size: tuple[float, ...]) -> list[Part]:
 
 _ANY_SURFACE = ("counter", "table", "drawer", "cupboard", "shelf")
 
+#: Where each object type is put away, as data: type -> the kinds of container insides
+#: (`pycram.world.environment.Surface.kind`: "drawer", "cupboard", "shelf" -- a fridge's) it
+#: belongs in, best first; each kind is one the type is found on (`ObjectType.found_on`). Cold
+#: food (milk) goes into the fridge, dry food (cereal) into the cupboard, cups, bowls and cutlery
+#: into the drawers, plates (too wide for a drawer) into the cupboard. Read by
+#: `ObjectType.stored_in`.
+STORED_IN: dict[str, tuple[str, ...]] = {
+    "cup": ("drawer", "cupboard"),
+    "mug": ("cupboard",),
+    "bowl": ("drawer", "cupboard"),
+    "plate": ("cupboard",),
+    "spoon": ("drawer",),
+    "cereal": ("cupboard",),
+    "milk": ("shelf",),
+}
+
 #: Every object type by name.
 OBJECT_TYPES: dict[str, ObjectType] = {
     t.name: t
@@ -196,6 +216,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (Grasp("side", 0.07, 0.05), Grasp("top", 0.07, 0.06, across="radial")),
             _ANY_SURFACE,
             "a drinking cup, 7 cm wide, 9 cm tall; from the top (in drawers) by its body",
+            stored_in=STORED_IN["cup"],
         ),
         ObjectType(
             "mug",
@@ -206,6 +227,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (Grasp("side", 0.06, 0.05), Grasp("top", 0.06, 0.07, across="radial")),
             ("counter", "table", "cupboard", "shelf"),
             "the thesis demo's mug, 6 cm wide, 10 cm tall (yellow, to stand out in pictures)",
+            stored_in=STORED_IN["mug"],
         ),
         ObjectType(
             "bowl",
@@ -216,6 +238,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (Grasp("top", 0.008, 0.06, radius=0.066, across="radial"),),
             _ANY_SURFACE,
             "a cereal bowl, 14 cm wide, 7 cm tall; grasped at its rim",
+            stored_in=STORED_IN["bowl"],
         ),
         ObjectType(
             "plate",
@@ -226,6 +249,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (Grasp("top", 0.008, 0.02, radius=0.106, across="radial"),),
             ("counter", "table", "cupboard", "shelf"),
             "a dinner plate, 22 cm wide, with a 1 cm rim; grasped at its rim",
+            stored_in=STORED_IN["plate"],
         ),
         ObjectType(
             "spoon",
@@ -236,6 +260,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             (Grasp("top", 0.022, 0.005, across="y"),),
             ("counter", "table", "drawer"),
             "a spoon (a flat bar, 15 cm long); grasped from above across its handle",
+            stored_in=STORED_IN["spoon"],
         ),
         ObjectType(
             "cereal",
@@ -250,6 +275,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             ),
             ("counter", "table", "cupboard", "shelf"),
             "a cereal box, 7 x 19 x 28 cm; grasped across its narrow side, 2.5 cm in from its end",
+            stored_in=STORED_IN["cereal"],
         ),
         ObjectType(
             "milk",
@@ -260,6 +286,7 @@ OBJECT_TYPES: dict[str, ObjectType] = {
             tuple(Grasp(a, 0.07, 0.1) for a in ("+x", "-x", "+y", "-y")),
             ("counter", "table", "shelf"),
             "a milk carton, 7 x 7 x 20 cm",
+            stored_in=STORED_IN["milk"],
         ),
     )
 }
@@ -277,6 +304,7 @@ __all__ = [
     "Grasp",
     "Part",
     "OBJECT_TYPES",
+    "STORED_IN",
     "APPROACHES",
     "FOOTPRINT_SLACK",
     "object_type",

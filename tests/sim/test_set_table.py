@@ -148,7 +148,7 @@ def test_the_demo_command_runs_a_scenario_through_its_registered_front_end(tmp_p
     from pycram.apps.experiments.scenarios import demo_scenario_names
     from pycram.apps.scenarios.set_table import display
 
-    assert demo_scenario_names() == ["set-table", "set-table-open"]
+    assert demo_scenario_names() == ["set-table", "set-table-open", "clear-table", "put-away", "serve"]
     started = []
 
     class Stopped(Exception):

@@ -69,7 +69,9 @@ def demo_command(
         "--scenario",
         help="thesis: fetch and place in the thesis kitchen; set-table: set the table for breakfast in the "
         "apartment (objects on counters and in a closed drawer); set-table-open: the same, every object "
-        "starting on an open surface.",
+        "starting on an open surface; clear-table: everything on the table into the drawers and the cupboard; "
+        "put-away: groceries from the counter into the fridge and the cupboard; serve: two requested objects "
+        "to a seat at the table (the last three also in generated apartments: --env procedural:SEED).",
     ),
     env: str | None = typer.Option(
         None,
@@ -80,7 +82,9 @@ def demo_command(
     faults: str = typer.Option(
         "",
         "--faults",
-        help="set-table only: comma-separated faults drawn from the seed: moved, taken, stuck, obstacle, missed.",
+        help="Comma-separated faults drawn from the seed: set-table: moved, taken, stuck, obstacle, missed; "
+        "clear-table: moved, taken, stuck, missed; put-away: moved, taken, missed; serve: moved, taken, obstacle, "
+        "missed.",
     ),
     verbose: bool = typer.Option(
         False,
@@ -140,7 +144,7 @@ def demo_command(
         code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
         raise typer.Exit(int(code or 0))
     if faults:
-        fail("--faults applies to --scenario set-table only (the thesis demo has --steal)", code=2)
+        fail("--faults applies to the household scenarios, not the thesis demo (it has --steal)", code=2)
     try:
         from pycram.apps.demos.kitchen import main as demo_main
     except ModuleNotFoundError as e:

@@ -28,7 +28,8 @@ def experiment_command(
     scenario: str | None = typer.Option(
         None,
         "--scenario",
-        help="Scenario: thesis (default), set-table, set-table-open, or an import path package.module:function.",
+        help="Scenario: thesis (default), set-table, set-table-open, clear-table, put-away, serve, or an import "
+        "path package.module:function.",
     ),
     robot: str | None = typer.Option(
         None,

@@ -354,3 +354,24 @@ register_scenario(
     description="set the table, every object starting on an open surface (none in a closed drawer)",
     environment="apartment",
 )
+register_scenario(
+    "clear-table",
+    "pycram.apps.scenarios.clear_table:run_clear_table",
+    demo="pycram.apps.scenarios.clear_table.display:main",
+    description="clear the table: a cup and a bowl into a drawer, a plate into the cupboard, all closed (issue 33)",
+    environment="apartment",
+)
+register_scenario(
+    "put-away",
+    "pycram.apps.scenarios.put_away:run_put_away",
+    demo="pycram.apps.scenarios.put_away.display:main",
+    description="put the groceries away: milk into the fridge, cereal into the cupboard, doors closed (issue 33)",
+    environment="apartment",
+)
+register_scenario(
+    "serve",
+    "pycram.apps.scenarios.serve:run_serve",
+    demo="pycram.apps.scenarios.serve.display:main",
+    description="serve: bring two requested objects to a seat at the table, next to each other (issue 33)",
+    environment="apartment",
+)

@@ -48,49 +48,25 @@ def main(
     import os
 
     from rich.console import Console
-    from rich.live import Live
-    from rich.markup import escape
 
-    from pycram.apps.scenarios.set_table.plan import current_object, objects_done
-    from pycram.apps.terminal import (
-        failure_hint,
-        failure_text,
-        log_to_terminal,
-        stderr_console,
-        task_tree_display,
-        write_run_pictures,
-    )
+    from pycram.apps.scenarios.common.display import begin, finish_recording, live_line, report_run
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     console = Console()
-    try:
-        kinds = _check(robot, seed, faults)
-        stepping = check_stepping(stepping)
-        check_until(until)
-    except ValueError as error:
-        console.print(f"[bold red]pycram demo:[/bold red] {error}", highlight=False, soft_wrap=True)
-        return 2
-    if not quiet:
-        log_to_terminal()
-    recorder = None
-    if record:
-        from pycram.trace import start_recording
 
-        recorder = start_recording(url=db, plan=f"set table ({robot}, seed {seed})")
+    def checks() -> tuple[frozenset[str], str]:
+        kinds = _check(robot, seed, faults)
+        checked_stepping = check_stepping(stepping)
+        check_until(until)
+        return kinds, checked_stepping
+
+    started = begin(console, checks, quiet=quiet, record=record, db=db, title=f"set table ({robot}, seed {seed})")
+    if started is None:
+        return 2
+    (kinds, stepping), recorder = started
     run_id = recorder.run_id if recorder is not None else None
     folder = Path(output) if output else _output_folder(robot, seed, run_id)
-    live = None if quiet else Live("", console=stderr_console(), refresh_per_second=4, transient=False)
-
-    def progress(world: Any, plan: Any, injector: Any) -> None:
-        if live is None:
-            return
-        current = current_object.get_value()
-        live.update(
-            f"objects done: {objects_done.get_value()}/{len(OBJECTS)}  "
-            f"{'bringing the ' + current if current else 'between objects':<22}  "
-            f"faults: {len(injector.injected)}  sim {world.sim_time.get_value():6.1f} s"
-        )
-
+    live, progress = live_line(quiet, len(OBJECTS))
     result: SetTableResult | None = None
     task = None
     try:
@@ -115,49 +91,18 @@ def main(
             record_replay_info(
                 recorder, result, task, in_containers=in_containers, stepping=stepping, pictures=True, until=until
             )
-            ok = result is not None and result.success
-            stopped = result is not None and result.stopped_at is not None
-            run_id = recorder.finish(
-                "succeeded" if ok else "interrupted" if stopped else "failed",
-                None if ok else (result.summary() if result else "error"),
-            )
-    files = [folder / n for n in ("start.png", "end.png", "run.gif") if (folder / n).exists()]
-    if recorder is not None:
-        files += write_run_pictures(run_id, task, folder, recorder.url)
-    console.print()
-    console.print(task_tree_display(task, run_id, db))
-    assert result is not None
-    console.print(
-        f"\nthe plan simulated {result.sim_time:.1f} s; the whole run took {result.wall_time:.1f} s of wall time"
+            run_id = finish_recording(recorder, result)
+    return report_run(
+        console,
+        result,
+        task,
+        folder=folder,
+        recorder=recorder,
+        run_id=run_id,
+        db=db,
+        until=until,
+        success_text="the table is set, every drawer closed",
     )
-    for name, obj in result.objects.items():
-        mark = (
-            "[green]placed[/green]"
-            if obj.placed
-            else f"[red]missing[/red] ({obj.failure or 'not at its place'}: {escape(failure_text(obj.reason))})"
-        )
-        console.print(f"  {name}: {mark}", highlight=False)
-    if result.faults_injected:
-        console.print("faults: " + "; ".join(result.faults_injected), highlight=False)
-    console.print(f"pictures in {folder.resolve()}: " + ", ".join(p.name for p in files))
-    if run_id is not None:
-        console.print(f"recorded as run {run_id} (see `pycram show {run_id}`)")
-    if result.stopped_at is not None:
-        console.print(
-            f"[bold yellow]STOPPED[/bold yellow] at t={result.stopped_at:.2f} s of simulated time (--until {until:g}): "
-            f"the scene, the belief and the task tree of that moment are in {result.stop_folder}",
-            highlight=False,
-        )
-        return 0
-    if result.success:
-        console.print("[bold green]SUCCESS[/bold green]: the table is set, every drawer closed")
-        return 0
-    console.print(f"[bold red]FAILURE[/bold red]: {escape(failure_text(result.summary()))}", highlight=False)
-    failed = [o.failure for o in result.objects.values() if o.failure]
-    first = result.error.split(":")[0] if result.error else (failed[0] if failed else None)
-    if failure_hint(first):
-        console.print(f"  try: {escape(failure_hint(first))}", highlight=False)
-    return 1
 
 
 def main_on_open_surfaces(**options: Any) -> int:

@@ -18,12 +18,13 @@ from pathlib import Path
 from typing import Any
 
 from pycram.apps.run_options import check_until
+from pycram.apps.scenarios.common.driver import ScenarioPlan, play, start_pictures
 from pycram.apps.scenarios.set_table.data import FAULTS, MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
 from pycram.apps.scenarios.set_table.faults import Faults, check_faults
-from pycram.apps.scenarios.set_table.judge import SetTableResult, _HeldAtOnce, judge
+from pycram.apps.scenarios.set_table.judge import SetTableResult, judge
 from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
 from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
-from pycram.core.runtime.lockstep import DEFAULT_STEPPING, LockstepClock, PlanThread
+from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 
 __all__ = [
     "open_world",
@@ -36,44 +37,18 @@ __all__ = [
 log = logging.getLogger("pycram.demo")
 
 
-class _PlanThread:
-    """The plan in a thread of its own (a task tree root), so the driver can watch time limits."""
+class _PlanThread(ScenarioPlan):
+    """The set-table plan in a thread of its own (a task tree root), so the driver can watch time
+    limits."""
 
     def __init__(self, robot: Any, settings: list[PlaceSetting]) -> None:
-        self.robot, self.settings = robot, settings
-        self.record = PlanRecord()
-        self.task: Any = None
-        self.error: BaseException | None = None
-        self.outcomes: list[SettingOutcome] | None = None
-        self._thread = PlanThread(target=self._run, name="pycram-set-table", daemon=True, hand_over=True)
+        self.settings = settings
+        super().__init__(robot, self._set_table, "set_table", "pycram-set-table")
 
-    def _run(self) -> None:
+    def _set_table(self, record: PlanRecord) -> list[SettingOutcome]:
         from pycram.apps.scenarios.set_table.plan import set_table
-        from pycram.core.runtime import current_task, end_thread_root, run_subtask
 
-        def whole_plan() -> Any:
-            self.task = current_task()
-            with self.robot:
-                self.outcomes = set_table(self.settings, self.record)
-
-        try:
-            run_subtask("set_table", whole_plan, kind="plan")
-        except BaseException as error:  # evaporated (time limit) or a bug
-            self.error = error
-        finally:
-            end_thread_root(self.error)
-
-    def start(self) -> None:
-        self._thread.start()
-
-    def join(self, timeout: float) -> bool:
-        self._thread.join(timeout)
-        return not self._thread.is_alive()
-
-    def stop(self, timeout: float = 30.0) -> None:
-        if self.task is not None:
-            self.task.evaporate()
-        self._thread.join(timeout)
+        return set_table(self.settings, record)
 
 
 def open_world(
@@ -139,7 +114,7 @@ def run_scenario(
     else ``output/set-table-ROBOT-SEED``), then stop the plan (`result.stopped_at`). Returns the
     result and the plan's task (the root of its task tree, None if it never started)."""
     from pycram import robots as robot_packages
-    from pycram.apps.terminal import STOP_PICTURE_SIZE, write_stop_pictures
+    from pycram.apps.terminal import STOP_PICTURE_SIZE
 
     kinds = _check(robot, seed, faults)
     check_until(until)
@@ -157,62 +132,26 @@ def run_scenario(
         if recorder is not None:
             recorder.set_run_info(robot=robot)
         camera = "overview"
-        if output is not None:
-            output.mkdir(parents=True, exist_ok=True)
-            world.snapshot(output / "start.png", camera=camera)
-            if animation:
-                world.start_recording(camera, fps=4.0, width=480, height=360, caption=_caption)
+        start_pictures(world, output, camera, animation, _caption)
         injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
-        held_at_once = _HeldAtOnce(world)
         plan = _PlanThread(robot_handle, settings)
-        sim_start = world.sim_time.get_value()
-        if until is not None:
-            world.hold_at(until)
-        injector.start()
-        plan.start()
-        if isinstance(world.clock, LockstepClock):
-            world.clock.leave()  # this thread only watches (by wall time): the plan runs on
-        sim_deadline, wall_deadline = sim_start + SIM_TIME_LIMIT, time.monotonic() + WALL_TIME_LIMIT
-        while not plan.join(0.25):
-            if progress is not None:
-                progress(world, plan, injector)
-            if until is not None and world.held.is_set():  # the world stands at `until`: look, then stop
-                result.stopped_at = world.sim_time.get_value()
-                folder = until_folder or output or Path("output") / f"set-table-{robot}-{seed}"
-                result.stop_folder = folder / f"until-{result.stopped_at:.1f}s"
-                title = f"set table · {robot} · seed {seed} · t={result.stopped_at:.2f} s"
-                write_stop_pictures(world, robot_handle.belief, plan.task, result.stop_folder, title)
-                result.error = f"stopped at t={result.stopped_at:.2f} s of simulated time (--until {until:g})"
-                plan.stop()  # evaporated while the world stands still: no task ends after `until`
-                break
-            if world.sim_time.get_value() > sim_deadline:
-                result.error = f"TimeoutError: the plan did not end within {SIM_TIME_LIMIT:.0f} s of simulated time"
-            elif time.monotonic() > wall_deadline:
-                result.error = f"TimeoutError: the plan did not end within {WALL_TIME_LIMIT:.0f} s of wall time"
-            if result.error:
-                log.warning("stopping the plan: %s", result.error)
-                plan.stop()
-                break
-        if isinstance(world.clock, LockstepClock):
-            world.clock.adopt()  # the plan ended (or was stopped): the world stands as it left it
-        injector.stop()
-        held_at_once.stop()
-        result.concurrency = {**plan.record.as_dict(), "most_held_at_once": held_at_once.most}
-        result.sim_time = world.sim_time.get_value() - sim_start
-        if plan.error is not None and result.error is None:
-            result.error = f"{type(plan.error).__name__}: {plan.error}"
-        result.faults_injected = list(injector.injected)
-        judge(world, settings, plan.outcomes, result)
-        result.final_poses = {"base": world.base_pose.get_value(), **world.item_poses.get_value()}
-        result.trajectory = world.trajectory()
-        if output is not None:
-            world.snapshot(output / "end.png", camera=camera)
-            if animation:
-                from pycram.backends.sim.render import write_animation
-
-                frames = world.stop_recording(timeout=300.0)
-                if frames:
-                    write_animation(output / "run.gif", frames, 8.0)
+        play(
+            world,
+            plan,
+            injector,
+            result,
+            sim_limit=SIM_TIME_LIMIT,
+            wall_limit=WALL_TIME_LIMIT,
+            progress=progress,
+            until=until,
+            folder=lambda: until_folder or output or Path("output") / f"set-table-{robot}-{seed}",
+            title=f"set table · {robot} · seed {seed}",
+            belief=robot_handle.belief,
+            judge=lambda outcomes: judge(world, settings, outcomes, result),
+            output=output,
+            camera=camera,
+            animation=animation,
+        )
     finally:
         if injector is not None:
             injector.stop()

@@ -13,6 +13,7 @@ import math
 import random
 from typing import Any
 
+from pycram.apps.scenarios.common.scene import table_edge
 from pycram.apps.scenarios.set_table.data import (
     OBJECTS,
     SCENE_DRAWS,
@@ -39,14 +40,7 @@ def place_settings(environment: Any, seat: str = SEAT, objects: tuple[str, ...] 
     x, y, yaw = environment.place(seat).pose
     fx, fy = math.cos(yaw), math.sin(yaw)  # the seat's heading: into the table
     rx, ry = fy, -fx  # to the right of the heading
-    # the table's edge facing the seat: where the heading from the seat enters the table's bounds
-    x0, y0, x1, y1 = table.bounds
-    edge = 0.0
-    for step in range(1, 400):
-        px, py = x + fx * 0.01 * step, y + fy * 0.01 * step
-        if x0 <= px <= x1 and y0 <= py <= y1:
-            edge = 0.01 * step
-            break
+    edge = table_edge(environment, seat)  # where the heading from the seat enters the table's bounds
     out = []
     for name in objects:
         if name not in SETTINGS:
