@@ -135,7 +135,7 @@ def test_the_demo_command_refuses_an_unknown_scenario_or_fault_naming_the_valid_
     assert result.exit_code == 2
     assert "valid faults: moved, taken, stuck, obstacle, missed" in result.output
     result = runner.invoke(app, ["demo", "--faults", "taken"])
-    assert result.exit_code == 2 and "set-table only" in result.output
+    assert result.exit_code == 2 and "not the thesis demo" in result.output
 
 
 def test_the_demo_command_runs_a_scenario_through_its_registered_front_end(tmp_path, monkeypatch):
