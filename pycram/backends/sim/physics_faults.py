@@ -29,6 +29,7 @@ and looks alike -- and no recovery of a plan handles it. The world's tools
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -76,6 +77,8 @@ FLOOR_TOLERANCE = 0.02
 #: Furniture boxes are shrunk by this much [m] on every side before an object's centre in them
 #: counts as sunk (thin boards are shrunk by at most a third of their half size).
 SINK_TOLERANCE = 0.002
+#: An object that moved less than this [m] since the last check is not tested for sinking again.
+MOVED = 1e-4
 #: The `Outcome` reason of commands ended by a physics fault.
 FAULT_REASON = "simulation_fault"
 
@@ -113,6 +116,7 @@ class PhysicsWatchdog:
         shrink = np.minimum(SINK_TOLERANCE, halves / 3.0)
         self._box_low, self._box_high = centres - halves + shrink, centres + halves - shrink
         self._fast = np.zeros(len(self._names), dtype=np.int64)
+        self._seen = np.full((len(self._names), 3), np.inf)  # positions at the last look [m]
         self._next = 0.0
         self.fault: SimulationFault | None = None
 
@@ -126,10 +130,11 @@ class PhysicsWatchdog:
         self._next = t + CHECK_PERIOD
         data = engine.data
         positions = data.xpos[self._bodies]
-        speeds = np.linalg.norm(data.qvel[self._linear], axis=1)
-        outside = np.any((positions < self._low) | (positions > self._high), axis=1)
-        self._fast = np.where(speeds > SPEED_LIMIT, self._fast + 1, 0)
+        velocities = data.qvel[self._linear]
+        squared = np.einsum("ij,ij->i", velocities, velocities)  # speeds squared [m^2/s^2]
+        self._fast = np.where(squared > SPEED_LIMIT * SPEED_LIMIT, self._fast + 1, 0)
         index, kind, detail = -1, "", ""
+        outside = ((positions < self._low) | (positions > self._high)).any(axis=1)
         if outside.any():
             index = int(np.flatnonzero(outside)[0])
             below = positions[index, 2] < self._low[2]
@@ -141,20 +146,15 @@ class PhysicsWatchdog:
                 if kind == "below_floor"
                 else f"outside the world (x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f}, z up to {z1:.1f} m)"
             )
-        elif (self._fast >= FAST_CHECKS).any():
+        elif self._fast.max(initial=0) >= FAST_CHECKS:
             index = int(np.flatnonzero(self._fast >= FAST_CHECKS)[0])
-            kind, detail = "too_fast", f"at {speeds[index]:.1f} m/s (more than {SPEED_LIMIT:.0f} m/s)"
+            kind, detail = "too_fast", f"at {math.sqrt(squared[index]):.1f} m/s (more than {SPEED_LIMIT:.0f} m/s)"
         elif len(self._box_names):
-            inside = np.all(
-                (positions[:, None, :] > self._box_low[None]) & (positions[:, None, :] < self._box_high[None]),
-                axis=2,
-            )
-            held = {g.holding for g in engine.grippers.values() if g.holding is not None}
-            for i, j in zip(*np.nonzero(inside), strict=True):
-                if self._names[int(i)] not in held:
-                    index, kind = int(i), "sunk"
-                    detail = f"its centre inside {self._box_names[int(j)]!r}"
-                    break
+            # only objects that moved since the last look can have sunk into something
+            moved = np.flatnonzero((np.abs(positions - self._seen) > MOVED).any(axis=1))
+            self._seen = positions
+            if moved.size:
+                index, kind, detail = self._sunk(engine, positions, moved)
         if index < 0:
             return None
         name = self._names[index]
@@ -163,9 +163,27 @@ class PhysicsWatchdog:
             f"{name} {PHYSICS_FAULT_KINDS[kind]} at t={t:.2f} s of simulated time: "
             f"at ({x:.2f}, {y:.2f}, {z:.2f}) m, {detail}"
         )
-        self.fault = SimulationFault(message, name, kind, t, (x, y, z), float(speeds[index]))
+        self.fault = SimulationFault(message, name, kind, t, (x, y, z), math.sqrt(float(squared[index])))
         log.error("physics fault: %s", message)
         return self.fault
+
+    def _sunk(self, engine: Engine, positions: np.ndarray, candidates: np.ndarray) -> tuple[int, str, str]:
+        """The first of the objects `candidates` (indices) whose centre is inside a solid piece
+        of furniture, no gripper holding it: (index, "sunk", detail), or (-1, "", "")."""
+        points = positions[candidates]
+        inside = np.all(
+            (points[:, None, :] > self._box_low[None]) & (points[:, None, :] < self._box_high[None]),
+            axis=2,
+        )
+        if not inside.any():
+            return -1, "", ""
+        held = {g.holding for g in engine.grippers.values() if g.holding is not None}
+        for i, j in zip(*np.nonzero(inside), strict=True):
+            index = int(candidates[int(i)])
+            if self._names[index] not in held:
+                return index, "sunk", f"its centre inside {self._box_names[int(j)]!r}"
+            self._seen[index] = np.inf  # held: looked at again at each check (it may be let go there)
+        return -1, "", ""
 
     def apply(self, world: World) -> None:
         """Run by the simulation thread each control tick, after the commands were started:
