@@ -127,3 +127,22 @@ def test_an_item_handed_into_the_open_gripper_is_grasped_when_the_robot_closes_i
     unattended = world.give_item("mug", gripper, close=False, timeout=1.0).wait(T)
     assert unattended is not None and not unattended.succeeded and unattended.reason == "timeout"
     assert world.gripper_states[gripper].get_value().holding is None
+
+
+def test_opening_lets_go_also_when_the_fingers_already_stand_fully_open(world):
+    """A box grasped across its diagonal (found as 9.9 cm in put-away: a 7-cm carton turned 45
+    deg) stalls the fingers at their widest; "open" is then no wider than they stand, and must
+    let go all the same (it did not: the carton was carried back out of the fridge)."""
+    d = world.description
+    arm = d.DEFAULT_ARM
+    gripper = d.ARMS[arm]["gripper"]
+    widest = d.GRIPPERS[gripper]["max_opening"]
+    ok(world.move_item("mug", (MUG_SPOT[0], MUG_SPOT[1], COUNTER_HEIGHT + world.scene.item("mug").half_height)))
+    ok(world.set_gripper(gripper, widest))
+    ok(world.move_arm_to(arm, "carry"))
+    # held with the fingers as wide as they go (as the contact weld does for a diagonal grasp)
+    ok(world._call("weld at full opening", lambda eng: eng.weld(eng.grippers[gripper], "mug")))
+    assert world.gripper_states[gripper].get_value().holding == "mug"
+    assert world.gripper_openings[gripper].get_value() >= widest - 0.002
+    ok(world.set_gripper(gripper, widest))
+    assert world.gripper_states[gripper].get_value().holding is None

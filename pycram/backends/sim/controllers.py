@@ -255,7 +255,9 @@ class GripperCommand(Controller):
         eng.model.actuator_forcerange[g.actuator] = (-effort * spec["effort_lever"], effort * spec["effort_lever"])
         g.closing = width < current - 1e-3 or width <= 0.005
         g.target_opening = width
-        if not g.closing and width > current + 1e-3:
+        if not g.closing:
+            # any command that does not close lets go -- also when the fingers already stand at
+            # that width (a held item can push them open as far as they go: then "open" is no wider)
             eng.release(g)
         # close a little beyond the goal so the fingers squeeze what they meet
         q = g.joint_for_opening(width)
