@@ -129,7 +129,8 @@ class MotionCommands(CommandQueue):
         The fingers never push harder than `effort` (the applied effort is published in
         `gripper_states[gripper].effort`). Closing on an item that is between the fingers (both
         touching it) grasps it with a weld; closing on nothing grasps nothing; any command that
-        does not close releases a held item (also one to the width the fingers stand at). A non-positive effort ends with reason "invalid".
+        does not close releases a held item (also one to the width the fingers stand at). A
+        non-positive effort ends with reason "invalid".
         """
         return self.submit(GripperCommand(self._check_gripper(gripper), opening, effort), f"gripper:{gripper}")
 
