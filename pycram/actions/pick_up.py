@@ -46,7 +46,7 @@ from pycram.execution.failures import (
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 from pycram.world.belief import PerceivedObject
-from pycram.world.objects import OBJECT_TYPES, Grasp, object_type
+from pycram.world.objects import OBJECT_TYPES, Grasp, approach_matches, object_type
 
 from .container_state import DOOR_USEFUL
 from .containers import DOOR_OPENING, Open, opening_one_at_a_time
@@ -92,6 +92,10 @@ STANDING_POSES = 2
 #: a plate or bowl depends on the view (its far rim hidden by its near one), by up to ~5 cm.
 MOVED = 0.03
 MOVED_FRACTION = 0.5
+#: A box measured turned by more than this [rad] from the pose its grasp was chosen for, once
+#: looked at from the standing pose, is planned for again (a first look from afar may measure no
+#: turn: a carton turned 45 deg was then grasped across its diagonal).
+TURNED = 0.2
 #: Picking from a drawer that is not far enough out: it is pulled to this much [m] short of its
 #: slide's end.
 WIDE_MARGIN = 0.03
@@ -119,7 +123,7 @@ def executable_grasps(type_name: str, requested: str | None = None) -> list[Gras
     top_ok = _reaching_takes_orientation()
     grasps = [g for g in object_type(type_name).grasps if top_ok or g.approach != "top"]
     if requested is not None:
-        grasps = [g for g in grasps if g.approach == requested]
+        grasps = [g for g in grasps if approach_matches(g.approach, requested)]
     return grasps
 
 
@@ -231,12 +235,24 @@ def _planned_reach(arm: str, location: Any, obj: PerceivedObject) -> Any:
     return reach
 
 
+def _turn_between(obj: PerceivedObject, before: float, after: float) -> float:
+    """How far [rad] `obj` turned between the yaws `before` and `after` [rad], up to the symmetry
+    of its top (a box with a square top looks the same a quarter turn on, another box half a turn
+    on; other shapes have no measured turn)."""
+    otype = OBJECT_TYPES.get(obj.type)
+    if otype is None or otype.shape != "box":
+        return 0.0
+    period = math.pi / 2 if otype.size[0] == otype.size[1] else math.pi
+    return abs((after - before + period / 2) % period - period / 2)
+
+
 def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     """One pick-up attempt from the standing pose `location` (see the module's description)."""
     arm = location.arm
     candidate = getattr(location, "grasp_candidate", None)
     gripper = gripper_of(arm)
     planned = tuple(obj.pose)
+    planned_yaw = obj.yaw
     motion(type="setting_gripper", gripper=gripper, position=1)
     # raised over the furniture; for a top grasp with the tool pointing down (``carry_top``),
     # which also keeps the arm out of the camera's view of a flat object (measured: the PR2's
@@ -275,6 +291,11 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     moved = max(MOVED, MOVED_FRACTION * object_type(obj.type).footprint_radius)
     if math.dist(obj.pose, planned) > moved:
         raise _ObjectMoved(f"{obj.name} moved from {_xyz(planned)} to {_xyz(obj.pose)}", obj)
+    turned = _turn_between(obj, planned_yaw, obj.yaw)
+    if turned > TURNED:  # measured turned from up close: the grasp was chosen for another turn
+        raise _ObjectMoved(
+            f"{obj.name} is turned {math.degrees(turned):.0f} deg from the pose its grasp was chosen for", obj
+        )
     poses: Any = getattr(location, "tool_poses", ())
     if candidate is not None:  # planned for where the object was when the location was resolved
         if math.dist(obj.pose, candidate.centre) > moved:

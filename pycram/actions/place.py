@@ -135,13 +135,18 @@ def _near_side(surface_name: str) -> tuple[float, float, float] | None:
 
 def _spots(target: Any, held: Held) -> Any:
     """The spots `target` stands for, best first. A surface's name means: on that surface, near
-    its side facing the robot (within easy reach of every arm)."""
+    its side facing the robot (within easy reach of every arm); a location designator ``on`` or
+    ``in`` something without ``for`` means spots for the held object's type."""
     if isinstance(target, str):
         near = _near_side(target)
         target = LocationDesignator(
             [("on", target), ("for", held.object.type)] + ([("near", near)] if near is not None else [])
         )
     if isinstance(target, LocationDesignator):
+        if target.prop_value("for") is None and (target.prop_value("on") or target.prop_value("in")):
+            # spots for this object: its centre above the surface, room for its footprint (without
+            # ``for`` a spot is a point of the surface itself)
+            target = target.copy([("for", held.object.type)])
         return solutions(target)
     if hasattr(target, "position"):
         return [tuple(target.position)]

@@ -9,7 +9,9 @@ believed object where it was put.
 
 A target inside a container (``('in', 'drawer 2')``, or the name of a drawer's, a shelf's or the
 fridge's inside) that the robot does not believe open is opened first (`Open`), before the object
-is fetched: the hand that opens it is free then, also on a one-armed robot.
+is fetched: the hand that opens it is free then, also on a one-armed robot. Into a container with
+a door, the object is taken from the side (`SIDE`) unless `grasp` says otherwise: the hand comes
+in through the door, under the shelf above.
 
 With ``close_container=True`` the container the object was taken from (a drawer the search
 opened) is closed again with `Close`, unless it was believed open before the transport: right
@@ -30,6 +32,7 @@ from pycram.designators.object import ObjectDesignator
 from pycram.execution.failures import GripperEmpty, ObjectSlipped
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
+from pycram.world.objects import SIDE
 
 from .container_state import CLOSED, DOOR_CLOSED
 from .containers import Close, Open
@@ -108,6 +111,19 @@ def _target_container(target: Any) -> str | None:
     return None
 
 
+def _grasp_for(container: str | None) -> str | None:
+    """The grasp an object must be held with to be put into `container`, by the way into it:
+    through a door (the fridge, a cupboard) the hand comes in from the front, so from the side
+    (`SIDE`: a hand that held it from the top finds no way in under the shelf above); into a
+    drawer from above, any grasp the object's type has; None when the target is in no door
+    container (any grasp)."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if container is None or environment is None:
+        return None
+    return SIDE if environment.container(container).kind == "door" else None
+
+
 def _type_of(wanted: Any) -> str | None:
     """The object type `wanted` names (an object designator's ``type``, a believed object's
     ``type``), None when it names none."""
@@ -153,6 +169,8 @@ def transporting(designator: ActionDesignator) -> Any:
     grasp = check_grasp("transporting", designator.prop_value("grasp"))
     opened_before = set(_open_containers())
     into = _target_container(target)
+    if grasp is None:
+        grasp = _grasp_for(into)
     if into is not None and into not in opened_before:
         log.info("transporting: opening %s first, to put the object in", into)
         perform(Open(into, arm=arm))

@@ -59,6 +59,7 @@ __all__ = [
     "color_name",
     "lying_orientation",
     "support_of",
+    "AXIS_KEPT_WITHIN",
 ]
 
 Vec3 = tuple[float, float, float]
@@ -69,6 +70,9 @@ MAX_LOOKS = 100
 #: camera with the ``missed`` fault: 3 looks in 10); two misses in a row are (for independent
 #: misses) 1 in 11, and an action that needs to know looks again (`PickUp`, `Place`).
 MISSES_TO_GONE = 2
+#: A look that measures no turn of an object (property "axis") keeps the one measured before
+#: while the object is seen within this distance [m] of where it was.
+AXIS_KEPT_WITHIN = 0.02
 
 #: Colour names a recogniser reports (see `color_name`).
 COLOR_NAMES = ("red", "orange", "yellow", "green", "blue", "purple", "white", "grey", "black")
@@ -114,7 +118,8 @@ class Detection:
     mean colour (`rgb`, channels in [0, 1]); `support` the surface it rests on and `container`
     the container that surface is in (None when it rests on none known / an open surface);
     `pixels` how many pixels of it were visible; `axis` [rad] the direction of the longer
-    horizontal axis of its top when seen from above (None: round, square or not seen from above).
+    horizontal axis of its top when seen from above, or of a square top's sides (up to quarter
+    turns); None when the top is round or not seen from above.
     """
 
     type: str
@@ -231,12 +236,15 @@ class PerceivedObject(BelievedObject):
     def yaw(self) -> float:
         """Its turn about the vertical [rad] as far as perception measured it: from the measured
         direction of its top's longer axis (property "axis") and its type's shape (a box whose
-        y side is the longer one is turned by that direction - 90 deg); 0 when not measured or
-        when the shape has no longer axis."""
+        y side is the longer one is turned by that direction - 90 deg; a box with a square top
+        by the measured direction of its sides, in [-45, 45) deg: the same box a quarter turn
+        on); 0 when not measured or when the shape is not a box."""
         axis = self.properties.get("axis")
         otype = OBJECT_TYPES.get(self.type)
-        if axis is None or otype is None or otype.shape != "box" or otype.size[0] == otype.size[1]:
+        if axis is None or otype is None or otype.shape != "box":
             return 0.0
+        if otype.size[0] == otype.size[1]:  # a square top: its sides' direction, up to quarter turns
+            return (float(axis) + math.pi / 4) % (math.pi / 2) - math.pi / 4
         yaw = float(axis) - (math.pi / 2 if otype.size[1] > otype.size[0] else 0.0)
         return (yaw + math.pi) % (2 * math.pi) - math.pi
 
@@ -521,6 +529,11 @@ class BeliefState(Belief):
 
     @staticmethod
     def _refresh(obj: PerceivedObject, detection: Detection, stamp: float) -> None:
+        axis = detection.axis
+        if axis is None and obj.pose is not None and math.dist(obj.pose, detection.position) <= AXIS_KEPT_WITHIN:
+            # a look that did not measure its turn (the top hidden or seen in part) keeps the
+            # turn measured before, while it stands where it stood
+            axis = obj.properties.get("axis")
         obj.properties.update(
             color=detection.color,
             size=detection.size,
@@ -528,7 +541,7 @@ class BeliefState(Belief):
             **{"in": detection.container},
             last_seen=stamp,
             pixels=detection.pixels,
-            axis=detection.axis,
+            axis=axis,
         )
         obj.gone = False
         obj.misses = 0

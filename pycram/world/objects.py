@@ -19,6 +19,17 @@ RGBA = tuple[float, float, float, float]
 #: Horizontal approach directions in the object's frame; "side" means any horizontal direction
 #: (round objects), "top" straight down.
 APPROACHES = ("top", "side", "+x", "-x", "+y", "-y")
+#: The approach "side": asked for (`PickUp(grasp='side')`, ``('grasp', 'side')``), any horizontal
+#: approach of the object's type (a box's ``+x``, ``-y``, ...), not from the top.
+SIDE = "side"
+
+
+def approach_matches(approach: str, requested: str) -> bool:
+    """Whether a grasp approached along `approach` is one `requested` asks for: the same
+    approach, or, for `SIDE`, any but ``"top"``."""
+    return approach == requested or (requested == SIDE and approach != "top")
+
+
 #: An object measured wider on its surface than its standing footprint (`ObjectType.footprint_radius`)
 #: by more than this [m] lies on its side (seen from above, a toppled object's shadow is longer
 #: than any standing one's: a milk carton lying shows at least 19 cm, standing at most 10 cm).
@@ -300,6 +311,8 @@ def object_type(name: str) -> ObjectType:
 
 
 __all__ = [
+    "SIDE",
+    "approach_matches",
     "ObjectType",
     "Grasp",
     "Part",

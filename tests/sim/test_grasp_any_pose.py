@@ -14,8 +14,8 @@ import pytest
 from action_helpers import COUNTER, apartment_with, holding
 from sim_helpers import ok, tilt
 
-from pycram.actions import MoveTorso, ParkArms, PickUp, Place
-from pycram.designator import ObjectDesignator, perform
+from pycram.actions import MoveTorso, ParkArms, PickUp, Place, Transport
+from pycram.designator import LocationDesignator, ObjectDesignator, perform
 from pycram.world.objects import object_type
 
 
@@ -96,3 +96,26 @@ def test_a_cereal_box_turned_60_degrees_is_picked_up(robot_name):
         box = world.item_poses.get_value()["cereal"]
         assert tilt(box.orientation) < math.radians(20)  # held upright
         assert math.dist(box.position[:2], (x, y)) > 0.15  # carried away from where it stood
+
+
+def test_a_square_carton_turned_45_degrees_goes_into_the_fridge_held_by_its_faces():
+    # Its sides' direction is measured (a square top has no longer axis); across its diagonal
+    # (9.9 cm) the fingers could not close. Into the fridge `Transport` takes it from the side:
+    # a hand holding it from the top finds no way in under the shelf above (before: a planned top
+    # grasp, then "no standing pose" to place it on any shelf).
+    yaw = math.radians(45)
+    with apartment_with("pr2", {"milk": COUNTER}) as (world, robot):
+        x, y = COUNTER[1]
+        z = world.environment.surface("counter").height + object_type("milk").half_height + 0.002
+        ok(world.move_item("milk", (x, y, z), (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))))
+        ready()
+        widths: list[float] = []
+        world.gripper_states["left"].on_change(lambda s: s.holding and widths.append(s.opening))
+        world.gripper_states["right"].on_change(lambda s: s.holding and widths.append(s.opening))
+        placed = perform(Transport(ObjectDesignator(type="milk"), LocationDesignator([("in", "fridge")])))
+        assert widths and max(widths) < 0.08  # held across two faces (7 cm), never the diagonal
+        milk = world.item_poses.get_value()["milk"]
+        assert placed.properties["in"] == "fridge"
+        assert any(s.contains(*milk.position[:2], 0.0) for s in world.environment.container("fridge").interior)
+        assert tilt(milk.orientation) < math.radians(20)
+        assert not holding(world)

@@ -200,3 +200,16 @@ def test_an_object_in_hand_is_not_missed_and_its_sighting_in_the_air_is_not_a_ne
     belief.picked_up(milk, "left")
     belief.lost(milk)
     assert belief.in_hand == {} and milk.gone
+
+
+def test_a_look_that_measures_no_turn_keeps_the_turn_measured_before_while_the_object_stays():
+    def milk(x, axis):
+        return Detection("milk", (x, 2.0, 0.85), (0.07, 0.07, 0.2), "white", support="table", pixels=500, axis=axis)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, -math.pi / 4),))).added
+    assert carton.yaw == pytest.approx(-math.pi / 4)  # a square top: its sides' direction
+    belief.update(PerceptionReport(2.0, (milk(4.305, None),)))  # the top hidden this time
+    assert carton.yaw == pytest.approx(-math.pi / 4)
+    belief.update(PerceptionReport(3.0, (milk(4.4, None),)))  # it moved: the old turn is no proof
+    assert carton.properties["axis"] is None and carton.yaw == 0.0

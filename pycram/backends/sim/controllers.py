@@ -253,7 +253,10 @@ class GripperCommand(Controller):
         width = min(max(self.opening, 0.0), spec["max_opening"])
         current = g.opening(eng.data)
         eng.model.actuator_forcerange[g.actuator] = (-effort * spec["effort_lever"], effort * spec["effort_lever"])
-        g.closing = width < current - 1e-3 or width <= 0.005
+        # opening as wide as the fingers go never closes, even when a held item pushed them
+        # a little further (measured: 92 mm of 90, a carton held across its diagonal)
+        widest = width >= spec["max_opening"] - 1e-3
+        g.closing = (width < current - 1e-3 and not widest) or width <= 0.005
         g.target_opening = width
         if not g.closing:
             # any command that does not close lets go -- also when the fingers already stand at

@@ -38,7 +38,7 @@ from pycram.reasoning.grasps import (
 )
 from pycram.reasoning.grasps import TOP_PENALTY as GRASP_TOP_PENALTY
 from pycram.world.environment import FURNITURE_TOPS, Container, Environment
-from pycram.world.objects import Grasp
+from pycram.world.objects import SIDE, Grasp, approach_matches
 
 from .costmap import Costmap, FloorGrid, angle_difference, ring_layer
 from .grasps import PHASES, grasp_sequence
@@ -85,12 +85,13 @@ class ReachVocabulary(StandingSearch):
         pose = _object_pose(target)
         # the tables' grasps are for objects standing upright: one lying on its side is grasped
         # with planned grasps only
-        lying = pose is not None and not pose.is_upright and desig.prop_value("grasp") is None
+        requested = desig.prop_value("grasp")
+        lying = pose is not None and not pose.is_upright and requested in (None, SIDE)
         if lying:
             grasps = []
         elif drawer is not None:
             grasps = self._over_the_rim(desig, target, grasps, drawer)
-        elif desig.prop_value("grasp") is None:  # out in the open, a cup is taken by its side
+        elif requested is None:  # out in the open, a cup is taken by its side
             grasps = [g for g in grasps if not _body_from_the_top(g)] or grasps
         grid = FloorGrid.of(env)
         # the base may come closer to an open drawer than to the furniture
@@ -295,7 +296,8 @@ class ReachVocabulary(StandingSearch):
         a box turned far from square to the furniture it stands on), and then no top grasp when
         its type has one of its own. Empty lists otherwise."""
         none: dict[str, list[GraspOption]] = {arm: [] for arm in arms}
-        if action != "grasp" or desig.prop_value("grasp") is not None or pose is None:
+        requested = desig.prop_value("grasp")
+        if action != "grasp" or requested not in (None, SIDE) or pose is None:
             return none
         if not self.geometry.max_openings:
             return none
@@ -309,6 +311,8 @@ class ReachVocabulary(StandingSearch):
             if drawer is not None:  # over the drawer's walls
                 options = [o for o in options if o.approach == "top"]
             elif upright and has_top:  # the type's own top grasp is tuned
+                options = [o for o in options if o.approach != "top"]
+            if requested == SIDE:  # from the side only: any horizontal approach
                 options = [o for o in options if o.approach != "top"]
             out[arm] = options
         return out
@@ -325,14 +329,15 @@ class ReachVocabulary(StandingSearch):
         return any(angle_difference(h, f) <= COVERED_TURN for h in headings if h is not None for f in facing)
 
     def _grasps(self, target: Target, requested: Any) -> list[Grasp]:
-        """The grasps to consider: the object type's, those with the approach `requested`, or
-        the `Grasp` `requested` itself (a planned grasp an object is held with, to put it down
-        as it is held)."""
+        """The grasps to consider: the object type's, those with the approach `requested`
+        (``'side'``: every horizontal approach -- a box's ``+x``/``-y``... as much as a cup's
+        ``side``), or the `Grasp` `requested` itself (a planned grasp an object is held with, to
+        put it down as it is held)."""
         if isinstance(requested, Grasp):
             return [requested]
         grasps = list(target.type.grasps) if target.type is not None else [_POINT_GRASP]
         if requested is not None:
-            chosen = [g for g in grasps if g.approach == requested]
+            chosen = [g for g in grasps if approach_matches(g.approach, requested)]
             if not chosen:
                 raise ValueError(
                     f"no grasp {requested!r} for {target.describe()}; available: {[g.approach for g in grasps]}"
