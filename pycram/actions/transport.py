@@ -11,7 +11,8 @@ A target inside a container (``('in', 'drawer 2')``, or the name of a drawer's, 
 fridge's inside) that the robot does not believe open is opened first (`Open`), before the object
 is fetched: the hand that opens it is free then, also on a one-armed robot. Into a container with
 a door, the object is taken from the side (`SIDE`) unless `grasp` says otherwise: the hand comes
-in through the door, under the shelf above.
+in through the door, under the shelf above. Where no standing pose takes it from the side where
+it stands, it is picked up as it can be, put down within reach and taken again from the side.
 
 With ``close_container=True`` the container the object was taken from (a drawer the search
 opened) is closed again with `Close`, unless it was believed open before the transport: right
@@ -29,7 +30,7 @@ from pycram.designators.action import ActionDesignator
 from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
-from pycram.execution.failures import GripperEmpty, ObjectSlipped
+from pycram.execution.failures import GripperEmpty, ObjectOutOfReach, ObjectSlipped
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 from pycram.world.objects import SIDE
@@ -158,6 +159,23 @@ def _open_wide_enough(container: str, type_name: str | None, arm: str | None) ->
     perform(Open(container, arm=arm, opening=float(drawer.limits[1])))
 
 
+def _pick_up(obj: Any, arm: str | None, grasp: str | None, regrasp: bool) -> Any:
+    """`PickUp` of `obj` with `grasp`. With `regrasp` (the grasp was chosen for the target, not
+    asked for), where no standing pose takes the object with that grasp where it stands (e.g. a
+    cereal box deep on the counter, for the cupboard from the side), it is picked up as it can be,
+    put down on its surface on the side facing the robot, and taken again with the grasp."""
+    try:
+        return perform(PickUp(obj, arm=arm, grasp=grasp))
+    except ObjectOutOfReach as error:
+        if not regrasp:
+            raise
+        log.info("transporting: %s cannot be taken %s where it stands (%s); moving it within reach", obj, grasp, error)
+    held = perform(PickUp(obj, arm=arm))
+    support = str(held.object.properties.get("on") or "table")
+    moved = perform(Place(held, support, arm=held.arm))
+    return perform(PickUp(moved, arm=arm, grasp=grasp))
+
+
 @action_plan("transporting")
 def transporting(designator: ActionDesignator) -> Any:
     wanted = designator.prop_value("object")
@@ -169,6 +187,7 @@ def transporting(designator: ActionDesignator) -> Any:
     grasp = check_grasp("transporting", designator.prop_value("grasp"))
     opened_before = set(_open_containers())
     into = _target_container(target)
+    chosen_for_target = grasp is None and _grasp_for(into) is not None
     if grasp is None:
         grasp = _grasp_for(into)
     if into is not None and into not in opened_before:
@@ -186,7 +205,7 @@ def transporting(designator: ActionDesignator) -> Any:
             close = (
                 bool(designator.prop_value("close_container")) and bool(container) and container not in opened_before
             )
-            held = perform(PickUp(obj, arm=arm, grasp=grasp))
+            held = _pick_up(obj, arm, grasp, chosen_for_target)
             free = [a for a in arms() if a not in held_objects()]
             if close and free:  # a free hand closes it at once, standing there
                 _close(container, free[0], obj)
