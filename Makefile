@@ -1,12 +1,14 @@
 # Two commands do all the set-up on a fresh machine:
 #   make demo  - create the virtual environment, install everything, run the thesis demo headless
 #   make test  - create the virtual environment if needed, install ROS 1 (scripts/install_ros.sh)
-#                and run the whole test suite
+#                and Chromium for the view's browser test (scripts/install_chromium.sh), and run
+#                the whole test suite
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 ROS    := $(VENV)/.ros-installed
+CHROMIUM := $(VENV)/.chromium-installed
 
 .PHONY: demo test bench docs check wheel ros clean lint types
 
@@ -22,10 +24,15 @@ $(ROS): $(STAMP) scripts/install_ros.sh $(wildcard pycram/backends/ros/interface
 
 ros: $(ROS)
 
+# Debian's headless Chromium for tests/view (apt-get only when `chromium` is missing).
+$(CHROMIUM): scripts/install_chromium.sh
+	scripts/install_chromium.sh
+	touch $(CHROMIUM)
+
 demo: $(STAMP)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(VENV)/bin/pycram demo
 
-test: $(STAMP) $(ROS)
+test: $(STAMP) $(ROS) $(CHROMIUM)
 	MUJOCO_GL=$${MUJOCO_GL:-egl} $(PY) -m pytest
 
 bench: $(STAMP)

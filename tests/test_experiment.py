@@ -263,9 +263,9 @@ def _run_inline(prepared, workers, stop, finished, outcome):
     """`_run_local` without worker processes (the test patches `execute_run` in this process)."""
     from pycram.apps.experiments import runner as experiment_runner
 
-    for robot, seed, variant in prepared.todo:
-        result = experiment_runner.execute_run(prepared.scenario.spec, robot, seed, variant, prepared.db)
-        finished((robot, seed, variant), result)
+    for key in prepared.todo:  # (robot, seed, variant, environment)
+        result = experiment_runner.execute_run(prepared.scenario.spec, key[0], key[1], key[2], prepared.db)
+        finished(key, result)
 
 
 @pytest.mark.skipif(

@@ -113,11 +113,11 @@ def test_every_run_is_recorded_with_its_environment(tmp_path):
     engine = sa.create_engine(f"sqlite:///{db}")
     try:
         with engine.connect() as conn:
-            rows = conn.execute(sa.text("SELECT variant, result FROM pycram_experiment_runs")).all()
+            rows = conn.execute(sa.text("SELECT variant, environment, result FROM pycram_experiment_runs")).all()
     finally:
         engine.dispose()
-    # the environment is in the run's key column and in its result
-    assert {(v, json.loads(r)["environment"]) for v, r in rows} == {(f"@{e}", e) for e in record.environments}
+    # the environment is in a column of its own (part of the run's key) and in its result
+    assert {(v, e, json.loads(r)["environment"]) for v, e, r in rows} == {("", e, e) for e in record.environments}
 
 
 @pytest.mark.parametrize(

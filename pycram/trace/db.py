@@ -19,7 +19,11 @@ Guarantees
 - Schema creation is idempotent and safe when several processes create it at once. A
   database written by an older PyCRAM is migrated on connect: missing columns are added
   (`ALTER TABLE ... ADD COLUMN`, NULL in old rows); when that is impossible (a read-only file),
-  readers still work (see `present_columns`).
+  readers still work (see `present_columns`). Schema 5 moved the environment of an
+  experiment's run out of its ``variant`` column (schema 4 wrote ``"faults@environment"``) into
+  a column of its own, ``environment``, and made it part of the run's key: an older
+  `pycram_experiment_runs` table is rebuilt (SQLite) or altered (PostgreSQL) on connect, in one
+  transaction under a lock, keeping every run (`migrate_experiment_runs`).
 - SQLite databases use write-ahead logging (WAL) and `synchronous=NORMAL`: a committed batch
   survives the writing process being killed (SIGKILL); readers never block the writer.
 """
@@ -29,6 +33,7 @@ from __future__ import annotations
 import logging
 import os
 import re
+import sqlite3
 import threading
 import weakref
 from pathlib import Path
@@ -56,13 +61,17 @@ __all__ = [
     "experiments_table",
     "experiment_runs_table",
     "present_columns",
+    "migrate_experiment_runs",
     "SUPPORTED_KINDS",
+    "SCHEMA_VERSION",
 ]
 
 #: 2: `pycram_tasks.error_origin`, `pycram_runs.clock` and `pycram_runs.lost_records`; 3:
 #: `pycram_tasks.location` (added to older databases on connect); 4: the tables
-#: `pycram_experiments` and `pycram_experiment_runs` (`pycram experiment`; created on connect).
-SCHEMA_VERSION = 4
+#: `pycram_experiments` and `pycram_experiment_runs` (`pycram experiment`; created on connect); 5:
+#: `pycram_experiment_runs.environment`, part of the run's key (migrated on connect:
+#: `migrate_experiment_runs`).
+SCHEMA_VERSION = 5
 
 #: Database kinds (SQLAlchemy backend names) that can hold run traces.
 SUPPORTED_KINDS = ("sqlite", "postgresql")
@@ -271,7 +280,8 @@ experiments_table = sa.Table(
     sa.Column("info", sa.Text),  # JSON object of extra metadata
 )
 
-#: One row per finished run of an experiment: robot, seed, variant and the scenario's result.
+#: One row per finished run of an experiment: robot, seed, variant, environment and the
+#: scenario's result.
 experiment_runs_table = sa.Table(
     "pycram_experiment_runs",
     metadata,
@@ -280,6 +290,9 @@ experiment_runs_table = sa.Table(
     sa.Column("robot", sa.String(255), nullable=False),
     sa.Column("seed", sa.Integer, nullable=False),
     sa.Column("variant", sa.String(512), nullable=False),  # sorted fault names joined by ",", "" for none
+    # the environment it ran in (`pycram experiment --env`: "procedural:3", "apartment", ...), "" for
+    # the scenario's own (an experiment without --env); schema 5 (older runs: migrated on connect)
+    sa.Column("environment", sa.String(512), nullable=False, server_default=""),
     sa.Column("status", sa.String(16), nullable=False),  # "done", or "error" when the scenario raised
     sa.Column("success", sa.Boolean, nullable=False),
     sa.Column("failure_causes", sa.Text),  # JSON list of failure type names
@@ -290,8 +303,15 @@ experiment_runs_table = sa.Table(
     sa.Column("result", sa.Text),  # the scenario's whole result (JSON)
     sa.Column("worker", sa.String(255)),  # host:pid that ran it
     sa.Column("finished_at", sa.DateTime(timezone=True)),
-    sa.UniqueConstraint("experiment_id", "robot", "seed", "variant", name="uq_pycram_experiment_runs_key"),
+    sa.UniqueConstraint(
+        "experiment_id", "robot", "seed", "variant", "environment", name="uq_pycram_experiment_runs_run"
+    ),
 )
+
+#: The unique constraint of `pycram_experiment_runs` before schema 5 (without the environment).
+_OLD_RUN_KEY = "uq_pycram_experiment_runs_key"
+#: How schema 4 joined a run's variant and environment in its ``variant`` column.
+_OLD_ENVIRONMENT_SEPARATOR = "@"
 
 
 def _enable_sqlite_wal(dbapi_connection: Any, _record: Any) -> None:
@@ -456,6 +476,7 @@ def ensure_schema(engine: Engine) -> None:
             if attempt == 2 or "already exists" not in text and "duplicate" not in text:
                 raise
             log.debug("schema creation raced with another process; retrying: %s", e)
+    migrate_experiment_runs(engine)
     _add_missing_columns(engine)
 
 
@@ -510,3 +531,125 @@ def _add_missing_columns(engine: Engine) -> None:
                 )
                 break
         _present.get(engine, {}).pop(table.name, None)
+
+
+def migrate_experiment_runs(engine: Engine) -> bool:
+    """Bring a `pycram_experiment_runs` table of schema 4 (no ``environment`` column; a run's
+    environment after ``@`` in its ``variant``) to schema 5: the column added, ``"faults@env"``
+    split into ``variant`` ``"faults"`` and ``environment`` ``"env"`` (``""`` where there was no
+    ``@``), the run's key made (experiment, robot, seed, variant, environment). Every run is kept.
+
+    SQLite cannot change a table's constraints, so the table is rebuilt (copied into a new one,
+    which replaces it) inside one ``BEGIN IMMEDIATE`` transaction; PostgreSQL alters it in one
+    transaction holding an exclusive lock on it. Either way another process migrating at the same
+    time waits, then finds the work done. Returns True when this call migrated the table; a
+    failure (e.g. a read-only file) is logged, not raised: readers of the old layout still work
+    (`present_columns` tells them which it has)."""
+    name = experiment_runs_table.name
+    inspector = sa.inspect(engine)
+    if not inspector.has_table(name) or "environment" in {c["name"] for c in inspector.get_columns(name)}:
+        return False
+    try:
+        if engine.dialect.name == "sqlite":
+            migrated = _migrate_sqlite(engine)
+        else:
+            migrated = _migrate_postgresql(engine)
+    except (sa_exc.DBAPIError, sqlite3.Error) as e:  # the SQLite rebuild runs on the driver's cursor
+        log.warning(
+            "cannot migrate %s in %s to schema %d (the environment of each run in a column of its own); "
+            "reading still works: %s",
+            name,
+            display_url(engine.url),
+            SCHEMA_VERSION,
+            str(getattr(e, "orig", e)).strip(),
+        )
+        return False
+    finally:
+        _present.get(engine, {}).pop(name, None)
+    if migrated:
+        log.info("trace database %s: moved the environments of experiment runs into their own column", engine.url)
+    return migrated
+
+
+def _split_sql(column: str, find: str, part: str) -> str:
+    """SQL for the variant (`part` "variant") or environment ("environment") of a schema-4
+    ``variant`` column value, with `find` the dialect's function `find(column, '@')`."""
+    at = f"{find}({column}, '{_OLD_ENVIRONMENT_SEPARATOR}')"
+    if part == "variant":
+        return f"CASE WHEN {at} > 0 THEN substr({column}, 1, {at} - 1) ELSE {column} END"
+    return f"CASE WHEN {at} > 0 THEN substr({column}, {at} + 1) ELSE '' END"
+
+
+def _migrate_sqlite(engine: Engine) -> bool:
+    """The schema-5 rebuild of `pycram_experiment_runs` in SQLite (see `migrate_experiment_runs`)."""
+    from sqlalchemy.schema import CreateTable
+
+    name = experiment_runs_table.name
+    staging = f"{name}_migrating"
+    staged = sa.MetaData()
+    experiments_table.to_metadata(staged)  # what the copy's foreign key refers to
+    new = experiment_runs_table.to_metadata(staged, name=staging)
+    raw = engine.raw_connection()
+    try:
+        dbapi: Any = raw.driver_connection
+        isolation = dbapi.isolation_level
+        dbapi.isolation_level = None  # transactions by hand: DDL would otherwise commit on its own
+        cursor = dbapi.cursor()
+        try:
+            cursor.execute("BEGIN IMMEDIATE")  # the write lock: a concurrent migration waits here
+            try:
+                old = [row[1] for row in cursor.execute(f"PRAGMA table_info({name})").fetchall()]
+                if "environment" in old:
+                    cursor.execute("ROLLBACK")
+                    return False  # another process migrated it while we waited
+                copied = [c.name for c in experiment_runs_table.columns if c.name in old]
+                values = [_split_sql("variant", "instr", "variant") if c == "variant" else c for c in copied]
+                cursor.execute(f"DROP TABLE IF EXISTS {staging}")
+                cursor.execute(str(CreateTable(new).compile(dialect=engine.dialect)))
+                cursor.execute(
+                    f"INSERT INTO {staging} ({', '.join(copied)}, environment) "
+                    f"SELECT {', '.join(values)}, {_split_sql('variant', 'instr', 'environment')} FROM {name}"
+                )
+                cursor.execute(f"DROP TABLE {name}")
+                cursor.execute(f"ALTER TABLE {staging} RENAME TO {name}")
+                cursor.execute("COMMIT")
+            except BaseException:
+                cursor.execute("ROLLBACK")
+                raise
+        finally:
+            cursor.close()
+            dbapi.isolation_level = isolation
+    finally:
+        raw.close()
+    return True
+
+
+def _migrate_postgresql(engine: Engine) -> bool:
+    """The schema-5 change of `pycram_experiment_runs` in PostgreSQL (see `migrate_experiment_runs`)."""
+    name = experiment_runs_table.name
+    with engine.begin() as conn:
+        conn.exec_driver_sql(f"LOCK TABLE {name} IN ACCESS EXCLUSIVE MODE")  # concurrent migrations wait
+        present = set(
+            conn.execute(
+                sa.text(
+                    "SELECT column_name FROM information_schema.columns "
+                    "WHERE table_name = :name AND table_schema = current_schema()"
+                ),
+                {"name": name},
+            ).scalars()
+        )
+        if "environment" in present:
+            return False
+        conn.exec_driver_sql(f"ALTER TABLE {name} ADD COLUMN environment VARCHAR(512) NOT NULL DEFAULT ''")
+        # the old key first: without the environment, runs in two environments would collide
+        conn.exec_driver_sql(f"ALTER TABLE {name} DROP CONSTRAINT IF EXISTS {_OLD_RUN_KEY}")
+        conn.exec_driver_sql(
+            f"UPDATE {name} SET environment = {_split_sql('variant', 'strpos', 'environment')}, "
+            f"variant = {_split_sql('variant', 'strpos', 'variant')} "
+            f"WHERE strpos(variant, '{_OLD_ENVIRONMENT_SEPARATOR}') > 0"
+        )
+        conn.exec_driver_sql(
+            f"ALTER TABLE {name} ADD CONSTRAINT uq_pycram_experiment_runs_run "
+            "UNIQUE (experiment_id, robot, seed, variant, environment)"
+        )
+    return True

@@ -8,6 +8,7 @@
     pycram graph [RUN] -o tree.svg      the task tree as an SVG picture
     pycram timeline [RUN] -o tl.png     which branches ran when (Gantt chart)
     pycram replay RUN                   run a recorded run again: "identical" or where it diverged
+    pycram view [RUN]                   the run in Rerun's web viewer (tree, statuses, failures; world with --rrd)
     pycram experiment --scenario thesis --robot pr2,tiago --seeds 1-200   many runs in parallel
 
 The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
@@ -19,7 +20,7 @@ Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the c
 need them.
 
 One module per group of commands: :mod:`~pycram.apps.cli.app` (the application and what
-the commands share), ``traces``, ``run``, ``demo``, ``replay``, ``scenes``, ``ros``, ``experiments``.
+the commands share), ``traces``, ``run``, ``demo``, ``replay``, ``scenes``, ``ros``, ``experiments``, ``view``.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import sys
 
 # The command groups register their commands on import, in the order `pycram --help` lists them.
 # isort: off
-from pycram.apps.cli import traces, run, demo, replay, scenes, ros, experiments  # noqa: F401
+from pycram.apps.cli import traces, run, demo, replay, scenes, ros, experiments, view  # noqa: F401
 
 # isort: on
 from pycram.apps.cli.app import app, console, err

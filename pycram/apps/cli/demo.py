@@ -13,6 +13,7 @@ from pycram.apps.cli.app import (
     record_flag,
     trace_errors,
 )
+from pycram.apps.cli.view import LiveView, ViewHostOption, ViewPortOption, ViewWaitOption
 from pycram.apps.run_options import check_until
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
@@ -101,6 +102,15 @@ def demo_command(
         "task tree of that moment into the output folder (until-T.Ts), stop the plan there; exit code 0 "
         "once they are written (a plan that ends before T: its usual exit code).",
     ),
+    view: bool = typer.Option(
+        False, "--view", help="Serve Rerun's web viewer (127.0.0.1) and stream the run into it; prints its URL."
+    ),
+    rrd: bool = typer.Option(
+        True, "--rrd/--no-rrd", help="Save the run's view as run.rrd next to its pictures (`pycram view RUN`)."
+    ),
+    view_port: int = ViewPortOption,
+    view_host: str = ViewHostOption,
+    view_wait: bool | None = ViewWaitOption,
 ) -> None:
     """The thesis demo (fetch and place in the simulated kitchen, with recovery from failures),
     or another scenario (`--scenario set-table`: search, fetch and place a breakfast setting).
@@ -140,8 +150,18 @@ def demo_command(
     environment = _environment_option(env, scenario)
     if environment is not None:
         common["environment"] = environment
+    live = LiveView(
+        view=view,
+        rrd=rrd,
+        port=view_port,
+        host=view_host,
+        wait=view_wait,
+        output=output,
+        name=f"pycram demo {scenario}",
+    )
     if scenario != "thesis":
-        code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
+        with live:
+            code = trace_errors(get_scenario(scenario).load_demo(), faults=faults, **common)
         raise typer.Exit(int(code or 0))
     if faults:
         fail("--faults applies to the household scenarios, not the thesis demo (it has --steal)", code=2)
@@ -151,15 +171,16 @@ def demo_command(
         if e.name and e.name.startswith("pycram.apps.demos"):
             fail("the kitchen demo (pycram.apps.demos.kitchen) is not available in this installation")
         fail(f"the demo needs the 'sim' extra (pip install 'pycram[sim]'): {e}")
-    code = trace_errors(
-        demo_main,
-        item_at=item_at,
-        steal=steal,
-        realtime=realtime,
-        interactive=interactive,
-        backend=backend,
-        **common,
-    )
+    with live:
+        code = trace_errors(
+            demo_main,
+            item_at=item_at,
+            steal=steal,
+            realtime=realtime,
+            interactive=interactive,
+            backend=backend,
+            **common,
+        )
     raise typer.Exit(int(code or 0))
 
 

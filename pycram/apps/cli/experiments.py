@@ -20,6 +20,7 @@ from pycram.apps.cli.app import (
     trace_errors,
     write_errors,
 )
+from pycram.apps.cli.view import ExperimentView, ViewHostOption, ViewPortOption, ViewWaitOption
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_names
 
 
@@ -84,6 +85,23 @@ def experiment_command(
         "not reproducible). A resumed experiment keeps its own.",
     ),
     db: str | None = DbOption,
+    verbose: bool = typer.Option(
+        False,
+        "--verbose",
+        "-v",
+        help="After the report, every failed run (robot, seed, environment, faults, its trace) with what ended it "
+        "as recorded, and errors in full instead of in two lines; `pycram show RUN` has a run's whole failure.",
+    ),
+    view: str | None = typer.Option(
+        None,
+        "--view",
+        metavar="RUN",
+        help="Watch one run live: SEED or ROBOT:SEED streams into Rerun's web viewer (served on 127.0.0.1; "
+        "its URL is printed). Local workers only.",
+    ),
+    view_port: int = ViewPortOption,
+    view_host: str = ViewHostOption,
+    view_wait: bool | None = ViewWaitOption,
 ) -> None:
     """Run a scenario over many robots, seeds and faults in parallel; report success and times.
 
@@ -99,6 +117,9 @@ def experiment_command(
     """
     import contextlib
 
+    from pycram.apps.terminal import set_verbose
+
+    set_verbose(verbose)
     os.environ.setdefault("MUJOCO_GL", "egl")
     try:
         from pycram.apps.experiments.runner import ExperimentInputError, RayUnavailable, prepare_experiment, ray_session
@@ -127,6 +148,17 @@ def experiment_command(
         stepping=stepping,
         environments=env,
     )
+    if view is not None and ray is not None:
+        fail("--view watches a run of local workers: not with --ray (look at a run afterwards: `pycram view RUN`)", 2)
+    watched = ExperimentView(view, view_port, view_host, view_wait) if view is not None else None
+    if watched is not None and seeds is not None:  # before an experiment is created (a resume checks below)
+        from pycram.apps.experiments.runner import parse_seeds
+
+        try:
+            if watched.seed not in parse_seeds(seeds):
+                fail(f"--view: seed {watched.seed} is not among the experiment's seeds", code=2)
+        except ValueError:
+            pass  # a bad --seeds: the experiment's own check says what is wrong
     with contextlib.ExitStack() as session:
         try:
             if ray is not None:  # check the input, then connect (before an experiment is created)
@@ -137,6 +169,10 @@ def experiment_command(
             fail(str(e), code=2)
         except RayUnavailable as e:
             fail(str(e))
+        if watched is not None:
+            if watched.seed not in prepared.record.seeds:
+                fail(f"--view: seed {watched.seed} is not among the experiment's seeds", code=2)
+            session.enter_context(watched)
         _run_experiment(prepared, workers, ray, output, db, reference)
 
 
@@ -155,7 +191,8 @@ def _run_experiment(
 
     from pycram.apps.experiments import report, store
     from pycram.apps.experiments.runner import ExperimentInputError, RayUnavailable, run_experiment
-    from pycram.apps.terminal import failure_text
+    from pycram.apps.experiments.splits import experiment_split
+    from pycram.apps.terminal import failure_text, is_verbose
     from pycram.core.interrupts import StopSignals
 
     record = prepared.record
@@ -169,6 +206,8 @@ def _run_experiment(
         + f"{len(record.variants)} variant(s): {total} runs, {prepared.done_before} recorded before, "
         f"{len(prepared.todo)} to run on {where}"
     )
+    split = experiment_split(record.seeds, record.environments)
+    _warn_split(split)
     counts = {"ok": 0, "failed": 0}
     with Progress(
         TextColumn("{task.description}"),
@@ -181,13 +220,14 @@ def _run_experiment(
     ) as bar:
         job = bar.add_task("runs", total=len(prepared.todo))
 
-        def progress(key: tuple[str, int, str], result: dict[str, Any] | None) -> None:
+        def progress(key: tuple[str, int, str, str], result: dict[str, Any] | None) -> None:
             if result is not None:
                 counts["ok" if result.get("success") else "failed"] += 1
+            last = f"{key[0]} seed {key[1]}" + (f" in {key[3]}" if key[3] else "")
             bar.update(
                 job,
                 advance=1 if result is not None else 0,
-                description=f"succeeded {counts['ok']}, failed {counts['failed']} · last: {key[0]} seed {key[1]}",
+                description=f"succeeded {counts['ok']}, failed {counts['failed']} · last: {escape(last)}",
             )
 
         with StopSignals() as stop:
@@ -201,17 +241,27 @@ def _run_experiment(
     groups = report.summarize(runs)
     title = f"experiment {record.id} ({record.name}): {record.scenario}, {len(runs)} of {total} runs"
     console.print(report.summary_table(groups, title=escape(title)))
-    console.print(report.causes_table(groups))
-    for line in report.comparisons(groups):
+    # several environments: the rates per environment above, over all of them below; the causes,
+    # the comparisons and (with many groups) the plot are over all of them
+    pooled = report.summarize(runs, by_environment=False) if len(record.environments) > 1 else groups
+    if pooled is not groups:
+        console.print(report.summary_table(pooled, title=escape(f"over all {len(record.environments)} environments")))
+    console.print(report.causes_table(pooled))
+    for line in report.comparisons(pooled):
         console.print(escape(line), highlight=False)
     if reference is not None:
-        theirs = report.summarize(trace_errors(store.run_records, db, reference.id))
+        theirs = trace_errors(store.run_records, db, reference.id)
+        theirs_groups = report.summarize(theirs, by_environment=pooled is groups)
         console.print(f"compared with experiment {reference.id} ({escape(reference.name)}):")
-        for line in report.comparisons(groups, reference=theirs) or ["(no robot and variant in common)"]:
+        for line in report.comparisons(pooled, reference=theirs_groups) or ["(no robot and variant in common)"]:
             console.print("  " + escape(line), highlight=False)
+    console.print(f"split: {escape(split.description)}", highlight=False)
+    _warn_split(split)
+    _tell_failed_runs(runs, is_verbose())
     folder = output if output is not None else Path("output") / f"experiment-{record.name}"
     if groups:
-        plot = write_errors(report.write_plot, groups, folder / "experiment.png", title)
+        drawn = groups if len(groups) <= _MAX_PLOTTED_GROUPS else pooled
+        plot = write_errors(report.write_plot, drawn, folder / "experiment.png", title)
         console.print(f"wrote {escape(str(plot))}")
     console.print(
         f"{outcome.recorded} runs in {outcome.wall_time:.1f} s "
@@ -225,7 +275,8 @@ def _run_experiment(
     if raised:
         err.print(
             f"[red]{len(raised)} runs raised an error[/red] (e.g. {escape(raised[0].robot)} seed {raised[0].seed}: "
-            f"{escape(failure_text(raised[0].error or ''))}); `pycram experiment --resume {record.id}` runs them again"
+            f"{escape(failure_text(raised[0].error or ''))}); `pycram experiment --resume {record.id}` runs them again",
+            soft_wrap=is_verbose(),
         )
     left = total - len(runs)
     if outcome.interrupted or left:
@@ -235,3 +286,60 @@ def _run_experiment(
         )
         raise typer.Exit(stop.exit_code if outcome.interrupted and stop.signum else 1)
     raise typer.Exit(1 if raised or outcome.errors else 0)
+
+
+#: The plot shows each robot, variant and environment up to this many groups, else each robot and
+#: variant over all environments.
+_MAX_PLOTTED_GROUPS = 12
+
+
+def _warn_split(split: Any) -> None:
+    """Warn (standard error) when an experiment mixes development or unsplit seeds or generated
+    apartments into an evaluation (`pycram.apps.experiments.splits`)."""
+    if split.problems:
+        err.print(
+            "[yellow]warning: not an evaluation:[/yellow] "
+            + escape("; ".join(split.problems))
+            + " -- report evaluation figures from evaluation seeds and worlds alone (docs/experiments.md)",
+            soft_wrap=True,
+        )
+
+
+def _failure_of(run: Any) -> str:
+    """What ended an unsuccessful run, as its result tells it: the error it raised, its summary,
+    the failures of its objects, or its failure causes."""
+    result = run.result or {}
+    if run.error:
+        return str(run.error)
+    if result.get("summary"):
+        return str(result["summary"])
+    objects = result.get("objects") or {}
+    told = [
+        f"{name}: {o.get('failure') or 'not placed'} ({o.get('reason')})"
+        for name, o in objects.items()
+        if isinstance(o, dict) and not o.get("placed")
+    ]
+    return "; ".join(told) or ", ".join(run.failure_causes) or "failed (no reason recorded)"
+
+
+def _tell_failed_runs(runs: list[Any], verbose: bool) -> None:
+    """With `verbose`, every unsuccessful run and what ended it, in full (`failure_text`); else
+    a hint that `--verbose` does so."""
+    from pycram.apps.terminal import failure_text
+
+    failed = [r for r in runs if not r.success]
+    if not failed:
+        return
+    if not verbose:
+        console.print(f"{len(failed)} runs failed; --verbose tells each of them in full", highlight=False)
+        return
+    console.print(f"{len(failed)} runs failed:")
+    for r in failed:
+        where = f" in {r.environment}" if r.environment else ""
+        trace = f" (trace: run {r.trace_run_id})" if r.trace_run_id is not None else ""
+        console.print(
+            escape(f"- {r.robot} seed {r.seed}{where}, faults {r.variant or 'none'}{trace}: ")
+            + escape(failure_text(_failure_of(r), verbose=True)),
+            highlight=False,
+            soft_wrap=True,
+        )

@@ -55,6 +55,7 @@ def replay_command(
     options = ", ".join(f"{k} {v}" for k, v in (replay.get("options") or {}).items() if k != "pictures")
     err.print(
         f"replaying run {info.id}: {replay['scenario']}, robot {replay['robot']}, seed {replay['seed']}"
+        + (f", in {escape(str(replay['environment']))}" if replay.get("environment") else "")
         + (f", {escape(options)}" if options else "")
         + f" (recorded by PyCRAM {replay.get('pycram')})",
         soft_wrap=True,

@@ -12,7 +12,7 @@ from pycram.apps.cli.app import (
     app,
     fail,
 )
-from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_NAMES
+from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_HELP
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 
@@ -64,7 +64,10 @@ def sim_ros_bridge_command(
         help="Thesis kitchen: where the demo's mug starts, position 1, 2 or 3 (0: no item; default 1).",
     ),
     environment: str = typer.Option(
-        DEFAULT_ENVIRONMENT, "--environment", help=f"The environment: {', '.join(ENVIRONMENT_NAMES)}."
+        DEFAULT_ENVIRONMENT,
+        "--environment",
+        "--env",
+        help=f"The environment: {ENVIRONMENT_HELP}. The plan's robot must be configured for the same one.",
     ),
     base_pose: str | None = typer.Option(
         None,
@@ -114,8 +117,12 @@ def sim_ros_bridge_command(
     would. Needs ROS_MASTER_URI."""
     if robot not in robot_names():
         fail(f"--robot must be {robot_choices()}, not {robot!r}", code=2)
-    if environment not in ENVIRONMENT_NAMES:
-        fail(f"--environment must be one of {', '.join(ENVIRONMENT_NAMES)}, not {environment!r}", code=2)
+    from pycram.apps.demos.ros_kitchen_world import bridge_environment
+
+    try:
+        environment = bridge_environment(environment)
+    except KeyError as e:
+        fail(f"--environment: {str(e).strip(chr(34) + chr(39))}", code=2)
     if item_at is not None and item_at != 0 and environment != DEFAULT_ENVIRONMENT:
         fail(f"--item-at places the demo's mug in the {DEFAULT_ENVIRONMENT}; use --object in the {environment}", code=2)
     try:

@@ -17,6 +17,7 @@ from pycram.apps.cli.app import (
     record_flag,
     trace_errors,
 )
+from pycram.apps.cli.view import LiveView, ViewHostOption, ViewPortOption, ViewWaitOption
 
 
 @app.command("run", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
@@ -31,6 +32,21 @@ def run_command(
     db: str | None = DbOption,
     plan: str | None = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
     robot: str | None = typer.Option(None, "--robot", help="Robot name recorded for the run."),
+    view: bool = typer.Option(
+        False, "--view", help="Serve Rerun's web viewer (127.0.0.1) and stream the run into it; prints its URL."
+    ),
+    rrd: bool = typer.Option(
+        False, "--rrd/--no-rrd", help="Save the run's view as run.rrd (next to its pictures, else in output/view-DATE)."
+    ),
+    view_port: int = ViewPortOption,
+    view_host: str = ViewHostOption,
+    view_wait: bool | None = ViewWaitOption,
+    verbose: bool = typer.Option(
+        False,
+        "--verbose",
+        help="Tell a failure of the plan in full (its traceback with every cause, then every message and "
+        "attempt) instead of its traceback ending in two lines; `pycram show RUN` always has the whole of it.",
+    ),
 ) -> None:
     """Run a plan script; arguments after FILE go to the script (in sys.argv).
 
@@ -39,13 +55,21 @@ def run_command(
     the exit code is 1. SIGINT (Ctrl-C) and SIGTERM stop the script so that its clean-up runs
     (in plain Python code as a KeyboardInterrupt, inside PyCRAM by evaporating the script's
     tasks): the run is recorded as "interrupted" with the reason, the exit code is 130 / 143; a
-    second signal while stopping exits at once.
+    second signal while stopping exits at once. A typed failure of the plan (`pycram.failures`)
+    ends its traceback with what failed, why and what to try in two lines, without the nested
+    causes; `--verbose` shows them all.
     """
+    from pycram.apps.terminal import set_verbose
     from pycram.core.interrupts import StopSignals
-    from pycram.core.macros import format_script_error, run_script
+    from pycram.core.macros import run_script
     from pycram.core.runtime import end_thread_root
     from pycram.execution.failures import SimulationFault
 
+    set_verbose(verbose)
+    # before the recorder: a viewer that cannot start stops the command before anything is recorded
+    live = LiveView(
+        view=view, rrd=rrd, port=view_port, host=view_host, wait=view_wait, name=f"pycram run {file.name}"
+    ).prepare()
     recorder = None
     if record_flag(record):
         from pycram.trace.recorder import Recorder
@@ -58,7 +82,7 @@ def run_command(
     error: BaseException | str | None  # what the trace records as the run's error
     outcome, error, code = "succeeded", None, 0
     ended: BaseException | None = None  # what ended the main thread's root task
-    with StopSignals(stop_main=True) as stop:
+    with live, StopSignals(stop_main=True) as stop:
         try:
             run_script(file, list(ctx.args))
         except SystemExit as e:
@@ -71,7 +95,7 @@ def run_command(
                 outcome, error, code, ended = "failed", e, 1, e
                 if not isinstance(e, (Exception, SimulationFault)):  # a broken simulation is a failure too
                     raise
-                sys.stderr.write(format_script_error(e, file))  # as `python FILE` would print it
+                sys.stderr.write(_script_error(e, file, verbose))  # as `python FILE` would print it
             else:
                 # SIGINT / SIGTERM (as `Interrupted`, or as `Evaporated` of the script's tasks), or a
                 # KeyboardInterrupt raised by the script itself
@@ -103,3 +127,33 @@ def _robot_from_active(recorder: Any) -> None:
         return
     if robot is not None:
         recorder.set_run_info(robot=str(getattr(robot, "name", robot)))
+
+
+def _script_error(error: BaseException, file: Path, verbose: bool) -> str:
+    """The report of the script's `error`: its traceback as `python FILE` prints it. For a typed
+    failure of the plan (a `PlanFailure` or `SimulationFault` in its chain), unless `verbose`,
+    the traceback of the error alone (no chained causes), ending in `failure_text`'s two lines
+    and where the rest is; `verbose`: the whole traceback, then every message and attempt
+    (`failure_text(verbose=True)`, as `pycram demo --verbose` tells a failure)."""
+    import traceback
+
+    from pycram.apps.terminal import failure_text
+    from pycram.core.macros import format_script_error
+    from pycram.execution.failures import PlanFailure, SimulationFault, failure_chain
+
+    typed = any(isinstance(e, (PlanFailure, SimulationFault)) for e in failure_chain(error))
+    if not typed:
+        return format_script_error(error, file)
+    if verbose:
+        return f"{format_script_error(error, file)}\nthe whole failure:\n{failure_text(error, verbose=True)}\n"
+    short = failure_text(error, verbose=False)
+    chained = (error.__cause__, error.__context__)
+    error.__cause__ = error.__context__ = None
+    try:
+        text = format_script_error(error, file)
+    finally:
+        error.__cause__, error.__context__ = chained
+    last = "".join(traceback.format_exception_only(type(error), error))
+    if text.endswith(last):
+        text = text[: -len(last)]
+    return f"{text}{short}\n(its causes in full: pycram run --verbose, or `pycram show RUN` for a recorded run)\n"

@@ -25,7 +25,7 @@ from pycram.core.fluent import Fluent
 from pycram.core.runtime.clock import set_clock
 from pycram.world.types import GripperState, Outcome, Pose
 
-__all__ = ["RosSimEnvironment", "open_ros_world"]
+__all__ = ["RosSimEnvironment", "open_ros_world", "bridge_environment"]
 
 logger = logging.getLogger(__name__)
 
@@ -126,18 +126,46 @@ class RosSimEnvironment:
         return f"RosSimEnvironment({self.robot!r})"
 
 
+def bridge_environment(name: str) -> str:
+    """The environment ``--environment`` names, as the bridge and the plan's robot both load it: a
+    hand-made one, ``procedural:SEED`` or ``file:PATH`` (made absolute, so that a process in
+    another folder finds the same file). Raises `pycram.environments.EnvironmentNameError` (a
+    `KeyError` naming the valid names) for a name `pycram.environments.load` cannot read."""
+    from pathlib import Path
+
+    from pycram.environments import FILE_PREFIX, check_name
+
+    text = check_name(name)
+    if text.startswith(FILE_PREFIX):
+        return FILE_PREFIX + str(Path(text[len(FILE_PREFIX) :]).expanduser().resolve())
+    return text
+
+
 def open_ros_world(
-    robot: str, item_at: int = 1, realtime: bool = False, master_uri: str | None = None
+    robot: str,
+    item_at: int = 1,
+    realtime: bool = False,
+    master_uri: str | None = None,
+    environment: str | None = None,
 ) -> tuple[RosSimEnvironment, Any]:
     """Connect to the simulated ``robot`` over ROS; return ``(environment, robot)``.
 
     ``master_uri`` (default ``$ROS_MASTER_URI``): a master with ``pycram sim-ros-bridge`` already
-    running. Without one, starts ``roscore`` on a free port of 127.0.0.1 and the bridge (with the
-    demo's mug at ``item_at``) as subprocesses, stopped by ``environment.close()``. The clock that
-    follows ``/clock`` is active until then.
+    running. Without one, starts ``roscore`` on a free port of 127.0.0.1 and the bridge as
+    subprocesses, stopped by ``environment.close()``. The clock that follows ``/clock`` is
+    active until then. ``environment`` (None: the thesis kitchen) is the world the bridge
+    simulates -- a name ``pycram.environments.load`` reads (``apartment``, ``procedural:SEED``,
+    ``file:PATH.toml``): the bridge started here builds it (with the demo's mug at ``item_at``
+    only in the thesis kitchen), and the robot is configured for it (its map and belief); a
+    bridge already running must simulate the same one. Raises `KeyError` (naming the valid
+    names) for an environment that cannot be loaded.
     """
+    from pycram.backends.ros.config import robot_config
     from pycram.backends.ros.launch import BridgeProcess, RosMaster, check_master_uri
+    from pycram.environments import DEFAULT_ENVIRONMENT
 
+    world_name = bridge_environment(environment or DEFAULT_ENVIRONMENT)
+    kitchen = world_name == DEFAULT_ENVIRONMENT
     processes: list = []
     master_uri = master_uri or os.environ.get("ROS_MASTER_URI")
     try:
@@ -145,23 +173,32 @@ def open_ros_world(
             master = RosMaster()
             processes.append(master)
             master_uri = master.uri
-            processes.append(BridgeProcess(robot, master_uri, item_at=item_at, realtime=realtime))
-            logger.info("started roscore on %s and sim-ros-bridge for %s", master_uri, robot)
+            processes.append(
+                BridgeProcess(
+                    robot,
+                    master_uri,
+                    item_at=item_at if kitchen else None,
+                    realtime=realtime,
+                    environment=None if kitchen else world_name,
+                )
+            )
+            logger.info("started roscore on %s and sim-ros-bridge for %s in %s", master_uri, robot, world_name)
         check_master_uri(master_uri, allow_remote=True)
         _use_master(master_uri)
         from pycram.backends.ros.ros1 import ros1_transport
         from pycram.robots.common.ros_robot import make_ros_robot
 
         transport = ros1_transport()
-        clock = transport.sim_clock(robot_config_clock(robot))
-        ros_robot = make_ros_robot(robot, transport)
-        environment = RosSimEnvironment(transport, ros_robot, clock, tuple(processes))
+        config = robot_config(robot).replace(environment=world_name)
+        clock = transport.sim_clock(config.clock_topic)
+        ros_robot = make_ros_robot(robot, transport, config)
+        world = RosSimEnvironment(transport, ros_robot, clock, tuple(processes))
     except BaseException:
         for process in reversed(processes):
             process.stop()
         raise
-    environment.activate_clock()
-    return environment, ros_robot
+    world.activate_clock()
+    return world, ros_robot
 
 
 def robot_config_clock(robot: str) -> str:

@@ -9,6 +9,7 @@ causes and times (see `docs/experiments.md`).
 - `pycram.apps.experiments.runner`: checking the input, running locally or on Ray, resuming.
 - `pycram.apps.experiments.store`: the experiment's rows in the trace database.
 - `pycram.apps.experiments.report`: the summary table and the plot.
+- `pycram.apps.experiments.splits`: development and evaluation seeds and worlds (which a figure may rest on).
 
 `import pycram.apps.experiments` is cheap: the submodules are imported when used.
 """

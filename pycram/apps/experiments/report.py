@@ -1,16 +1,18 @@
 """What an experiment found: success rates, failure causes and times, as a table and a plot.
 
-`summarize(runs)` groups the recorded runs (`pycram.apps.experiments.store.RunRecord`) by robot and
-variant; `summary_table` renders that as a `rich` table (each success rate with its 95 %
-confidence interval, Wilson), `comparisons` says which differences between groups -- variants of
-one robot, robots in one variant, or the same group in another experiment -- are larger than the
-noise (:mod:`pycram.apps.experiments.statistics`), `write_plot` draws success rate (with the
-intervals), times and failure causes into a PNG (matplotlib, the `db` extra).
+`summarize(runs)` groups the recorded runs (`pycram.apps.experiments.store.RunRecord`) by robot,
+variant and environment (`by_environment=False`: over all environments); `summary_table`
+renders that as a `rich` table (each success rate with its 95 % confidence interval, Wilson),
+`comparisons` says which differences between groups -- variants of one robot, robots in one
+variant (each in the same environment), or the same group in another experiment -- are larger
+than the noise (:mod:`pycram.apps.experiments.statistics`), `write_plot` draws success rate
+(with the intervals), times and failure causes into a PNG (matplotlib, the `db` extra).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -24,6 +26,7 @@ __all__ = [
     "summarize",
     "percentile",
     "variant_label",
+    "group_label",
     "summary_table",
     "causes_table",
     "comparisons",
@@ -45,12 +48,22 @@ def variant_label(variant: str) -> str:
     return variant if variant else "none"
 
 
+def _natural(text: str | None) -> tuple[Any, ...]:
+    """Sort key putting procedural:2 before procedural:10 (None first)."""
+    if text is None:
+        return ()
+    return tuple(int(part) if part.isdigit() else part for part in re.split(r"(\d+)", text))
+
+
 @dataclass
 class GroupSummary:
-    """The runs of one robot in one variant: counts, success rate, times [s], failure causes."""
+    """The runs of one robot in one variant and environment: counts, success rate, times [s],
+    failure causes. `environment` is None for the scenario's own, or for a group over all
+    environments (`summarize(..., by_environment=False)`)."""
 
     robot: str
     variant: str
+    environment: str | None = None
     runs: int = 0
     successes: int = 0
     errors: int = 0  # runs whose scenario raised
@@ -74,11 +87,22 @@ class GroupSummary:
         return [s / w for s, w in zip(self.sim_times, self.wall_times) if w and w > 0 and s is not None]
 
 
-def summarize(runs: Iterable[Any]) -> list[GroupSummary]:
-    """Group recorded runs by (robot, variant), in order of appearance."""
-    groups: dict[tuple[str, str], GroupSummary] = {}
+def group_label(group: GroupSummary) -> str:
+    """How a group is named in plots and failure-cause tables: its robot, "faults: VARIANT"
+    and its environment (when it has one), each on a line of its own."""
+    label = f"{group.robot}\nfaults: {variant_label(group.variant)}"
+    return label + (f"\n{group.environment}" if group.environment else "")
+
+
+def summarize(runs: Iterable[Any], by_environment: bool = True) -> list[GroupSummary]:
+    """Group recorded runs by robot, variant and (unless not `by_environment`) environment (a
+    run's ``environment`` attribute; None or missing: the scenario's own), ordered by variant,
+    robot and environment (procedural:2 before procedural:10)."""
+    groups: dict[tuple[str, str, str | None], GroupSummary] = {}
     for run in runs:
-        group = groups.setdefault((run.robot, run.variant), GroupSummary(run.robot, run.variant))
+        environment = getattr(run, "environment", None) if by_environment else None
+        key = (run.robot, run.variant, environment)
+        group = groups.setdefault(key, GroupSummary(run.robot, run.variant, environment))
         group.runs += 1
         group.successes += bool(run.success)
         group.errors += run.status == "error"
@@ -87,7 +111,7 @@ def summarize(runs: Iterable[Any]) -> list[GroupSummary]:
             group.wall_times.append(run.wall_time)
         if not run.success:
             group.causes.update(run.failure_causes or ["unknown"])
-    return sorted(groups.values(), key=lambda g: (g.variant, g.robot))
+    return sorted(groups.values(), key=lambda g: (g.variant, g.robot, _natural(g.environment)))
 
 
 def _seconds(value: float | None) -> str:
@@ -95,14 +119,18 @@ def _seconds(value: float | None) -> str:
 
 
 def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
-    """A `rich.table.Table`: per robot and variant the runs, success rate with its 95 %
-    confidence interval (Wilson), simulated and wall time p50/p95 [s] and the median real-time
-    factor."""
+    """A `rich.table.Table`: per robot, variant and environment (a column when some group has
+    one) the runs, success rate with its 95 % confidence interval (Wilson), simulated and wall
+    time p50/p95 [s] and the median real-time factor."""
     from rich.table import Table
 
+    environments = any(g.environment for g in groups)
     table = Table(title=title or None, header_style="bold")
     table.add_column("robot")
     table.add_column("faults", overflow="fold")
+    if environments:  # names kept whole up to 24 characters (longer ones fold)
+        widest = max(len(g.environment or "(its own)") for g in groups)
+        table.add_column("environment", overflow="fold", min_width=min(widest, 24))
     for name in ("runs", "success\n95 % CI", "sim [s]\np50 / p95", "wall [s]\np50 / p95", "× real\ntime"):
         table.add_column(name, justify="right", no_wrap=True)
     for g in groups:
@@ -113,6 +141,7 @@ def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
         table.add_row(
             g.robot,
             variant_label(g.variant),
+            *([g.environment or "(its own)"] if environments else []),
             str(g.runs),
             f"[{style}]{100 * rate:.1f} %[/{style}] ({g.successes})\n{100 * low:.1f}-{100 * high:.1f} %",
             f"{_seconds(percentile(g.sim_times, 50))} / {_seconds(percentile(g.sim_times, 95))}",
@@ -123,8 +152,8 @@ def summary_table(groups: list[GroupSummary], title: str = "") -> Any:
 
 
 def causes_table(groups: list[GroupSummary]) -> Any:
-    """A `rich.table.Table` of failure causes: how many failed runs each robot and variant had
-    per cause (a run with several causes counts for each), most frequent first."""
+    """A `rich.table.Table` of failure causes: how many failed runs each group (robot, variant,
+    environment) had per cause (a run with several causes counts for each), most frequent first."""
     from rich.table import Table
 
     total: Counter[str] = Counter()
@@ -133,7 +162,7 @@ def causes_table(groups: list[GroupSummary]) -> Any:
     table = Table(title="failure causes", header_style="bold")
     table.add_column("cause")
     for g in groups:
-        table.add_column(f"{g.robot}\nfaults: {variant_label(g.variant)}", justify="right", overflow="fold")
+        table.add_column(group_label(g), justify="right", overflow="fold")
     for cause, _ in total.most_common():
         table.add_row(cause, *(str(g.causes.get(cause, 0)) for g in groups))
     if not total:
@@ -146,9 +175,9 @@ def comparisons(groups: list[GroupSummary], reference: list[GroupSummary] | None
     percentage points with its 95 % confidence interval, Newcombe's method):
 
     * with `reference` (the groups of another experiment, e.g. the same seeds on older code):
-      each group against the reference's group of the same robot and variant;
+      each group against the reference's group of the same robot, variant and environment;
     * without: each robot's variants against its runs without faults ("none"), and in each
-      variant the robots against each other.
+      variant the robots against each other -- each in the same environment.
     """
     lines: list[str] = []
 
@@ -156,31 +185,41 @@ def comparisons(groups: list[GroupSummary], reference: list[GroupSummary] | None
         difference = compare_rates(a.successes, a.runs, b.successes, b.runs)
         lines.append(f"{what}: {a.successes}/{a.runs} vs {b.successes}/{b.runs}, {difference.describe()}")
 
+    def where(environment: str | None) -> str:
+        return f" in {environment}" if environment else ""
+
     if reference is not None:
-        theirs = {(g.robot, g.variant): g for g in reference}
+        theirs = {(g.robot, g.variant, g.environment): g for g in reference}
         for g in groups:
-            other = theirs.get((g.robot, g.variant))
+            other = theirs.get((g.robot, g.variant, g.environment))
             if other is not None and g.runs and other.runs:
-                line(f"{g.robot}, faults {variant_label(g.variant)}: this vs reference", g, other)
+                line(f"{g.robot}, faults {variant_label(g.variant)}{where(g.environment)}: this vs reference", g, other)
         return lines
-    by_key = {(g.robot, g.variant): g for g in groups if g.runs}
-    for (robot, variant), g in by_key.items():
-        base = by_key.get((robot, ""))
+    by_key = {(g.robot, g.variant, g.environment): g for g in groups if g.runs}
+    for (robot, variant, environment), g in by_key.items():
+        base = by_key.get((robot, "", environment))
         if variant and base is not None:
-            line(f"{robot}: faults {variant_label(variant)} vs none", g, base)
-    variants = sorted({variant for _, variant in by_key})
-    robots = list(dict.fromkeys(robot for robot, _ in by_key))
+            line(f"{robot}: faults {variant_label(variant)} vs none{where(environment)}", g, base)
+    variants = sorted({variant for _, variant, _ in by_key})
+    robots = list(dict.fromkeys(robot for robot, _, _ in by_key))
+    environments = sorted({environment for _, _, environment in by_key}, key=_natural)
     for variant in variants:
-        present = [r for r in robots if (r, variant) in by_key]
-        for i, a in enumerate(present):
-            for b in present[i + 1 :]:
-                line(f"faults {variant_label(variant)}: {a} vs {b}", by_key[(a, variant)], by_key[(b, variant)])
+        for environment in environments:
+            present = [r for r in robots if (r, variant, environment) in by_key]
+            for i, a in enumerate(present):
+                for b in present[i + 1 :]:
+                    line(
+                        f"faults {variant_label(variant)}{where(environment)}: {a} vs {b}",
+                        by_key[(a, variant, environment)],
+                        by_key[(b, variant, environment)],
+                    )
     return lines
 
 
 def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
-    """Draw success rate, simulated and wall time (p50 with a bar up to p95) per robot and
-    variant, and the failure causes, into the PNG `path` (folders created). Returns `path`."""
+    """Draw success rate, simulated and wall time (p50 with a bar up to p95) per group (robot,
+    variant, environment), and the failure causes, into the PNG `path` (folders created).
+    Returns `path`."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -188,7 +227,7 @@ def write_plot(groups: list[GroupSummary], path: Path, title: str = "") -> Path:
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    labels = [f"{g.robot}\nfaults: {variant_label(g.variant)}" for g in groups]
+    labels = [group_label(g) for g in groups]
     xs = list(range(len(groups)))
     fig, (ax_rate, ax_time, ax_causes) = plt.subplots(1, 3, figsize=(15, 4.8))
     try:

@@ -80,9 +80,9 @@ MAX_SEEDS = 100_000
 #: At most this many environments per experiment (`--env procedural:1-50`).
 MAX_ENVIRONMENTS = 10_000
 
-#: A run of an experiment: (robot, seed, variant column — sorted fault names joined by ",", and
-#: with `--env` the run's environment after "@": `pycram.apps.experiments.store.run_variant`).
-RunKey = tuple[str, int, str]
+#: A run of an experiment: (robot, seed, variant -- sorted fault names joined by ",", environment
+#: -- its name with `--env`, "" for the scenario's own); `pycram.apps.experiments.store.RunKey`.
+RunKey = tuple[str, int, str, str]
 
 
 class ExperimentInputError(ValueError):
@@ -400,6 +400,10 @@ def execute_run(
     try:
         entry = get_scenario(scenario)
         function = entry.load()
+        if os.environ.get("PYCRAM_VIEW_RUN"):  # `pycram experiment --view`: this run into the viewer
+            from pycram.trace.view.session import viewed_run
+
+            function = viewed_run(function, robot, seed, name=scenario)
         extra: dict[str, Any] = {}
         if environment is not None and accepts_keyword(function, "environment"):
             extra["environment"] = environment
@@ -494,7 +498,7 @@ def run_experiment(
 
     def finished(key: RunKey, result: dict[str, Any] | None) -> None:
         if result is not None:
-            store.record_run(prepared.db, record_id, key[0], key[1], key[2], result)
+            store.record_run(prepared.db, record_id, key[0], key[1], key[2], result, environment=key[3])
             outcome.recorded += 1
         else:
             outcome.not_finished.append(key)
@@ -519,24 +523,21 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-    from pycram.apps.experiments.store import split_variant
-
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_worker_init)
     futures: dict[Any, RunKey] = {}
     try:
         for key in prepared.todo:
-            variant, environment = split_variant(key[2])
             future = pool.submit(
                 execute_run,
                 prepared.scenario.spec,
                 key[0],
                 key[1],
-                variant,
+                key[2],
                 prepared.db,
                 True,
                 prepared.stepping,
-                environment,
+                key[3] or None,
             )
             futures[future] = key
         pending = set(futures)
@@ -648,14 +649,11 @@ def _run_ray_tasks(ray: Any, prepared: PreparedExperiment, stop: Any, finished: 
             "write: the runs' traces are not recorded (their results are); use PostgreSQL (--db "
             "postgresql://...) to record them"
         )
-    from pycram.apps.experiments.store import split_variant
-
     task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
     refs: dict[Any, RunKey] = {}
     for key in prepared.todo:
-        variant, environment = split_variant(key[2])
         ref = task.remote(
-            prepared.scenario.spec, key[0], key[1], variant, prepared.db, record, prepared.stepping, environment
+            prepared.scenario.spec, key[0], key[1], key[2], prepared.db, record, prepared.stepping, key[3] or None
         )
         refs[ref] = key
     cancelled = False

@@ -1,10 +1,17 @@
 """Experiments in the trace database: one row per experiment, one per finished run.
 
 The tables are `pycram_experiments` and `pycram_experiment_runs` of the trace schema
-(`pycram.trace.db`, schema 4; created in older databases on connect). Only the process driving
-an experiment writes these rows (the scenario runs themselves record their traces into the same
-database): every result is committed as soon as it arrives, so an interrupted experiment keeps
-every run that finished, and `finished_keys` tells a resumed one what is left to do.
+(`pycram.trace.db`: schema 4 created them, schema 5 gave each run an ``environment`` column;
+both are brought about in older databases on connect). Only the process driving an experiment
+writes these rows (the scenario runs themselves record their traces into the same database):
+every result is committed as soon as it arrives, so an interrupted experiment keeps every run
+that finished, and `finished_keys` tells a resumed one what is left to do.
+
+A run is keyed by (robot, seed, variant, environment): the variant is its fault set
+(`variant_key`), the environment the name it ran in (`pycram experiment --env`), ``""`` for
+the scenario's own (an experiment without ``--env``). A database of schema 4 that could not be
+migrated (a read-only file) is still read: there the environment is split off the variant
+column (`split_variant`).
 """
 
 from __future__ import annotations
@@ -26,8 +33,10 @@ from pycram.trace.db import (
     TraceDatabaseError,
     connect,
     database_error,
+    display_url,
     experiment_runs_table,
     experiments_table,
+    present_columns,
 )
 
 log = logging.getLogger(__name__)
@@ -37,8 +46,8 @@ __all__ = [
     "RunRecord",
     "ExperimentNotFound",
     "variant_key",
+    "RunKey",
     "ENVIRONMENT_SEPARATOR",
-    "run_variant",
     "split_variant",
     "create_experiment",
     "find_experiment",
@@ -58,19 +67,17 @@ def variant_key(faults: frozenset[str] | list[str] | tuple[str, ...]) -> str:
     return ",".join(sorted(set(faults)))
 
 
-#: In the `variant` column of a run of an experiment with environments (`pycram experiment
-#: --env`), the variant key and the run's environment are joined by this: "moved,taken@procedural:3"
-#: (fault names never contain it). Runs of experiments without environments store the variant key.
+#: A run of an experiment: (robot, seed, variant key, environment -- "" for the scenario's own).
+RunKey = tuple[str, int, str, str]
+
+#: How trace schema 4 stored a run's environment: after this in its `variant` column
+#: ("moved,taken@procedural:3"); schema 5 has a column for it (databases are migrated on connect).
 ENVIRONMENT_SEPARATOR = "@"
 
 
-def run_variant(variant: str, environment: str | None) -> str:
-    """The `variant` column of a run: the variant key, with the environment when there is one."""
-    return variant if environment is None else f"{variant}{ENVIRONMENT_SEPARATOR}{environment}"
-
-
 def split_variant(column: str) -> tuple[str, str | None]:
-    """(variant key, environment or None) of a run's `variant` column (see `run_variant`)."""
+    """(variant key, environment or None) of a `variant` column as schema 4 wrote it
+    ("faults@environment", or the variant key alone)."""
     variant, separator, environment = column.partition(ENVIRONMENT_SEPARATOR)
     return (variant, environment if separator else None)
 
@@ -95,14 +102,14 @@ class ExperimentRecord:
     #: variant in each; empty: the scenario's own environment.
     environments: tuple[str, ...] = ()
 
-    def keys(self) -> list[tuple[str, int, str]]:
-        """Every run of the experiment as (robot, seed, variant column: the variant key, with the
-        environment when the experiment has environments, see `run_variant`), in the order they
-        run: per variant, per environment, per robot, by seed."""
+    def keys(self) -> list[RunKey]:
+        """Every run of the experiment as (robot, seed, variant key, environment: "" for the
+        scenario's own when the experiment has no environments), in the order they run: per
+        variant, per environment, per robot, by seed."""
         return [
-            (robot, seed, run_variant(variant_key(variant), environment))
+            (robot, seed, variant_key(variant), environment)
             for variant in self.variants
-            for environment in (self.environments or (None,))
+            for environment in (self.environments or ("",))
             for robot in self.robots
             for seed in self.seeds
         ]
@@ -114,7 +121,7 @@ class RunRecord:
 
     robot: str
     seed: int
-    variant: str  # the variant key (fault names), without the environment
+    variant: str  # the variant key (fault names)
     status: str
     success: bool
     failure_causes: list[str] = field(default_factory=list)
@@ -233,38 +240,75 @@ def set_status(url: str | None, experiment_id: int, status: str) -> None:
         raise database_error(engine.url, e, "write to") from None
 
 
-def finished_keys(url: str | None, experiment_id: int, *, errors: bool = False) -> set[tuple[str, int, str]]:
-    """(robot, seed, variant key) of every run of the experiment recorded as finished (status
-    "done"); with `errors` also those whose scenario raised (status "error", which a resumed
-    experiment runs again)."""
+def _has_environments(engine: Engine) -> bool:
+    """Whether the runs table has its `environment` column (schema 5; False only in a database
+    of schema 4 that could not be migrated, e.g. a read-only file)."""
+    return "environment" in present_columns(engine, experiment_runs_table)
+
+
+def _key_columns(engine: Engine) -> list[Any]:
+    table = experiment_runs_table
+    columns = [table.c.robot, table.c.seed, table.c.variant]
+    return columns + [table.c.environment] if _has_environments(engine) else columns
+
+
+def _variant_environment(row: Any) -> tuple[str, str]:
+    """(variant key, environment: "" for the scenario's own) of a run's row, in either schema."""
+    environment = getattr(row, "environment", None)
+    if environment is not None:
+        return row.variant, environment
+    variant, old = split_variant(row.variant)
+    return variant, old or ""
+
+
+def finished_keys(url: str | None, experiment_id: int, *, errors: bool = False) -> set[RunKey]:
+    """(robot, seed, variant key, environment) of every run of the experiment recorded as
+    finished (status "done"); with `errors` also those whose scenario raised (status "error",
+    which a resumed experiment runs again)."""
     table = experiment_runs_table
     engine = _engine(url)
     statuses = ("done", "error") if errors else ("done",)
     try:
         with engine.connect() as conn:
             rows = conn.execute(
-                sa.select(table.c.robot, table.c.seed, table.c.variant).where(
+                sa.select(*_key_columns(engine)).where(
                     table.c.experiment_id == experiment_id, table.c.status.in_(statuses)
                 )
             ).all()
     except sa_exc.SQLAlchemyError as e:
         raise database_error(engine.url, e, "read") from None
-    return {(r.robot, r.seed, r.variant) for r in rows}
+    return {(r.robot, r.seed, *_variant_environment(r)) for r in rows}
 
 
 def record_run(
-    url: str | None, experiment_id: int, robot: str, seed: int, variant: str, result: dict[str, Any]
+    url: str | None,
+    experiment_id: int,
+    robot: str,
+    seed: int,
+    variant: str,
+    result: dict[str, Any],
+    environment: str = "",
 ) -> None:
-    """Commit one finished run: the scenario's `result` dict (with `error` set when the scenario
-    raised). A run recorded as "error" before is replaced; one recorded as "done" is kept."""
+    """Commit one finished run in `environment` ("" for the scenario's own): the scenario's
+    `result` dict (with `error` set when the scenario raised; its trace's run id as
+    ``trace_run_id`` or ``run_id``). A run recorded as "error" before is replaced; one recorded
+    as "done" is kept. Raises `TraceDatabaseError` (also for a database of schema 4 that could
+    not be migrated: it cannot hold the environment)."""
     table = experiment_runs_table
     error = result.get("error")
-    trace = result.get("trace_run_id")
+    trace = result.get("trace_run_id", result.get("run_id"))
+    engine = _engine(url)
+    if not _has_environments(engine):
+        raise TraceDatabaseError(
+            f"the trace database {display_url(engine.url)} has the schema of an older PyCRAM and could not be "
+            "migrated (is it read-only?): experiment runs cannot be recorded in it"
+        )
     values = {
         "experiment_id": experiment_id,
         "robot": robot,
         "seed": int(seed),
         "variant": variant,
+        "environment": environment or "",
         "status": "error" if error else "done",
         "success": bool(result.get("success")) and not error,
         "failure_causes": json.dumps(list(result.get("failure_causes") or [])),
@@ -276,7 +320,6 @@ def record_run(
         "worker": result.get("worker") or f"{socket.gethostname()}:{os.getpid()}",
         "finished_at": _now(),
     }
-    engine = _engine(url)
     try:
         with engine.begin() as conn:
             conn.execute(
@@ -285,34 +328,41 @@ def record_run(
                     table.c.robot == robot,
                     table.c.seed == int(seed),
                     table.c.variant == variant,
+                    table.c.environment == (environment or ""),
                     table.c.status == "error",
                 )
             )
             conn.execute(sa.insert(table).values(**values))
     except sa_exc.IntegrityError:
-        log.warning("run %s seed %s (%s) of experiment %s was recorded already", robot, seed, variant, experiment_id)
+        log.warning(
+            "run %s seed %s (faults %s, environment %s) of experiment %s was recorded already",
+            robot,
+            seed,
+            variant or "none",
+            environment or "its own",
+            experiment_id,
+        )
     except sa_exc.SQLAlchemyError as e:
         raise database_error(engine.url, e, "write to") from None
 
 
 def run_records(url: str | None, experiment_id: int) -> list[RunRecord]:
-    """The recorded runs of the experiment, by variant, robot and seed."""
+    """The recorded runs of the experiment, by variant, environment, robot and seed (each with
+    its `environment`, None for the scenario's own)."""
     table = experiment_runs_table
     engine = _engine(url)
+    columns = [c for c in table.columns if c.name in present_columns(engine, table)]
     try:
         with engine.connect() as conn:
-            rows = conn.execute(
-                sa.select(table)
-                .where(table.c.experiment_id == experiment_id)
-                .order_by(table.c.variant, table.c.robot, table.c.seed)
-            ).all()
+            rows = conn.execute(sa.select(*columns).where(table.c.experiment_id == experiment_id)).all()
     except sa_exc.SQLAlchemyError as e:
         raise database_error(engine.url, e, "read") from None
+    runs = sorted(((r, *_variant_environment(r)) for r in rows), key=lambda x: (x[1], x[2], x[0].robot, x[0].seed))
     return [
         RunRecord(
             robot=r.robot,
             seed=r.seed,
-            variant=split_variant(r.variant)[0],
+            variant=variant,
             status=r.status,
             success=bool(r.success),
             failure_causes=json.loads(r.failure_causes or "[]"),
@@ -321,9 +371,9 @@ def run_records(url: str | None, experiment_id: int) -> list[RunRecord]:
             trace_run_id=r.trace_run_id,
             error=r.error,
             result=json.loads(r.result or "{}"),
-            environment=split_variant(r.variant)[1],
+            environment=environment or None,
         )
-        for r in rows
+        for r, variant, environment in runs
     ]
 
 

@@ -93,6 +93,9 @@ class CandidateSearch:
     max_candidates: int
     #: The costmaps of the latest base-pose resolution by name (for pictures; not for reasoning).
     last_costmaps: dict[str, Costmap]
+    #: The candidates of the latest search, in the order checked: (x [m], y [m], arm, why it was
+    #: ruled out or None when accepted, yaw [rad] when accepted) -- for views; not for reasoning.
+    last_candidates: list[tuple[float, float, str | None, str | None, float | None]]
 
     @property
     def _base_radius(self) -> float:
@@ -190,6 +193,8 @@ class CandidateSearch:
         (counted in `tally` when given)."""
         tally = _Tally() if tally is None else tally
         given: list[BaseLocation] = []
+        tried: list[tuple[float, float, str | None, str | None, float | None]] = []
+        self.last_candidates = tried
         failed: list[tuple[str | None, float, float]] = []
         for cell in cells:
             if tally.tried >= self.max_candidates:
@@ -204,9 +209,11 @@ class CandidateSearch:
             solution, failure = validate(cell)
             if solution is not None:
                 given.append(solution)
+                tried.append((x, y, arm, None, getattr(solution, "yaw", None)))
                 yield solution
             else:
                 failed.append((arm, x, y))
+                tried.append((x, y, arm, failure[0], None))
                 tally.fail(*failure)
         if not given:
             if tally.tried == 0:
