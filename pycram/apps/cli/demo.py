@@ -13,7 +13,7 @@ from pycram.apps.cli.app import (
     record_flag,
     trace_errors,
 )
-from pycram.apps.cli.view import LiveView, ViewHostOption, ViewPortOption, ViewWaitOption
+from pycram.apps.cli.view import LiveView, ViewHostOption, ViewOption, ViewPortOption, ViewWaitOption
 from pycram.apps.run_options import check_until
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
@@ -102,9 +102,7 @@ def demo_command(
         "task tree of that moment into the output folder (until-T.Ts), stop the plan there; exit code 0 "
         "once they are written (a plan that ends before T: its usual exit code).",
     ),
-    view: bool = typer.Option(
-        False, "--view", help="Serve Rerun's web viewer (127.0.0.1) and stream the run into it; prints its URL."
-    ),
+    view: bool = ViewOption,
     rrd: bool = typer.Option(
         True, "--rrd/--no-rrd", help="Save the run's view as run.rrd next to its pictures (`pycram view RUN`)."
     ),

@@ -17,7 +17,7 @@ from pycram.apps.cli.app import (
     record_flag,
     trace_errors,
 )
-from pycram.apps.cli.view import LiveView, ViewHostOption, ViewPortOption, ViewWaitOption
+from pycram.apps.cli.view import LiveView, ViewHostOption, ViewOption, ViewPortOption, ViewWaitOption
 
 
 @app.command("run", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
@@ -32,9 +32,7 @@ def run_command(
     db: str | None = DbOption,
     plan: str | None = typer.Option(None, "--plan", help="Plan name recorded for the run (default: the file name)."),
     robot: str | None = typer.Option(None, "--robot", help="Robot name recorded for the run."),
-    view: bool = typer.Option(
-        False, "--view", help="Serve Rerun's web viewer (127.0.0.1) and stream the run into it; prints its URL."
-    ),
+    view: bool = ViewOption,
     rrd: bool = typer.Option(
         False, "--rrd/--no-rrd", help="Save the run's view as run.rrd (next to its pictures, else in output/view-DATE)."
     ),

@@ -20,6 +20,9 @@ VIEW_PORT = 9090
 #: Where the viewer listens unless `--view-host` says otherwise: this machine only.
 VIEW_HOST = "127.0.0.1"
 
+ViewOption = typer.Option(
+    False, "--view", help="Serve Rerun's web viewer (127.0.0.1) and stream the run into it; prints its URL."
+)
 ViewPortOption = typer.Option(
     VIEW_PORT, "--view-port", help="Port of the web viewer (0: any free port).", min=0, max=65535
 )
