@@ -24,12 +24,15 @@ def test_the_server_serves_the_web_viewer_on_loopback_only():
         assert wasm[:4] == b"\0asm"
         import psutil
 
+        viewer = psutil.Process(server.pid)  # (not every child of this process: a roscore of
+        # another test listens on every interface)
         listening = {
             c.laddr.ip
-            for p in psutil.Process().children(recursive=True)
+            for p in [viewer, *viewer.children(recursive=True)]
             for c in p.net_connections(kind="tcp")
             if c.status == psutil.CONN_LISTEN
         }
+        assert listening  # the viewer's own sockets were found
         assert listening == {"127.0.0.1"}
     assert not server.running
 

@@ -199,6 +199,11 @@ class ViewerServer:
         """True while the viewer program runs."""
         return self._process is not None and self._process.poll() is None
 
+    @property
+    def pid(self) -> int | None:
+        """The process id of the viewer program while it runs (None before `start`)."""
+        return None if self._process is None else self._process.pid
+
     def wait(self) -> int:
         """Block until the viewer program ends (e.g. on Ctrl-C); returns its exit code."""
         process = self._process
