@@ -40,6 +40,7 @@ __all__ = [
     "KitchenFileError",
     "load",
     "check_name",
+    "procedural_seed",
 ]
 
 #: Environment name -> module under `pycram.environments`.
@@ -95,6 +96,14 @@ def check_name(name: str) -> str:
         f"{error.args[0]}; or procedural:SEED (a generated apartment) or file:PATH.toml (a kitchen from files)",
     )
     raise error
+
+
+def procedural_seed(name: str) -> int:
+    """The seed of a generated apartment's name ``procedural:SEED``. Raises `ValueError` saying
+    what is wrong (not a decimal, non-negative seed; too large)."""
+    from .procedural import parse_seed
+
+    return parse_seed(name)
 
 
 def load(name: str | Environment) -> Environment:

@@ -51,12 +51,10 @@ def seed_split(seed: int) -> str:
 def environment_split(name: str) -> str:
     """The split of an environment name: ``procedural:SEED`` as its seed (`seed_split`); a
     hand-made environment or a kitchen from a file: "hand-made" (one world, developed in)."""
-    from pycram.environments import PROCEDURAL_PREFIX
+    from pycram.environments import PROCEDURAL_PREFIX, procedural_seed
 
     if name.startswith(PROCEDURAL_PREFIX):
-        from pycram.environments.procedural import parse_seed
-
-        return seed_split(parse_seed(name))
+        return seed_split(procedural_seed(name))
     return "hand-made"
 
 
