@@ -33,7 +33,7 @@ from pycram.designators.object import ObjectDesignator
 from pycram.execution.failures import GripperEmpty, ObjectOutOfReach, ObjectSlipped
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
-from pycram.world.objects import SIDE
+from pycram.world.objects import OBJECT_TYPES, SIDE, approach_matches, object_type
 
 from .container_state import CLOSED, DOOR_CLOSED
 from .containers import Close, Open
@@ -112,17 +112,20 @@ def _target_container(target: Any) -> str | None:
     return None
 
 
-def _grasp_for(container: str | None) -> str | None:
-    """The grasp an object must be held with to be put into `container`, by the way into it:
-    through a door (the fridge, a cupboard) the hand comes in from the front, so from the side
-    (`SIDE`: a hand that held it from the top finds no way in under the shelf above); into a
-    drawer from above, any grasp the object's type has; None when the target is in no door
-    container (any grasp)."""
+def _grasp_for(container: str | None, type_name: str | None) -> str | None:
+    """The grasp an object of `type_name` must be held with to be put into `container`, by the
+    way into it: through a door (the fridge, a cupboard) the hand comes in from the front, so from
+    the side (`SIDE`: a hand that held it from the top finds no way in under the shelf above) --
+    when its type has a grasp from the side (a bowl or a plate, held by its rim from the top, has
+    none: any grasp then); None (any grasp) for a drawer, for no container and for an unknown
+    type."""
     belief = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
-    if container is None or environment is None:
+    if container is None or environment is None or type_name not in OBJECT_TYPES:
         return None
-    return SIDE if environment.container(container).kind == "door" else None
+    if environment.container(container).kind != "door":
+        return None
+    return SIDE if any(approach_matches(g.approach, SIDE) for g in object_type(type_name).grasps) else None
 
 
 def _type_of(wanted: Any) -> str | None:
@@ -187,9 +190,11 @@ def transporting(designator: ActionDesignator) -> Any:
     grasp = check_grasp("transporting", designator.prop_value("grasp"))
     opened_before = set(_open_containers())
     into = _target_container(target)
-    chosen_for_target = grasp is None and _grasp_for(into) is not None
     if grasp is None:
-        grasp = _grasp_for(into)
+        grasp = _grasp_for(into, _type_of(wanted))
+        chosen_for_target = grasp is not None
+    else:
+        chosen_for_target = False
     if into is not None and into not in opened_before:
         log.info("transporting: opening %s first, to put the object in", into)
         perform(Open(into, arm=arm))

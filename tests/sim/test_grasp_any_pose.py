@@ -119,3 +119,14 @@ def test_a_square_carton_turned_45_degrees_goes_into_the_fridge_held_by_its_face
         assert any(s.contains(*milk.position[:2], 0.0) for s in world.environment.container("fridge").interior)
         assert tilt(milk.orientation) < math.radians(20)
         assert not holding(world)
+
+
+def test_into_a_door_container_the_grasp_is_from_the_side_only_for_types_that_have_one():
+    # a bowl, a plate or a spoon is held by its rim or body from the top: asking for a side grasp
+    # failed at once with "no_executable_grasp" (actions benchmark, eval seeds 32007-32009)
+    from pycram.actions.transport import _grasp_for
+
+    with apartment_with("pr2", {"cup": COUNTER}):
+        assert [_grasp_for("fridge", t) for t in ("milk", "cereal", "cup")] == ["side"] * 3
+        assert [_grasp_for("cupboard", t) for t in ("bowl", "plate", "spoon")] == [None] * 3
+        assert _grasp_for("drawer 2", "milk") is None and _grasp_for(None, "milk") is None
