@@ -160,7 +160,8 @@ _SIDE_ANGLES = np.radians(np.arange(-45.0, 45.0, 1.0))
 SQUARENESS = 1.25
 #: ... when that best rectangle is about as long as it is wide (its shorter side at least this
 #: share of its longer one: a top seen in part, cut by an edge of the view or by the robot's arm,
-#: looks oblong and turned -- measured: a milk carton standing square, seen from 3 m, read 54 deg) ...
+#: looks oblong and turned -- measured: a milk carton standing square, seen in part from 3 m,
+#: showed a 10 x 5 cm top whose longer axis read 54 deg) ...
 SIDE_ASPECT = 0.75
 #: ... and at least this many points of the top show it.
 SIDE_POINTS = 60
