@@ -118,7 +118,7 @@ def _pull_open(
     least `DOOR_TOLERANCE` but stopped short (the arm's reach along the arc ends: measured, the
     PR2's at 50 of 69 deg from one standing pose) goes on from where the door now stands, with
     standing poses found anew for the rest of the arc, up to `CONTAINER_ATTEMPTS` times."""
-    for _ in range(CONTAINER_ATTEMPTS):
+    for pull in range(1, CONTAINER_ATTEMPTS + 2):
         before = belief.container_states.get(container.name, 0.0)
         try:
             return _try_poses(
@@ -126,8 +126,8 @@ def _pull_open(
             )
         except ContainerStuck:
             now = belief.container_states.get(container.name, 0.0)
-            if now < before + DOOR_TOLERANCE:
-                raise  # it did not move: stuck
+            if now < before + DOOR_TOLERANCE or pull > CONTAINER_ATTEMPTS:
+                raise  # it did not move (stuck), or it moved on every pull and is still short
             log.info(
                 "%s: pulled from %.0f to %.0f deg of %.0f; going on from there",
                 container.name,
@@ -135,7 +135,7 @@ def _pull_open(
                 math.degrees(now),
                 math.degrees(goal),
             )
-    return _try_poses("opening", designator, container, _standing_poses(container, arm, goal), partial(move, goal=goal))
+    raise AssertionError("unreachable: the last pull returns or raises")
 
 
 def _remembered_handle_pose(container: Any, arm: str | None) -> list[Any]:

@@ -123,14 +123,20 @@ class LiveView:
                 how = f"`pycram view {self.session.run_id}`" if self.session.run_id is not None else "`rerun FILE`"
                 err.print(f"view saved in {escape(str(self.saved))} (open it with {how})", soft_wrap=True)
         if self.server is not None:
-            try:
-                if self.wait and exc[0] is None:
-                    err.print(f"view: still at {escape(self.server.url)}; Ctrl-C to stop", soft_wrap=True)
-                    self.server.wait()
-            except KeyboardInterrupt:
-                pass
-            finally:
-                self.server.stop()
+            _serve_on(self.server, self.wait and exc[0] is None)
+
+
+def _serve_on(server: Any, wait: bool) -> None:
+    """With `wait`, keep serving the view after the run until the viewer ends or Ctrl-C; then
+    stop the viewer in any case."""
+    try:
+        if wait:
+            err.print(f"view: still at {escape(server.url)}; Ctrl-C to stop", soft_wrap=True)
+            server.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
 
 
 def run_rrd(run_id: int, output: Path = Path("output")) -> Path | None:
@@ -258,16 +264,8 @@ class ExperimentView:
 
         os.environ.pop(VIEW_CONNECT_ENV, None)
         os.environ.pop(VIEW_RUN_ENV, None)
-        if self.server is None:
-            return
-        try:
-            if self.wait and (error is None or isinstance(error, typer.Exit)):
-                err.print(f"view: still at {escape(self.server.url)}; Ctrl-C to stop", soft_wrap=True)
-                self.server.wait()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            self.server.stop()
+        if self.server is not None:
+            _serve_on(self.server, self.wait and (error is None or isinstance(error, typer.Exit)))
 
 
 def parse_view_run(run: str) -> tuple[str | None, int]:
