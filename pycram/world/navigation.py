@@ -27,6 +27,11 @@ validates the final path every `EXACT_STEP` -- wherever an obstacle of a layer i
 of an outline (poses farther than every outline's radius from every obstacle are free by
 construction).
 
+A differential drive (`pycram.world.base_kinematics`) cannot step sideways: every straight
+segment above is then checked, and returned, as a chain of turns on the spot and straight
+drives along the heading (forwards, a short way backwards, or arriving at / leaving a pose
+straight along its heading), intermediate waypoints facing the way the robot goes.
+
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
 question gives the same path, which tests and traces rely on), and "no path exists" is a
@@ -50,6 +55,7 @@ import numpy as np
 
 from pycram.execution.failures import GoalUnreachable, NavigationFailure
 
+from .base_kinematics import POSITION_EPS, BaseKinematics, move_options
 from .prospection import BasePose, as_base_pose
 
 __all__ = [
@@ -66,12 +72,18 @@ SQRT2 = math.sqrt(2.0)
 #: A robot that already touches something may move this far [m] from its start unchecked, to
 #: get clear (e.g. after a drive stopped on contact).
 ESCAPE_RADIUS = 0.15
+#: A differential drive that touches something gets clear only along its heading: poses turned
+#: more than this [rad] from its start are checked.
+ESCAPE_TURN = 0.05
 #: A* searches per plan: after each, cells where the footprint fits at no heading are blocked.
 MAX_SEARCHES = 8
 #: Spacing [m] of the backend's exact checks along a path, and the half width [cells] of the
 #: square blocked around a spot where one failed.
 EXACT_STEP = 0.1
 EXACT_BLOCK_CELLS = 3
+#: A differential drive turns on the spot, sweeping its arms round: its turns are checked
+#: exactly where the outermost point of its outlines has moved this far [m] (a cup is 8 cm wide).
+EXACT_TURN_STEP = 0.04
 #: Weight of A*'s distance heuristic: above 1 it expands far fewer cells, for a path at most
 #: this factor longer than the cheapest on the grid (before shortening: `_shorten` straightens
 #: it wherever the straight line is free).
@@ -304,7 +316,11 @@ class PathPlanner:
     keep off the counters the arms reach over. ``grid`` (attribute) is the
     union of all. Construction inflates the grid (a few ms); :meth:`plan` is then a pure function of its
     arguments (thread-safe, deterministic). ``cost_weight`` is the extra cost per cell [m/m]
-    of passing where the footprint fits only at some headings.
+    of passing where the footprint fits only at some headings. ``kinematics``: how the base
+    moves (default omnidirectional); for a differential drive every segment of a plan is a
+    chain of turns on the spot and straight drives (`pycram.world.base_kinematics`), and
+    :meth:`plan` returns those primitives, so that each step of the result is one a
+    differential drive makes.
     """
 
     def __init__(
@@ -314,7 +330,9 @@ class PathPlanner:
         clearance: float = 0.03,
         cost_weight: float = 2.0,
         layers: Sequence[tuple[np.ndarray, Footprint | Sequence[Footprint]]] = (),
+        kinematics: BaseKinematics | None = None,
     ) -> None:
+        self.kinematics = kinematics or BaseKinematics()
         res = grid.resolution
         # a cell is marked when its centre is under an obstacle: the obstacle may reach half a
         # cell diagonal further, so checks add that to the clearance
@@ -387,8 +405,32 @@ class PathPlanner:
     def segment_free(
         self, a: BasePose, b: BasePose, escape: BasePose | None = None, exact_check: PoseCheck | None = None
     ) -> bool:
-        """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?
-        Poses within `ESCAPE_RADIUS` of ``escape`` are not checked."""
+        """Can the base move from ``a`` to ``b`` touching nothing? Omnidirectional: the straight
+        drive, turning uniformly; differential: one of the chains of turns and straight drives
+        of `pycram.world.base_kinematics.move_options`. Poses within `ESCAPE_RADIUS` of
+        ``escape`` are not checked."""
+        return self._free_chain(a, b, escape, exact_check) is not None
+
+    def _free_chain(
+        self, a: BasePose, b: BasePose, escape: BasePose | None, exact_check: PoseCheck | None
+    ) -> list[BasePose] | None:
+        """The first chain of `move_options` from ``a`` to ``b`` whose every straight step is
+        free (``a`` excluded, ``b`` last), or None."""
+        for chain in move_options(a, b, self.kinematics):
+            prev, free = a, True
+            for pose in chain:
+                if not self._straight_free(prev, pose, escape, exact_check):
+                    free = False
+                    break
+                prev = pose
+            if free:
+                return chain
+        return None
+
+    def _straight_free(
+        self, a: BasePose, b: BasePose, escape: BasePose | None = None, exact_check: PoseCheck | None = None
+    ) -> bool:
+        """Is the straight drive from ``a`` to ``b`` (turning uniformly) free everywhere?"""
         dist = math.hypot(b.x - a.x, b.y - a.y)
         dyaw = _wrap(b.yaw - a.yaw)
         # sample so that neither the centre nor a corner moves more than half a cell per step
@@ -397,8 +439,34 @@ class PathPlanner:
         xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
         if escape is not None:
             keep = np.hypot(xs - escape.x, ys - escape.y) >= ESCAPE_RADIUS
+            if not self.kinematics.holonomic:  # a differential drive escapes straight: its turns are checked
+                keep |= np.abs((yaws - escape.yaw + np.pi) % (2.0 * np.pi) - np.pi) > ESCAPE_TURN
             xs, ys, yaws = xs[keep], ys[keep], yaws[keep]
         return self._free(xs, ys, yaws, exact_check)
+
+    def _primitives(
+        self, start: BasePose, waypoints: list[BasePose], escape: BasePose | None, exact_check: PoseCheck | None
+    ) -> list[BasePose] | None:
+        """`waypoints` with each segment replaced by its first free chain of moves (the same
+        list for an omnidirectional base), or None when a segment has none. A differential
+        drive keeps at an intermediate waypoint the heading it arrives with where it can (it
+        turns once there, towards the next one, not twice)."""
+        if self.kinematics.holonomic:
+            return list(waypoints)
+        out: list[BasePose] = []
+        prev = start
+        for i, w in enumerate(waypoints):
+            chain = None
+            if i < len(waypoints) - 1 and math.hypot(w.x - prev.x, w.y - prev.y) >= POSITION_EPS:
+                arriving = BasePose(w.x, w.y, math.atan2(w.y - prev.y, w.x - prev.x))
+                chain = self._free_chain(prev, arriving, escape, exact_check)
+            if chain is None:
+                chain = self._free_chain(prev, w, escape, exact_check)
+            if chain is None:
+                return None
+            out += chain
+            prev = chain[-1]
+        return out
 
     # ------------------------------------------------------------------ planning
     def plan(self, start: object, goal: object, exact_check: PoseCheck | None = None) -> list[BasePose]:
@@ -421,7 +489,7 @@ class PathPlanner:
         escape = None if self.pose_free(a.x, a.y, a.yaw, exact_check) else a
         ctx = _Query(escape, exact_check)
         if self.path_free(a, [b], exact_check):
-            return [b]
+            return self._primitives(a, [b], escape, exact_check) or [b]
         sc, gc = g.cell(a.x, a.y), g.cell(b.x, b.y)
         for name, cell, pose in (("start", sc, a), ("goal", gc, b)):
             if not g.inside(*cell):
@@ -440,6 +508,7 @@ class PathPlanner:
                 )
             path, misfits = self._shorten(a, b, cells, ctx)
             if not misfits:
+                path = self._primitives(a, path, escape, exact_check) or path
                 hit = self._exact_hit(a, path, escape, exact_check)
                 if hit is None:
                     return path
@@ -455,14 +524,19 @@ class PathPlanner:
         raise NoPathError("no_path", "no path where the robot fits at the headings it needs", a, b)
 
     def path_free(self, start: BasePose, waypoints: list[BasePose], exact_check: PoseCheck | None = None) -> bool:
-        """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?"""
+        """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?
+        For a differential drive, each segment by one of its chains of moves."""
         escape = None if self.pose_free(start.x, start.y, start.yaw, exact_check) else start
-        prev = start
-        for w in waypoints:
-            if not self.segment_free(prev, w, escape, exact_check):
-                return False
-            prev = w
-        return self._exact_hit(start, waypoints, escape, exact_check) is None
+        moves = self._primitives(start, waypoints, escape, exact_check)
+        if moves is None:  # a differential drive: no free chain (its chains are checked)
+            return False
+        if self.kinematics.holonomic:
+            prev = start
+            for w in moves:
+                if not self._straight_free(prev, w, escape, exact_check):
+                    return False
+                prev = w
+        return self._exact_hit(start, moves, escape, exact_check) is None
 
     def _exact_hit(
         self, start: BasePose, waypoints: list[BasePose], escape: BasePose | None, exact_check: PoseCheck | None
@@ -474,18 +548,29 @@ class PathPlanner:
         for w in waypoints:
             dist = math.hypot(w.x - prev.x, w.y - prev.y)
             dyaw = _wrap(w.yaw - prev.yaw)
-            n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius) / EXACT_STEP)))
+            step = EXACT_STEP if self.kinematics.holonomic else EXACT_TURN_STEP
+            n = max(1, int(math.ceil(max(dist / EXACT_STEP, abs(dyaw) * self._turn_radius / step))))
             for i in range(1, n + 1):
                 s = i / n
                 x, y = prev.x + s * (w.x - prev.x), prev.y + s * (w.y - prev.y)
-                if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+                yaw = prev.yaw + s * dyaw
+                if self._escaping(escape, x, y, yaw):
                     continue
                 if self._surely_free(x, y):  # no layer's obstacle within any outline's reach
                     continue
-                if not exact_check(x, y, prev.yaw + s * dyaw):
+                if not exact_check(x, y, yaw):
                     return (x, y)
             prev = w
         return None
+
+    def _escaping(self, escape: BasePose | None, x: float, y: float, yaw: float) -> bool:
+        """Whether the pose (x, y, yaw) is part of getting clear from `escape` (unchecked): within
+        `ESCAPE_RADIUS` of it, and for a differential drive also within `ESCAPE_TURN` of its
+        heading (it backs off or drives on straight; a turn on the spot would sweep whatever
+        it touches)."""
+        if escape is None or math.hypot(x - escape.x, y - escape.y) >= ESCAPE_RADIUS:
+            return False
+        return self.kinematics.holonomic or abs(_wrap(yaw - escape.yaw)) <= ESCAPE_TURN
 
     def _astar(
         self, sc: tuple[int, int], gc: tuple[int, int], bad: set[tuple[int, int]], start_free: bool
@@ -566,7 +651,13 @@ class PathPlanner:
             lengths.append(lengths[-1] + math.hypot(x1 - x0, y1 - y0))
         total = lengths[-1] or 1.0
         dyaw = _wrap(b.yaw - a.yaw)
-        profiles = (lambda s: a.yaw + dyaw * s, lambda s: a.yaw + dyaw, lambda s: a.yaw)
+        profiles: tuple[Callable[[float], float], ...] = (
+            lambda s: a.yaw + dyaw * s,
+            lambda s: a.yaw + dyaw,
+            lambda s: a.yaw,
+        )
+        if not self.kinematics.holonomic:
+            profiles = profiles[:1]  # a differential drive faces the way it goes (`_headed`)
         fewest: set[tuple[int, int]] | None = None
         for profile in profiles:
             poses, bad = self._headed(a, b, pts, lengths, total, cells, profile, ctx)
@@ -591,6 +682,8 @@ class PathPlanner:
         bad: set[tuple[int, int]] = set()
         for i in range(1, len(pts) - 1):
             (x, y), yaw = pts[i], profile(lengths[i] / total)
+            if not self.kinematics.holonomic:  # a differential drive faces the way it goes
+                yaw = math.atan2(y - pts[i - 1][1], x - pts[i - 1][0])
             fitting = self._fitting_yaw(x, y, yaw, ctx)
             if fitting is None:
                 bad.add(cells[i])
@@ -625,8 +718,7 @@ class PathPlanner:
     def _fitting_yaw(self, x: float, y: float, yaw: float, ctx: _Query) -> float | None:
         """`yaw` if the footprint fits there at it, else the nearest heading (in steps of
         pi/16) that fits, else None."""
-        escape = ctx.escape
-        if escape is not None and math.hypot(x - escape.x, y - escape.y) < ESCAPE_RADIUS:
+        if self._escaping(ctx.escape, x, y, yaw):
             return yaw
         for k in range(17):
             for sign in (1,) if k == 0 else (1, -1):

@@ -8,8 +8,10 @@ validated object as on the module. :meth:`RobotDescription.from_module` checks t
 raises :class:`RobotDescriptionError` naming the robot, the key and the valid keys or choices.
 
 Units are those of the data modules: angles in [rad], lengths in [m], velocities in [m/s] /
-[rad/s], forces in [N]. The values are the module's own objects (not copies): the object is
-frozen (no field can be rebound), its mappings are the module's.
+[rad/s], forces in [N]. The values are the module's own objects (not copies; except ``ARMS`` and
+``GRIPPERS`` when something in them is read from the URDF, see
+:mod:`pycram.world.robot_model_file`): the object is frozen (no field can be rebound), its
+mappings are the module's.
 
 Optional keys and their defaults (the defaults the readers used before this schema existed):
 ``DEFAULT_ARM`` (the first arm of ``ARMS``), ``ARM_ALIASES`` (each arm names itself),
@@ -27,11 +29,18 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
 
-__all__ = ["RobotDescription", "RobotDescriptionError", "ARM_KEYS", "GRIPPER_KEYS"]
+from .base_kinematics import BaseKinematics
+from .robot_model_file import ModelFileError, infer_from_model
+
+__all__ = ["RobotDescription", "RobotDescriptionError", "ARM_KEYS", "ARM_OPTIONAL_KEYS", "GRIPPER_KEYS"]
 
 #: The keys of one entry of ``ARMS``: its joints (in the order of `set_arm_joints`), its tool
 #: frame's link (x: approach direction, y: finger opening direction) and its gripper.
 ARM_KEYS = ("joints", "tool_link", "gripper")
+#: Keys an entry of ``ARMS`` may have besides `ARM_KEYS`: ``root_link``, the link its chain
+#: starts at -- then ``joints`` may be left out and is read from the URDF
+#: (`pycram.world.robot_model_file.infer_from_model`).
+ARM_OPTIONAL_KEYS = ("root_link",)
 
 #: The keys of one entry of ``GRIPPERS``.
 GRIPPER_KEYS = (
@@ -73,7 +82,9 @@ class RobotDescription:
     #: Root link of the URDF, mounted on an omnidirectional base (slide x, slide y, hinge yaw).
     ROOT_LINK: str
     #: Base limits (velocities, accelerations), footprint radii [m] and the links that count as
-    #: the base when checking for collisions while driving.
+    #: the base when checking for collisions while driving; ``kind``: how it moves,
+    #: ``"omnidirectional"`` (the default) or ``"differential"`` (then optionally
+    #: ``max_reverse`` and ``approach`` [m]: `pycram.world.base_kinematics.BaseKinematics`).
     BASE: dict[str, Any]
     #: The torso's ``joint``, its ``range`` [m] and ``default`` height [m].
     TORSO: dict[str, Any]
@@ -167,6 +178,12 @@ class RobotDescription:
                 missing[0],
                 f"missing key {missing[0]!r}{where}; required keys: {', '.join(cls.required_keys())}",
             )
+        try:
+            data = infer_from_model(data, robot)
+        except ModelFileError as exc:
+            key = "ARMS" if ": ARMS:" in str(exc) else "GRIPPERS" if ": GRIPPERS:" in str(exc) else "URDF"
+            problem = str(exc).removeprefix(f"robot description of {robot!r}: ")
+            raise RobotDescriptionError(robot, key, problem) from None
         return cls(**data)
 
     def _fail(self, key: str, problem: str) -> RobotDescriptionError:
@@ -184,6 +201,7 @@ class RobotDescription:
                 raise self._fail(f.name, f"must be a mapping, not {type(value).__name__}")
         self._validate_grippers()
         self._validate_arms()
+        self._validate_base()
         if self.DEFAULT_ARM not in self.ARMS:
             raise self._fail("DEFAULT_ARM", f"{self.DEFAULT_ARM!r} is no arm; arms: {', '.join(self.ARMS)}")
         for key, valid in (("ARM_ALIASES", self.ARMS), ("GRIPPER_ALIASES", self.GRIPPERS)):
@@ -203,11 +221,22 @@ class RobotDescription:
             if arm not in self.ARM_CONFIGURATIONS:
                 raise self._fail("ARM_CONFIGURATIONS", f"no configurations of arm {arm!r}")
 
+    @property
+    def base_kinematics(self) -> BaseKinematics:
+        """How the base moves (``BASE["kind"]``, ``"max_reverse"``, ``"approach"``)."""
+        return BaseKinematics.of(self.BASE)
+
+    def _validate_base(self) -> None:
+        try:
+            BaseKinematics.of(self.BASE)
+        except ValueError as exc:
+            raise self._fail("BASE", str(exc)) from None
+
     def _validate_arms(self) -> None:
         if not self.ARMS:
             raise self._fail("ARMS", "a robot needs at least one arm")
         for arm, spec in self.ARMS.items():
-            self._check_entry("ARMS", arm, spec, ARM_KEYS)
+            self._check_entry("ARMS", arm, spec, ARM_KEYS, ARM_OPTIONAL_KEYS)
             joints = spec["joints"]
             if isinstance(joints, str) or not joints or not all(isinstance(j, str) for j in joints):
                 raise self._fail("ARMS", f"arm {arm!r}: 'joints' must be a non-empty sequence of joint names")
@@ -228,13 +257,20 @@ class RobotDescription:
                     "GRIPPERS", f"gripper {gripper!r}: 'joint_range' must be (closed, open), not {joint_range!r}"
                 )
 
-    def _check_entry(self, key: str, name: str, spec: Any, valid: tuple[str, ...]) -> None:
+    def _check_entry(
+        self, key: str, name: str, spec: Any, valid: tuple[str, ...], optional: tuple[str, ...] = ()
+    ) -> None:
         what, article = ("arm", "an") if key == "ARMS" else ("gripper", "a")
         if not isinstance(spec, Mapping):
             raise self._fail(key, f"{what} {name!r} must be a mapping with the keys {', '.join(valid)}")
         missing = [k for k in valid if k not in spec]
         if missing:
-            raise self._fail(key, f"{what} {name!r} lacks {missing[0]!r}; keys of {article} {what}: {', '.join(valid)}")
-        unknown = sorted(set(spec) - set(valid))
+            hint = " (or 'root_link', to read them from the URDF)" if missing[0] == "joints" else ""
+            raise self._fail(
+                key, f"{what} {name!r} lacks {missing[0]!r}{hint}; keys of {article} {what}: {', '.join(valid)}"
+            )
+        unknown = sorted(set(spec) - set(valid) - set(optional))
         if unknown:
-            raise self._fail(key, f"{what} {name!r} has the unknown key {unknown[0]!r}; valid: {', '.join(valid)}")
+            raise self._fail(
+                key, f"{what} {name!r} has the unknown key {unknown[0]!r}; valid: {', '.join(valid + optional)}"
+            )

@@ -100,3 +100,37 @@ def test_an_arm_holding_nothing_is_not_lifted():
     base = (2.0, 3.9, math.pi / 2)
     assert reasoner._lifted_arrival(prosp, ARM, base, reasoner.arrival_configuration(prosp)) == ()
     assert reasoner.carried() == []
+
+
+def _differential(geometry: RobotGeometry) -> RobotGeometry:
+    import dataclasses
+
+    from pycram.world.base_kinematics import BaseKinematics
+
+    return dataclasses.replace(geometry, base_kinematics=BaseKinematics("differential", approach=0.3))
+
+
+def test_a_differential_drive_needs_a_way_in_an_omnidirectional_base_does_not():
+    """A pose the robot fits at, but neither straight behind it (where it would come from) nor
+    turned on the spot: no way in for a differential drive; an omnidirectional base slides in."""
+    base = (2.0, 3.0, 0.0)
+
+    def boxed_in(pose):  # free only at the pose's own (x, y) facing +x
+        return not (abs(pose[0] - 2.0) < 1e-9 and abs(pose[1] - 3.0) < 1e-9 and abs(pose[2]) < 1e-9)
+
+    prosp = LiftingProspection(robot_collides=boxed_in)
+    geometry = RobotGeometry.from_description(pr2)
+    omni = LocationReasoner(geometry, lambda: APARTMENT, lambda: prosp, holding=lambda: {})
+    diff = LocationReasoner(_differential(geometry), lambda: APARTMENT, lambda: prosp, holding=lambda: {})
+    tucked = geometry.tucked
+    assert not omni.no_way_in(prosp, base, tucked)
+    prosp.asked.clear()
+    assert diff.no_way_in(prosp, base, tucked)
+    # it asked about the poses behind it, then about turning on the spot
+    asked = [b for b, *_ in prosp.asked]
+    assert (1.85, 3.0, 0.0) in [tuple(round(v, 6) for v in b) for b in asked]
+    assert any(abs(b[2] - math.pi / 4) < 1e-9 for b in asked)
+    # free behind it: it comes in straight; free all round: it turns there
+    behind_free = LiftingProspection(robot_collides=lambda pose: abs(pose[1] - 3.0) > 1e-9 or abs(pose[2]) > 1e-9)
+    assert not diff.no_way_in(behind_free, base, tucked)
+    assert not diff.no_way_in(LiftingProspection(), base, tucked)

@@ -97,3 +97,27 @@ def test_a_door_left_open_across_the_route_is_driven_around():
         assert closest > _footprint_radius(world)
     finally:
         world.close()
+
+
+def test_each_base_moves_as_its_kinematics_allow(world):
+    """The PR2's omnidirectional base steps sideways; the TIAGo's differential drive never does:
+    asked to move 0.4 m to its left it turns, drives along its heading and turns back."""
+    start = world.base_pose.get_value()
+    left = (-math.sin(start.yaw), math.cos(start.yaw))
+    poses = Recorder(world.base_pose)
+    ok(world.drive_to(start.x + 0.4 * left[0], start.y + 0.4 * left[1], start.yaw))
+    samples = [start, *poses.samples]
+    sideways = 0.0  # [m] travelled along the base's own y axis
+    for a, b in zip(samples, samples[1:]):
+        dx, dy = b.x - a.x, b.y - a.y
+        sideways += abs(-math.sin(a.yaw) * dx + math.cos(a.yaw) * dy)
+    turned = max(abs(math.remainder(p.yaw - start.yaw, 2 * math.pi)) for p in samples)
+    final = world.base_pose.get_value()
+    assert math.hypot(final.x - start.x - 0.4 * left[0], final.y - start.y - 0.4 * left[1]) < 0.01
+    if world.description.BASE.get("kind", "omnidirectional") == "differential":
+        assert sideways < 0.02, sideways
+        assert turned > 1.2  # it faced the way it went (about 90 deg)
+    else:
+        assert sideways > 0.35, sideways
+        assert turned < 0.05
+    ok(world.drive_to(start.x, start.y, start.yaw))

@@ -19,6 +19,8 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
+from pycram.world.base_kinematics import BaseKinematics, is_primitive, move_options
+from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D, wrap_angle
 
 from .engine import Engine
@@ -92,6 +94,12 @@ class Instant(Controller):
 class BaseDrive(Controller):
     """Drive the base on a straight line to a map pose while turning, with trapezoidal profiles.
 
+    A differential drive (the description's ``BASE["kind"]``, `pycram.world.base_kinematics`)
+    never steps sideways: a goal that is not straight ahead, straight behind or a turn on the
+    spot is reached by turning to face it, driving straight and turning to its heading (the
+    references obey the drive's constraint; the joint servos correct millimetres of tracking
+    error).
+
     Fails with "collision" when a base link touches the environment, with "blocked" when the base
     lags its reference by more than `max_lag` [m] (or 0.15 rad), and with "timeout" when it does
     not settle within 2 cm / 2 deg. Succeeds within `tolerance` [m] and `yaw_tolerance` [rad].
@@ -99,10 +107,14 @@ class BaseDrive(Controller):
 
     channel = "base"
 
+    #: Tolerances [m], [rad] of the intermediate stops of a differential drive's turn-drive-turn.
+    STOP_TOLERANCE = (0.01, 0.02)
+
     def __init__(
         self, goal: Pose2D, tolerance: float = 0.005, yaw_tolerance: float = 0.009, max_lag: float = 0.06
     ) -> None:
         self.goal, self.tol, self.yaw_tol, self.max_lag = goal, tolerance, yaw_tolerance, max_lag
+        self._stops: list[Pose2D] = []
 
     def start(self, eng: Engine) -> Outcome | None:
         refused = invalid_input(
@@ -113,18 +125,29 @@ class BaseDrive(Controller):
         )
         if refused is not None:
             return refused
+        p = eng.base_pose()
+        kinematics = BaseKinematics.of(eng.desc.BASE)
+        here, goal = BasePose(p.x, p.y, p.yaw), BasePose(self.goal.x, self.goal.y, self.goal.yaw)
+        if not kinematics.holonomic and not is_primitive(here, goal, self.yaw_tol):
+            moves = move_options(here, goal, kinematics)[0]  # turn, drive forwards, turn
+            self._stops = [Pose2D(m.x, m.y, m.yaw) for m in moves[:-1]]
+        self._begin(eng, self._stops[0] if self._stops else self.goal)
+        return None
+
+    def _begin(self, eng: Engine, target: Pose2D) -> None:
+        """Start the straight, turning move from where the base is to `target`."""
         b = eng.desc.BASE
-        self.start_pose = p = eng.base_pose()
-        self.dx, self.dy = self.goal.x - p.x, self.goal.y - p.y
+        self.target = target
+        p = eng.base_pose()
+        self.dx, self.dy = target.x - p.x, target.y - p.y
         # unwrap the current yaw joint value to stay continuous
         self.yaw0 = eng.q("base_yaw")
-        self.dyaw = wrap_angle(self.goal.yaw - p.yaw)
+        self.dyaw = wrap_angle(target.yaw - p.yaw)
         self.lin = Trapezoid(math.hypot(self.dx, self.dy), b["max_linear_velocity"], b["linear_acceleration"])
         self.ang = Trapezoid(abs(self.dyaw), b["max_angular_velocity"], b["angular_acceleration"])
         self.duration = max(self.lin.duration, self.ang.duration)
         self.t0 = eng.time
         self.x0, self.y0 = eng.q("base_x"), eng.q("base_y")
-        return None
 
     def _reference(self, t: float) -> tuple[float, float, float]:
         s_lin = self.lin.fraction(t - self.t0, self.duration)
@@ -147,8 +170,16 @@ class BaseDrive(Controller):
         elapsed = t - self.t0
         if elapsed >= self.duration:
             p = eng.base_pose()
-            err = p.distance_to(self.goal)
-            yerr = p.yaw_error_to(self.goal)
+            err = p.distance_to(self.target)
+            yerr = p.yaw_error_to(self.target)
+            if self._stops:  # an intermediate stop of a differential drive
+                tol, yaw_tol = self.STOP_TOLERANCE
+                if err <= tol and yerr <= yaw_tol:
+                    self._stops.pop(0)
+                    self._begin(eng, self._stops[0] if self._stops else self.goal)
+                elif elapsed > self.duration + 3.0:
+                    return fail("timeout", f"base settled {err:.3f} m / {math.degrees(yerr):.1f} deg off a stop", p)
+                return None
             if err <= self.tol and yerr <= self.yaw_tol:
                 return ok(p)
             if elapsed > self.duration + 3.0:

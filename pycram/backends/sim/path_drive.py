@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 import mujoco
 import numpy as np
 
+from pycram.world.base_kinematics import BaseKinematics
 from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
 from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D
@@ -49,6 +50,7 @@ class Navigation:
     def __init__(self, eng: Engine) -> None:
         self.floor: FloorMap = build_floor_map(eng.scene, eng.data)
         self.footprint: Footprint = base_footprint(eng.scene, eng.data)
+        self.kinematics = BaseKinematics.of(eng.desc.BASE)
         self._state: np.ndarray | None = None
         # `FloorMap.movable_state`'s indices as arrays: the state is compared every control tick
         self._mocap = np.asarray(self.floor.mocap_ids, dtype=np.int64)
@@ -148,7 +150,7 @@ class Navigation:
         self._state, self._outline = state, key
         layers = [(mask, outlines[top]) for top, mask in bands.items()]
         nothing = OccupancyGrid(self.floor.origin, self.floor.resolution, np.zeros(self.floor.shape, bool))
-        self._planner = PathPlanner(nothing, self.footprint, layers=layers)
+        self._planner = PathPlanner(nothing, self.footprint, layers=layers, kinematics=self.kinematics)
         return self._planner, True
 
 

@@ -123,6 +123,8 @@ class OpenVocabulary(StandingSearch):
             arrival = self.arrival_configuration(prosp)
             if prosp.in_collision((x, y, yaw), {**arrival, **pulled_out}, self.carried(), objects=True):
                 return None, ("in collision", None)
+            if self.no_way_in(prosp, (x, y, yaw), arrival):  # the drawer is closed as it comes
+                return None, ("no way in for a differential drive", None)
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
             c0, s0 = math.cos(headings[0]), math.sin(headings[0])
@@ -230,6 +232,9 @@ class OpenVocabulary(StandingSearch):
             for offset in PUSH_YAW_OFFSETS:
                 yaw = _wrap(natural + offset)
                 if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
+                    continue
+                if self.no_way_in(prosp, (x, y, yaw), arrival):
+                    failure = ("no way in for a differential drive", None)
                     continue
                 solved, reason = self._reachable_along(prosp, arm, (x, y, yaw), poses, joint)
                 if reason is None:

@@ -203,6 +203,9 @@ class ReachVocabulary(StandingSearch):
                     lifted = self._lifted_arrival(prosp, arm, (x, y, natural), tucked) if action == "place" else ()
                     if not lifted:
                         return None, ("in collision", None)
+                coming = {**tucked, **dict(zip(self.geometry.arm_joints[arm], lifted))} if lifted else tucked
+                if self.no_way_in(prosp, (x, y, natural), coming):
+                    return None, ("no way in for a differential drive", None)
                 if prosp.in_collision((x, y, natural), raised):
                     failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
                     if torsos == "current":
@@ -217,9 +220,11 @@ class ReachVocabulary(StandingSearch):
             joint = self.geometry.torso_joint
             for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
-                if prosp.in_collision(
-                    (x, y, natural), {**tucked, joint: height}, self.carried(), objects=True
-                ) or prosp.in_collision((x, y, natural), {**raised, joint: height}):
+                if (
+                    prosp.in_collision((x, y, natural), {**tucked, joint: height}, self.carried(), objects=True)
+                    or prosp.in_collision((x, y, natural), {**raised, joint: height})
+                    or self.no_way_in(prosp, (x, y, natural), {**tucked, joint: height})
+                ):
                     continue
                 other, why = sequences({**raised, joint: height})
                 if other is not None:

@@ -6,7 +6,7 @@ number comes from the robot's validated description (:class:`pycram.world.robot_
 from ``pycram.robots.<name>.description``): ``BASE``
 (``radius``: circumscribed, ``inscribed_radius``), ``ARMS``, ``ARM_ALIASES``, ``DEFAULT_ARM``,
 ``REACH_POINT_IN_BASE``, ``APPROACH_OFFSETS``, ``ARM_CONFIGURATIONS`` (``park``), optionally
-``DOOR_PUSH``. Lengths in [m].
+``DOOR_PUSH``; ``BASE["kind"]`` (its kinematics). Lengths in [m].
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, cast
 
+from pycram.world.base_kinematics import BaseKinematics
 from pycram.world.robot_description import RobotDescription
 
 __all__ = ["RobotGeometry"]
@@ -43,7 +44,9 @@ class RobotGeometry:
     (``FINGERTIP_REACH``); a top grasp keeps them `top_grasp_clearance` [m]
     (``TOP_GRASP_CLEARANCE``) above the surface the object rests on (`top_grasp_height`).
     `max_openings` per arm: the largest opening [m] of its gripper (``GRIPPERS[...]['max_opening']``;
-    grasp planning, `pycram.reasoning.grasps`).
+    grasp planning, `pycram.reasoning.grasps`). `base_kinematics`: how the base moves
+    (``BASE["kind"]``; a differential drive must be able to drive into a base pose,
+    `CandidateSearch.no_way_in`).
     """
 
     name: str
@@ -64,6 +67,7 @@ class RobotGeometry:
     fingertip_reach: float = 0.0
     top_grasp_clearance: float = 0.0
     max_openings: Mapping[str, float] = None  # type: ignore[assignment]
+    base_kinematics: BaseKinematics = BaseKinematics()
 
     @classmethod
     def from_description(cls, d: RobotDescription) -> RobotGeometry:
@@ -97,6 +101,7 @@ class RobotGeometry:
             fingertip_reach=float(d.FINGERTIP_REACH),
             top_grasp_clearance=float(d.TOP_GRASP_CLEARANCE),
             max_openings={a: float(d.GRIPPERS[s["gripper"]]["max_opening"]) for a, s in d.ARMS.items()},
+            base_kinematics=d.base_kinematics,
         )
 
     def top_grasp_height(self, bottom: float, wanted: float) -> float:

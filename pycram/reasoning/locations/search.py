@@ -141,6 +141,25 @@ class CandidateSearch:
                 return tuple(float(v) for v in answer.positions)
             step += 1
 
+    def no_way_in(self, prosp: Any, base: tuple[float, float, float], configuration: Mapping[str, float]) -> bool:
+        """Whether a differential drive cannot get to `base` (x [m], y [m], yaw [rad]) in
+        `configuration` with what it carries: it can neither have come straight along its heading
+        (the robot touches something `approach`/2 or `approach` behind the pose) nor turn there on
+        the spot (it touches something at one of the other seven eighths of a turn). The pose
+        itself is checked by the caller. Always False for an omnidirectional base, which may come
+        in any direction."""
+        kinematics = self.geometry.base_kinematics
+        if kinematics.holonomic:
+            return False
+        x, y, yaw = base
+        carried = self.carried()
+        d = kinematics.approach
+        behind = [(x - f * d * math.cos(yaw), y - f * d * math.sin(yaw), yaw) for f in (0.5, 1.0)]
+        if d > 0.0 and not any(prosp.in_collision(p, configuration, carried, objects=True) for p in behind):
+            return False
+        turns = [(x, y, yaw + k * math.pi / 4) for k in range(1, 8)]
+        return any(prosp.in_collision(p, configuration, carried, objects=True) for p in turns)
+
     def carried(self) -> list[str]:
         """The names of the objects the robot holds now (believed), to check base poses with:
         they arrive with the robot (`Prospection.in_collision`'s ``carried``)."""

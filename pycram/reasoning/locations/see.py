@@ -48,6 +48,8 @@ class SeeVocabulary(CandidateSearch):
             arrival = self.arrival_configuration(prosp)
             if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
                 return None, ("in collision", None)
+            if self.no_way_in(prosp, (x, y, yaw), arrival):
+                return None, ("no way in for a differential drive", None)
             seen = prosp.visible(what, (x, y, yaw), 0.5, arrival)
             if seen:
                 return BaseLocation(x, y, yaw, cost=cost, visible=seen.fraction), None

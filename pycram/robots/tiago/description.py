@@ -14,7 +14,14 @@ NAME = "tiago"
 URDF = "robots/tiago_description/robots/tiago_no_hand.urdf"
 ROOT_LINK = "base_footprint"
 
+#: TIAGo's base is a differential drive (two driven wheels and casters): it drives along its
+#: heading or turns on the spot, never sideways (`pycram.world.base_kinematics`). It backs up
+#: at most `max_reverse` (no laser behind it) and arrives at / leaves a pose straight along its
+#: heading over `approach` where turning on the spot would not fit.
 BASE = {
+    "kind": "differential",
+    "max_reverse": 0.5,  # [m]
+    "approach": 0.3,  # [m]
     "max_linear_velocity": 0.6,  # [m/s]
     "max_angular_velocity": 1.0,  # [rad/s]
     "linear_acceleration": 0.8,  # [m/s^2]

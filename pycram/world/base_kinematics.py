@@ -1,0 +1,178 @@
+"""How a robot's base can move: omnidirectional, or a differential drive that cannot go sideways.
+
+A robot description's ``BASE["kind"]`` names its kinematics (:data:`KINDS`); :class:`BaseKinematics`
+holds it with the numbers a differential drive needs. Backend-neutral (no simulator, no numpy):
+the path planner (`pycram.world.navigation.PathPlanner`), the simulated drives
+(`pycram.backends.sim.controllers`) and location reasoning read it.
+
+An **omnidirectional** base (PR2, TIAGo Pro) drives any straight line while turning: one move
+from pose ``a`` to pose ``b`` is that line.
+
+A **differential drive** (TIAGo) moves only along its heading (forwards or backwards) or turns on
+the spot. One move from ``a`` to ``b`` is a chain of such *primitives*; :func:`move_options` lists
+the chains that realise it, in the order a planner should prefer them:
+
+1. turn to face ``b``, drive forwards, turn to ``b``'s heading;
+2. the same backwards (only up to ``max_reverse`` [m]: the robot has no eyes behind it); this
+   comes first when it turns less (a step back from a counter);
+3. arrive straight: drive (as 1) to the point ``approach`` [m] behind ``b`` along ``b``'s
+   heading, turn to that heading, drive the last ``approach`` metres straight in -- the way to
+   a pose facing a counter when turning on the spot there would sweep a carried object or an
+   arm over it;
+4. leave straight: back out ``approach`` metres along ``a``'s heading first, then as 1;
+5. leave and arrive straight (4 and 3).
+
+Every pose of a chain but the last is an intermediate stop; consecutive poses differ either in
+position along the common heading (a straight drive) or in heading alone (a turn on the spot).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from .prospection import BasePose
+
+__all__ = [
+    "KINDS",
+    "OMNIDIRECTIONAL",
+    "DIFFERENTIAL",
+    "BaseKinematics",
+    "move_options",
+    "is_primitive",
+    "POSITION_EPS",
+    "HEADING_EPS",
+]
+
+OMNIDIRECTIONAL = "omnidirectional"
+DIFFERENTIAL = "differential"
+#: The base kinematics a robot description may name (``BASE["kind"]``).
+KINDS = (OMNIDIRECTIONAL, DIFFERENTIAL)
+#: Moves shorter than this [m] are turns on the spot.
+POSITION_EPS = 1e-3
+#: Headings closer than this [rad] need no turn.
+HEADING_EPS = 1e-3
+
+
+@dataclass(frozen=True)
+class BaseKinematics:
+    """A base's kinematics: `kind` (one of `KINDS`); for a differential drive the longest
+    backwards drive `max_reverse` [m] and the straight run `approach` [m] of arriving at or
+    leaving a pose along its heading."""
+
+    kind: str = OMNIDIRECTIONAL
+    max_reverse: float = 0.5
+    approach: float = 0.3
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"base kind {self.kind!r} is unknown; valid kinds: {', '.join(KINDS)}")
+        for name in ("max_reverse", "approach"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0.0:
+                raise ValueError(f"base {name} must be a finite length >= 0 [m], not {value!r}")
+
+    @property
+    def holonomic(self) -> bool:
+        """Whether the base can move in any direction (omnidirectional)."""
+        return self.kind == OMNIDIRECTIONAL
+
+    @classmethod
+    def of(cls, base: Mapping[str, Any]) -> BaseKinematics:
+        """The kinematics of a description's ``BASE`` mapping: ``kind`` (default
+        omnidirectional), ``max_reverse`` and ``approach`` [m] (defaults 0.5 and 0.3)."""
+        defaults = cls()
+        return cls(
+            kind=base.get("kind", defaults.kind),
+            max_reverse=base.get("max_reverse", defaults.max_reverse),
+            approach=base.get("approach", defaults.approach),
+        )
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _turn_and_drive(chain: list[BasePose], goal_x: float, goal_y: float, backwards: bool) -> None:
+    """Append to `chain` the turn (if needed) and the straight drive from its last pose to
+    (goal_x, goal_y), facing the way of travel (or away from it, `backwards`)."""
+    here = chain[-1]
+    dx, dy = goal_x - here.x, goal_y - here.y
+    if math.hypot(dx, dy) < POSITION_EPS:
+        return
+    heading = math.atan2(dy, dx) + (math.pi if backwards else 0.0)
+    heading = here.yaw + _wrap(heading - here.yaw)  # the nearer way round, yaw kept continuous
+    if abs(heading - here.yaw) > HEADING_EPS:
+        chain.append(BasePose(here.x, here.y, heading))
+    chain.append(BasePose(goal_x, goal_y, heading))
+
+
+def _turn_to(chain: list[BasePose], yaw: float) -> None:
+    here = chain[-1]
+    if abs(_wrap(yaw - here.yaw)) > HEADING_EPS:
+        chain.append(BasePose(here.x, here.y, here.yaw + _wrap(yaw - here.yaw)))
+
+
+def _chain(a: BasePose, b: BasePose, backwards: bool, leave: float, arrive: float) -> list[BasePose]:
+    chain = [a]
+    if leave > 0.0:
+        _turn_and_drive(chain, a.x - leave * math.cos(a.yaw), a.y - leave * math.sin(a.yaw), backwards=True)
+    if arrive > 0.0:
+        px, py = b.x - arrive * math.cos(b.yaw), b.y - arrive * math.sin(b.yaw)
+        _turn_and_drive(chain, px, py, backwards)
+        _turn_to(chain, b.yaw)
+    _turn_and_drive(chain, b.x, b.y, backwards)
+    _turn_to(chain, b.yaw)
+    out = chain[1:]
+    if out:
+        last = out[-1]
+        out[-1] = BasePose(last.x, last.y, b.yaw)  # the goal's own yaw value, not an unwrapped one
+    return out or [b]
+
+
+def _turning(a: BasePose, chain: list[BasePose]) -> float:
+    """The total turn [rad] of a chain of moves from ``a``."""
+    total, yaw = 0.0, a.yaw
+    for pose in chain:
+        total += abs(_wrap(pose.yaw - yaw))
+        yaw = pose.yaw
+    return total
+
+
+def move_options(a: BasePose, b: BasePose, kinematics: BaseKinematics) -> list[list[BasePose]]:
+    """The chains of poses (``a`` excluded, ``b`` last) that move a base of `kinematics` from
+    ``a`` to ``b``, preferred first (see the module docstring). An omnidirectional base has one:
+    ``[b]``. Deterministic: the same question gives the same chains."""
+    if kinematics.holonomic:
+        return [[b]]
+    dist = math.hypot(b.x - a.x, b.y - a.y)
+    options = [_chain(a, b, False, 0.0, 0.0)]
+    if POSITION_EPS <= dist <= kinematics.max_reverse:
+        backwards = _chain(a, b, True, 0.0, 0.0)
+        # a short way back (e.g. stepping back from a counter): backwards first if it turns less
+        options.insert(0 if _turning(a, backwards) < _turning(a, options[0]) else 1, backwards)
+    d = kinematics.approach
+    if d > 0.0 and dist >= POSITION_EPS:
+        options.append(_chain(a, b, False, 0.0, d))
+        if d <= kinematics.max_reverse:
+            options.append(_chain(a, b, False, d, 0.0))
+            options.append(_chain(a, b, False, d, d))
+    unique: list[list[BasePose]] = []
+    for option in options:
+        if option not in unique:
+            unique.append(option)
+    return unique
+
+
+def is_primitive(a: BasePose, b: BasePose, tolerance: float = 0.02) -> bool:
+    """Whether the move from ``a`` to ``b`` is a turn on the spot or a straight drive along
+    ``a``'s heading (forwards or backwards) to within `tolerance` [rad] of heading: a move a
+    differential drive makes without a sideways step."""
+    dist = math.hypot(b.x - a.x, b.y - a.y)
+    if dist < POSITION_EPS:
+        return True
+    heading = math.atan2(b.y - a.y, b.x - a.x)
+    along = min(abs(_wrap(heading - a.yaw)), abs(_wrap(heading - a.yaw - math.pi)))
+    return along <= tolerance and abs(_wrap(b.yaw - a.yaw)) <= tolerance

@@ -1,0 +1,70 @@
+"""What a robot description may leave to its URDF (pycram.world.robot_model_file): an arm's
+joints from the link its chain starts at, a gripper's joints and range from the hand below it."""
+
+from __future__ import annotations
+
+import pytest
+
+from pycram.world.robot_description import RobotDescription, RobotDescriptionError
+from pycram.world.robot_model_file import ModelFileError, infer_from_model, read_urdf
+from pycram.world.robot_registry import robot_description
+
+pr2 = robot_description("pr2")
+GRIPPER_FROM_FILE = ("joint", "coupled_joints", "joint_range")
+
+
+def _pr2_from_file(root_link: str = "torso_lift_link") -> dict:
+    """The PR2's description with its arms' joints and grippers' joints left to the URDF."""
+    data = {k: getattr(pr2, k) for k in RobotDescription.keys()}
+    data["ARMS"] = {
+        arm: {"root_link": root_link, "tool_link": spec["tool_link"], "gripper": spec["gripper"]}
+        for arm, spec in pr2.ARMS.items()
+    }
+    data["GRIPPERS"] = {
+        g: {k: v for k, v in spec.items() if k not in GRIPPER_FROM_FILE} for g, spec in pr2.GRIPPERS.items()
+    }
+    return data
+
+
+def test_arm_joints_are_the_movable_joints_from_the_root_link_to_the_tool():
+    described = RobotDescription.from_mapping(_pr2_from_file())
+    for arm in ("left", "right"):
+        assert described.ARMS[arm]["joints"] == pr2.ARMS[arm]["joints"]  # as the PR2 states them
+
+
+def test_a_gripper_is_its_one_driven_joint_its_mimics_and_its_limits():
+    right = RobotDescription.from_mapping(_pr2_from_file()).GRIPPERS["right"]
+    assert right["joint"] == pr2.GRIPPERS["right"]["joint"]
+    assert set(pr2.GRIPPERS["right"]["coupled_joints"]) <= set(right["coupled_joints"])
+    assert right["joint_range"] == pytest.approx(pr2.GRIPPERS["right"]["joint_range"], abs=1e-3)
+
+
+def test_a_description_that_states_everything_is_not_changed():
+    data = {k: getattr(pr2, k) for k in RobotDescription.keys()}
+    assert infer_from_model(data, "pr2")["ARMS"] is pr2.ARMS
+
+
+def test_a_root_link_not_above_the_tool_names_the_links_that_are():
+    with pytest.raises(RobotDescriptionError, match=r"ARMS: arm '\w+': link 'head_pan_link' is not above .*r_forearm"):
+        data = _pr2_from_file("head_pan_link")
+        data["ARMS"] = {"right": data["ARMS"]["right"]}
+        data["GRIPPERS"] = {"right": data["GRIPPERS"]["right"]}
+        data["ARM_CONFIGURATIONS"] = {"right": pr2.ARM_CONFIGURATIONS["right"]}
+        data["REACH_POINT_IN_BASE"] = {"right": pr2.REACH_POINT_IN_BASE["right"]}
+        data["ARM_ALIASES"] = {"right": "right"}
+        data["GRIPPER_ALIASES"] = {"right": "right"}
+        RobotDescription.from_mapping(data)
+
+
+def test_an_unknown_link_and_a_missing_file_are_named():
+    with pytest.raises(RobotDescriptionError, match="has no link 'no_such_link'"):
+        RobotDescription.from_mapping(_pr2_from_file("no_such_link"))
+    with pytest.raises(ModelFileError, match="'robots/none.urdf' not found"):
+        read_urdf("robots/none.urdf")
+
+
+def test_a_robot_with_a_gripper_of_its_own_ends_its_chain_at_the_mount():
+    tiago = robot_description("tiago")
+    data = {k: getattr(tiago, k) for k in RobotDescription.keys()}
+    data["ARMS"] = {"right": {"root_link": "torso_lift_link", "tool_link": "gripper_tool_link", "gripper": "right"}}
+    assert RobotDescription.from_mapping(data).ARMS["right"]["joints"] == tiago.ARMS["right"]["joints"]
