@@ -10,6 +10,8 @@
     pycram replay RUN                   run a recorded run again: "identical" or where it diverged
     pycram view [RUN]                   the run in Rerun's web viewer (tree, statuses, failures; world with --rrd)
     pycram experiment --scenario thesis --robot pr2,tiago --seeds 1-200   many runs in parallel
+    pycram robot list                   the registered robots: arms, grippers, base kind, URDF
+    pycram robot check NAME [--short]   a conformance run for a robot: a table of what passed, exit 1 on a failure
 
 The database is `--db URL`, else `$PYCRAM_DB_URL`, else the default SQLite file (see
 `pycram.trace.db`); a database named with `--db` must exist for the inspecting commands, and
@@ -20,7 +22,8 @@ Heavy modules (SQLAlchemy, matplotlib, the simulator) are imported only by the c
 need them.
 
 One module per group of commands: :mod:`~pycram.apps.cli.app` (the application and what
-the commands share), ``traces``, ``run``, ``demo``, ``replay``, ``scenes``, ``ros``, ``experiments``, ``view``.
+the commands share), ``traces``, ``run``, ``demo``, ``replay``, ``scenes``, ``ros``, ``experiments``, ``view``,
+``robot``.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ import sys
 
 # The command groups register their commands on import, in the order `pycram --help` lists them.
 # isort: off
-from pycram.apps.cli import traces, run, demo, replay, scenes, ros, experiments, view  # noqa: F401
+from pycram.apps.cli import traces, run, demo, replay, scenes, ros, experiments, view, robot  # noqa: F401
 
 # isort: on
 from pycram.apps.cli.app import app, console, err
