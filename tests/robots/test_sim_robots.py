@@ -277,7 +277,10 @@ def test_evaporating_a_running_drive_stops_the_base(robot):
     navigation = robot.process_module("navigation")
     assert navigation.status.get_value() is ProcessModuleStatus.CANCELLED
     here = world.base_pose.get_value()
-    assert 0.05 < distance(here, start) < 1.0
+    # it had moved (a differential drive may still be turning towards the goal) and stopped short
+    turned = abs(math.remainder(here.yaw - start.yaw, 2 * math.pi))
+    assert distance(here, start) > 0.05 or turned > 0.1
+    assert distance(here, start) < 1.0
     sleep(0.5)
     assert distance(world.base_pose.get_value(), here) < 0.05
     motion(type="moving", pose=START)

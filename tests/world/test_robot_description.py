@@ -22,7 +22,7 @@ def _data(robot: str = "pr2") -> dict:
 
 
 def test_the_registry_lists_the_robots_of_the_entry_points():
-    assert robot_names() == ("pr2", "tiago")
+    assert robot_names() == ("pr2", "tiago", "tiago-pro")
     assert robot_package("pr2") == "pycram.robots.pr2"
     assert robot_package("tiago") == "pycram.robots.tiago"
 

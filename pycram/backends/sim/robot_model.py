@@ -13,7 +13,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from pycram.world.robot_description import RobotDescription
+from pycram.world.robot_description import RobotDescription, RobotDescriptionError
 from pycram.world.robot_registry import robot_description, robot_names
 
 from . import collision
@@ -62,43 +62,75 @@ def _camera_quat() -> list[float]:
     return quat.tolist()
 
 
+def _remove_replaced_links(spec: mujoco.MjSpec, desc: RobotDescription, links: Any) -> None:
+    """Delete the links `links` of the URDF (with everything below them: the model file's own
+    gripper that `desc.GRIPPER_MODEL` replaces) and the equalities of their joints."""
+    gone: set[str] = set()
+    for name in links:
+        body = spec.body(name)
+        if body is None:
+            raise RobotDescriptionError(
+                desc.NAME, "GRIPPER_MODEL", f"GRIPPER_MODEL: 'replaces' names {name!r}, which is no link of {desc.URDF}"
+            )
+        stack = [body]
+        while stack:
+            b = stack.pop()
+            gone.update(j.name for j in b.joints)
+            stack.extend(b.bodies)
+        spec.delete(body)
+    for eq in list(spec.equalities):
+        if eq.type == mujoco.mjtEq.mjEQ_JOINT and (eq.name1 in gone or eq.name2 in gone):
+            spec.delete(eq)
+
+
 def _add_parallel_gripper(spec: mujoco.MjSpec, desc: RobotDescription, g: dict[str, Any]) -> None:
-    """Build the simple parallel gripper `g` (`desc.GRIPPER_MODEL`, TIAGo) into the robot spec."""
-    grip = next(iter(desc.GRIPPERS.values()))
-    mount = spec.body(g["mount_link"])
+    """Build the simple parallel gripper `g` (`desc.GRIPPER_MODEL`) onto each arm's mount link.
+
+    `g["mount_link"]` is one link (a one-armed robot) or ``{gripper: link}``; the optional
+    `g["mount_quat"]` (w, x, y, z) turns the gripper's frame (x: approach, y: opening) in the
+    mount link's frame; the optional `g["replaces"]` names links of the URDF deleted first (with
+    their subtrees: the model file's own gripper).
+    """
+    if g.get("replaces"):
+        _remove_replaced_links(spec, desc, g["replaces"])
+    mounts = g["mount_link"]
     px, py, pz = g["palm_size"]
     fx, fy, fz = g["finger_size"]
-    palm = mount.add_body(name=grip["palm_link"], pos=[px, 0, 0], mass=g["mass"], inertia=[1e-3, 1e-3, 1e-3])
-    palm.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[px, py, pz], rgba=[0.25, 0.25, 0.28, 1])
-    tool = palm.add_body(
-        name=desc.ARMS[desc.DEFAULT_ARM]["tool_link"],
-        pos=[g["tool_offset"] - px, 0, 0],
-        mass=0.001,
-        inertia=[1e-6, 1e-6, 1e-6],
-    )
-    del tool
-    names = (grip["joint"],) + tuple(grip["coupled_joints"])
-    for side, (link, jname) in enumerate(zip(grip["finger_links"], names)):
-        sign = 1.0 if side == 0 else -1.0
-        finger = palm.add_body(name=link, pos=[px + fx, sign * fy, 0], mass=0.05, inertia=[2e-5, 2e-5, 2e-5])
-        finger.add_joint(
-            name=jname,
-            type=mujoco.mjtJoint.mjJNT_SLIDE,
-            axis=[0, sign, 0],
-            range=list(grip["joint_range"]),
-            limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-            # a stiff closed limit: squeezing a bowl's 8 mm rim, the fingers were pushed 16 mm
-            # past it (soft default limit), crossed over and locked onto the rim -- the gripper
-            # could no longer open to let go
-            solref_limit=[0.004, 1.0],
+    quat = list(g.get("mount_quat", (1.0, 0.0, 0.0, 0.0)))
+    turn = np.zeros(9)
+    mujoco.mju_quat2Mat(turn, np.asarray(quat, float))
+    palm_pos = (turn.reshape(3, 3) @ np.array([px, 0.0, 0.0])).tolist()
+    for arm in desc.ARMS.values():
+        gname = arm["gripper"]
+        grip = desc.GRIPPERS[gname]
+        mount = spec.body(mounts if isinstance(mounts, str) else mounts[gname])
+        palm = mount.add_body(
+            name=grip["palm_link"], pos=palm_pos, quat=quat, mass=g["mass"], inertia=[1e-3, 1e-3, 1e-3]
         )
-        finger.add_geom(
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[fx, fy, fz],
-            rgba=[0.35, 0.35, 0.4, 1],
-            friction=[1.5, 0.01, 0.001],
-            condim=4,
-        )
+        palm.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[px, py, pz], rgba=[0.25, 0.25, 0.28, 1])
+        palm.add_body(name=arm["tool_link"], pos=[g["tool_offset"] - px, 0, 0], mass=0.001, inertia=[1e-6, 1e-6, 1e-6])
+        names = (grip["joint"],) + tuple(grip["coupled_joints"])
+        for side, (link, jname) in enumerate(zip(grip["finger_links"], names)):
+            sign = 1.0 if side == 0 else -1.0
+            finger = palm.add_body(name=link, pos=[px + fx, sign * fy, 0], mass=0.05, inertia=[2e-5, 2e-5, 2e-5])
+            finger.add_joint(
+                name=jname,
+                type=mujoco.mjtJoint.mjJNT_SLIDE,
+                axis=[0, sign, 0],
+                range=list(grip["joint_range"]),
+                limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                # a stiff closed limit: squeezing a bowl's 8 mm rim, the fingers were pushed 16 mm
+                # past it (soft default limit), crossed over and locked onto the rim -- the gripper
+                # could no longer open to let go
+                solref_limit=[0.004, 1.0],
+            )
+            finger.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=[fx, fy, fz],
+                rgba=[0.35, 0.35, 0.4, 1],
+                friction=[1.5, 0.01, 0.001],
+                condim=4,
+            )
 
 
 def build_robot_spec(desc: RobotDescription) -> mujoco.MjSpec:

@@ -2,8 +2,9 @@
 
 Two arms and two grippers, each with its own process module (the thesis' ``Pr2ArmL`` /
 ``Pr2ArmR``); requests name them ``'left'`` / ``'right'`` (or the thesis' ``'0'`` / ``'1'``).
-All numbers come from :mod:`pycram.robots.pr2.description`
-(validated by the robot registry).
+All numbers come from :mod:`pycram.robots.pr2.description` (validated by the robot registry);
+the modules and resolvers are those every simulated robot gets
+(:func:`pycram.robots.common.sim_robot.make_sim_robot`).
 
 Process modules (``robot.process_module(name)``): ``navigation``, ``base_stop``, ``head``,
 ``torso``, ``arm_left``, ``arm_right``, ``gripper_left``, ``gripper_right``, ``sensors``,
@@ -14,15 +15,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from pycram.execution.process_module import ProcessModule
-from pycram.robots.common import sim_modules as sm
-from pycram.robots.common.sim_resolvers import (
-    make_location_generator,
-    make_motion_resolver,
-    physical_arm,
-    physical_gripper,
-)
-from pycram.robots.common.sim_vocabulary import motion_types
+from pycram.robots.common.sim_modules import SimRobot
+from pycram.robots.common.sim_robot import make_sim_robot
 from pycram.world.robot_registry import robot_description
 
 __all__ = ["make_robot"]
@@ -31,53 +25,6 @@ __all__ = ["make_robot"]
 description = robot_description("pr2")
 
 
-def make_robot(world: Any) -> sm.SimRobot:
+def make_robot(world: Any) -> SimRobot:
     """The PR2 of ``world`` (a :class:`pycram.sim.World` built for ``'pr2'``), modules online."""
-    if getattr(world, "robot", None) != description.NAME:
-        raise ValueError(
-            f"make_robot for {description.NAME!r} needs a world with a {description.NAME!r}, got {world!r}"
-        )
-    robot = sm.SimRobot(description.NAME, world, description)
-    navigation = robot.add_process_module("navigation", sm.NavigationModule(world))
-    base_stop = robot.add_process_module("base_stop", sm.BaseStopModule(world, navigation))
-    head = robot.add_process_module("head", sm.HeadModule(world))
-    torso = robot.add_process_module("torso", sm.TorsoModule(world))
-    arms = {
-        arm: robot.add_process_module(f"arm_{arm}", sm.ArmModule(world, arm, robot=robot)) for arm in description.ARMS
-    }
-    grippers = {g: robot.add_process_module(f"gripper_{g}", sm.GripperModule(world, g)) for g in description.GRIPPERS}
-    sensors = robot.add_process_module("sensors", sm.SensorModule(world))
-    perception = robot.add_process_module("perception", sm.PerceptionModule(world, robot.belief))
-
-    robot.motion_types.update(motion_types(world, description))
-    robot.motion_resolvers.append(make_motion_resolver(world, description))
-    robot.location_generators.append(make_location_generator(world, description, robot.belief))
-
-    def available_process_modules(desig: Any) -> ProcessModule | None:
-        """Thesis ch. 4.2.2: choose the PR2's module by the designator's type (and arm)."""
-        if desig.check_constraints([("type", "moving")]):
-            return navigation
-        if desig.check_constraints([("type", "cancelling_movement")]):
-            return base_stop
-        if desig.check_constraints([("type", "pointing_head")]):
-            return head
-        if desig.check_constraints([("type", "setting_torso")]):
-            return torso
-        if desig.check_constraints([("type", "detecting")]):
-            return perception
-        if desig.check_constraints([("type", "subscribing_pose")]) or desig.check_constraints(
-            [("type", "subscribing_gripper")]
-        ):
-            return sensors
-        if desig.check_constraints([("type", "setting_gripper"), "gripper"]):
-            return grippers[physical_gripper(description, desig.prop_value("gripper"))]
-        if (
-            desig.check_constraints([("type", "setting_arm_configuration"), "arm"])
-            or desig.check_constraints([("type", "setting_arm_joints"), "arm"])
-            or desig.check_constraints([("type", "reaching"), "arm"])
-        ):
-            return arms[physical_arm(description, desig.prop_value("arm"))]
-        return None
-
-    robot.process_module_resolvers.append(available_process_modules)
-    return robot
+    return make_sim_robot(world, description)
