@@ -30,7 +30,8 @@ construction).
 A differential drive (`pycram.world.base_kinematics`) cannot step sideways: every straight
 segment above is then checked, and returned, as a chain of turns on the spot and straight
 drives along the heading (forwards, a short way backwards, or arriving at / leaving a pose
-straight along its heading), intermediate waypoints facing the way the robot goes.
+straight along its heading); intermediate waypoints face along the way the robot goes
+(forwards or backwards, whichever the robot faces more), and it turns only where its way turns.
 
 A* on a grid was chosen over sampling planners (RRT, PRM) because a 2D omnidirectional base in a
 room has a small grid (10^4..10^5 cells), A* is complete and deterministic on it (the same
@@ -251,6 +252,16 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def _same_place(a: BasePose, b: BasePose) -> bool:
+    return math.hypot(a.x - b.x, a.y - b.y) < POSITION_EPS
+
+
+def _along(yaw: float, direction: float) -> float:
+    """`direction` or its opposite, whichever is nearer `yaw` (driving forwards or backwards)."""
+    back = _wrap(direction + math.pi)
+    return direction if abs(_wrap(direction - yaw)) <= abs(_wrap(back - yaw)) else back
+
+
 class _Layer:
     """Occupied cells that one outline must keep off (e.g. counters: the base; walls and boxes:
     the whole robot as it stands). The outline is one convex footprint or several (their
@@ -456,14 +467,11 @@ class PathPlanner:
         out: list[BasePose] = []
         prev = start
         for i, w in enumerate(waypoints):
-            chain = None
-            if i < len(waypoints) - 1 and math.hypot(w.x - prev.x, w.y - prev.y) >= POSITION_EPS:
-                arriving = BasePose(w.x, w.y, math.atan2(w.y - prev.y, w.x - prev.x))
-                chain = self._free_chain(prev, arriving, escape, exact_check)
-            if chain is None:
-                chain = self._free_chain(prev, w, escape, exact_check)
+            chain = self._free_chain(prev, w, escape, exact_check)
             if chain is None:
                 return None
+            if i < len(waypoints) - 1 and len(chain) > 1 and _same_place(chain[-1], chain[-2]):
+                chain = chain[:-1]  # no turn to the waypoint's heading: the next segment turns
             out += chain
             prev = chain[-1]
         return out
@@ -682,8 +690,8 @@ class PathPlanner:
         bad: set[tuple[int, int]] = set()
         for i in range(1, len(pts) - 1):
             (x, y), yaw = pts[i], profile(lengths[i] / total)
-            if not self.kinematics.holonomic:  # a differential drive faces the way it goes
-                yaw = math.atan2(y - pts[i - 1][1], x - pts[i - 1][0])
+            if not self.kinematics.holonomic:  # a differential drive faces the way it goes, or away
+                yaw = _along(poses[-1].yaw, math.atan2(y - pts[i - 1][1], x - pts[i - 1][0]))
             fitting = self._fitting_yaw(x, y, yaw, ctx)
             if fitting is None:
                 bad.add(cells[i])
