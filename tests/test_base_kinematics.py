@@ -103,3 +103,54 @@ def test_a_narrow_bay_is_entered_straight():
     assert PathPlanner(room(bay), long_robot, clearance=0.02, kinematics=approach).segment_free(a, inside)
     no_approach = BaseKinematics("differential", max_reverse=0.5, approach=0.0)
     assert not PathPlanner(room(bay), long_robot, clearance=0.02, kinematics=no_approach).segment_free(a, inside)
+
+
+def test_a_differential_drive_backs_out_of_a_dead_end_before_it_turns():
+    """In a dead end too narrow to turn in, facing its closed end, the robot must back out
+    before it can turn: the cell search (which knows no headings) finds no such path, the
+    search over headings does; every step is a turn on the spot or a straight drive."""
+    dead_end = [(2.0, 0.0, 4.0, 2.7), (2.0, 3.3, 4.0, 6.0), (4.0, 0.0, 4.2, 6.0)]
+    long_robot = Footprint.rectangle(-0.35, -0.15, 0.35, 0.15)
+    planner = PathPlanner(room(dead_end), long_robot, clearance=0.02, kinematics=DIFF)
+    start, goal = BasePose(3.4, 3.0, 0.0), BasePose(1.0, 1.0, -math.pi / 2)
+    path = planner.plan(start, goal)
+    assert path[-1] == goal
+    assert _all_primitive(start, path)
+    assert planner.path_free(start, path)
+    # it left the dead end backwards, facing its end, and turned only outside it
+    prev = start
+    for p in path:
+        if abs(math.remainder(p.yaw - prev.yaw, 2 * math.pi)) > 0.1:
+            assert p.x < 2.0 - 0.3, (prev, p)
+        prev = p
+
+
+def test_turning_round_in_a_dead_end_takes_backing_out_and_coming_back():
+    """Facing the closed end of a dead end too narrow to turn in, and asked to face the other
+    way at the same spot: only backing out, turning outside and driving back in does it. The
+    cell search knows no headings; the search over headings (`_lattice`) finds it."""
+    dead_end = [(2.0, 0.0, 4.0, 2.7), (2.0, 3.3, 4.0, 6.0), (4.0, 0.0, 4.2, 6.0)]
+    long_robot = Footprint.rectangle(-0.35, -0.15, 0.35, 0.15)
+    planner = PathPlanner(room(dead_end), long_robot, clearance=0.02, kinematics=DIFF)
+    start, goal = BasePose(3.4, 3.0, 0.0), BasePose(3.4, 3.0, math.pi)
+    path = planner.plan(start, goal)
+    assert path[-1] == goal
+    assert _all_primitive(start, path)
+    assert planner.path_free(start, path)
+    assert min(p.x for p in path) < 2.0  # out of the dead end and back
+
+
+def test_a_differential_drive_moves_on_arcs_or_turns_then_drives():
+    """From where a drive ended a little off its line the next move is an arc through the goal
+    (then a small turn); a goal far to the side is turn, drive, turn."""
+    from pycram.world.base_kinematics import arc_pose, arc_radius, drive_moves
+
+    here = BasePose(0.0, 0.0, 0.0)
+    slightly_off = BasePose(1.0, 0.1, 0.0)
+    moves = drive_moves(here, slightly_off, DIFF)
+    assert len(moves) == 2 and arc_radius(here, moves[0]) is not None and moves[-1] == slightly_off
+    mid = arc_pose(here, moves[0], 0.5)  # on the arc, the robot faces along it
+    assert math.hypot(mid.x, mid.y - arc_radius(here, moves[0])) == pytest.approx(abs(arc_radius(here, moves[0])))
+    aside = BasePose(0.0, 1.0, 0.0)
+    assert len(drive_moves(here, aside, DIFF)) == 3  # turn, drive, turn
+    assert drive_moves(here, aside, BaseKinematics()) == [aside]

@@ -8,9 +8,10 @@ the path planner (`pycram.world.navigation.PathPlanner`), the simulated drives
 An **omnidirectional** base (PR2, TIAGo Pro) drives any straight line while turning: one move
 from pose ``a`` to pose ``b`` is that line.
 
-A **differential drive** (TIAGo) moves only along its heading (forwards or backwards) or turns on
-the spot. One move from ``a`` to ``b`` is a chain of such *primitives*; :func:`move_options` lists
-the chains that realise it, in the order a planner should prefer them:
+A **differential drive** (TIAGo) moves only along its heading (forwards or backwards): straight,
+on an arc (constant wheel speeds, `arc_radius`) or turning on the spot. A move from ``a`` to ``b``
+that lies on one arc is one move; otherwise it is a chain of straight drives and turns;
+:func:`move_options` lists the chains that realise it, in the order a planner should prefer them:
 
 1. turn to face ``b``, drive forwards, turn to ``b``'s heading;
 2. the same backwards (only up to ``max_reverse`` [m]: the robot has no eyes behind it); this
@@ -42,6 +43,9 @@ __all__ = [
     "BaseKinematics",
     "move_options",
     "is_primitive",
+    "arc_radius",
+    "arc_pose",
+    "drive_moves",
     "POSITION_EPS",
     "HEADING_EPS",
 ]
@@ -54,6 +58,11 @@ KINDS = (OMNIDIRECTIONAL, DIFFERENTIAL)
 POSITION_EPS = 1e-3
 #: Headings closer than this [rad] need no turn.
 HEADING_EPS = 1e-3
+#: `drive_moves` reaches a goal by an arc when its position lies within this [rad] of straight
+#: ahead or behind (the arc then turns the robot by twice as much).
+MAX_TANGENT = math.pi / 6
+#: A move is an arc when its chord points within this [rad] of the mean of its end headings.
+ARC_TOLERANCE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -147,9 +156,12 @@ def move_options(a: BasePose, b: BasePose, kinematics: BaseKinematics) -> list[l
     ``[b]``. Deterministic: the same question gives the same chains."""
     if kinematics.holonomic:
         return [[b]]
+    rho = arc_radius(a, b)
+    if rho is not None and (rho > 0 or abs(rho * _wrap(b.yaw - a.yaw)) <= kinematics.max_reverse + 1e-6):
+        return [[b]]  # on an arc: one move with constant wheel speeds
     dist = math.hypot(b.x - a.x, b.y - a.y)
     options = [_chain(a, b, False, 0.0, 0.0)]
-    if POSITION_EPS <= dist <= kinematics.max_reverse:
+    if POSITION_EPS <= dist <= kinematics.max_reverse + 1e-6:
         backwards = _chain(a, b, True, 0.0, 0.0)
         # a short way back (e.g. stepping back from a counter): backwards first if it turns less
         options.insert(0 if _turning(a, backwards) < _turning(a, options[0]) else 1, backwards)
@@ -166,12 +178,62 @@ def move_options(a: BasePose, b: BasePose, kinematics: BaseKinematics) -> list[l
     return unique
 
 
+def arc_radius(a: BasePose, b: BasePose) -> float | None:
+    """The signed ratio [m/rad] of distance to turn of the arc from ``a`` to ``b`` -- the arc a
+    differential drive follows with constant wheel speeds (positive: forwards, negative:
+    backwards) -- or None when ``b`` is not on such an arc from ``a`` (a sideways step), and
+    for a straight drive or a turn on the spot (they have no finite turn radius)."""
+    dist = math.hypot(b.x - a.x, b.y - a.y)
+    turn = _wrap(b.yaw - a.yaw)
+    if dist < POSITION_EPS or abs(turn) < HEADING_EPS or abs(turn) > math.pi / 2:
+        return None
+    chord = math.atan2(b.y - a.y, b.x - a.x)
+    mean = a.yaw + turn / 2.0  # an arc's chord points along the mean of its end headings
+    forwards = abs(_wrap(chord - mean)) <= ARC_TOLERANCE
+    if not forwards and abs(_wrap(chord - mean - math.pi)) > ARC_TOLERANCE:
+        return None
+    length = dist * (abs(turn) / 2.0) / math.sin(abs(turn) / 2.0)
+    return (length if forwards else -length) / turn
+
+
+def arc_pose(a: BasePose, b: BasePose, s: float) -> BasePose:
+    """The pose at fraction `s` (0..1) of the move from ``a`` to ``b``: on the arc between them
+    when there is one (`arc_radius`), else on the straight line, turning uniformly."""
+    rho = arc_radius(a, b)
+    yaw = a.yaw + s * _wrap(b.yaw - a.yaw)
+    if rho is None:
+        return BasePose(a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), yaw)
+    return BasePose(a.x + rho * (math.sin(yaw) - math.sin(a.yaw)), a.y - rho * (math.cos(yaw) - math.cos(a.yaw)), yaw)
+
+
+def drive_moves(here: BasePose, goal: BasePose, kinematics: BaseKinematics, tolerance: float = 0.02) -> list[BasePose]:
+    """The moves a differential drive makes from where it is (``here``) to ``goal``, ``goal``
+    last: the move itself when it is one a differential drive makes (`is_primitive`, within
+    `tolerance` [rad]); else, when ``goal`` lies within `MAX_TANGENT` of straight ahead (or
+    behind, up to ``max_reverse``), the arc that leaves ``here`` along its heading through
+    ``goal``'s position, then a turn to ``goal``'s heading (how a drive that ended a little off
+    its line makes its next straight move); else turn, drive, turn (`move_options`). An
+    omnidirectional base makes the move itself."""
+    if kinematics.holonomic or is_primitive(here, goal, tolerance):
+        return [goal]
+    dist = math.hypot(goal.x - here.x, goal.y - here.y)
+    chord = math.atan2(goal.y - here.y, goal.x - here.x)
+    for backwards in (False, True):
+        off = _wrap(chord - here.yaw - (math.pi if backwards else 0.0))
+        if abs(off) <= MAX_TANGENT and (not backwards or dist <= kinematics.max_reverse + 1e-6):
+            end = BasePose(goal.x, goal.y, here.yaw + 2.0 * off)  # the chord is the mean heading
+            return [end, goal] if abs(_wrap(goal.yaw - end.yaw)) > HEADING_EPS else [goal]
+    return move_options(here, goal, kinematics)[0]
+
+
 def is_primitive(a: BasePose, b: BasePose, tolerance: float = 0.02) -> bool:
-    """Whether the move from ``a`` to ``b`` is a turn on the spot or a straight drive along
-    ``a``'s heading (forwards or backwards) to within `tolerance` [rad] of heading: a move a
-    differential drive makes without a sideways step."""
+    """Whether the move from ``a`` to ``b`` is one a differential drive makes without a
+    sideways step: a turn on the spot, a straight drive along ``a``'s heading (forwards or
+    backwards) to within `tolerance` [rad] of heading, or an arc (`arc_radius`)."""
     dist = math.hypot(b.x - a.x, b.y - a.y)
     if dist < POSITION_EPS:
+        return True
+    if arc_radius(a, b) is not None:
         return True
     heading = math.atan2(b.y - a.y, b.x - a.x)
     along = min(abs(_wrap(heading - a.yaw)), abs(_wrap(heading - a.yaw - math.pi)))

@@ -56,7 +56,7 @@ import numpy as np
 
 from pycram.execution.failures import GoalUnreachable, NavigationFailure
 
-from .base_kinematics import POSITION_EPS, BaseKinematics, move_options
+from .base_kinematics import POSITION_EPS, BaseKinematics, arc_radius, move_options
 from .prospection import BasePose, as_base_pose
 
 __all__ = [
@@ -85,6 +85,17 @@ EXACT_BLOCK_CELLS = 3
 #: A differential drive turns on the spot, sweeping its arms round: its turns are checked
 #: exactly where the outermost point of its outlines has moved this far [m] (a cup is 8 cm wide).
 EXACT_TURN_STEP = 0.04
+#: A differential drive's search over headings (`PathPlanner._lattice`, when the cell search
+#: finds no path for it): headings per turn, the length [m] of a straight step, the extra cost of
+#: a step backwards, how near the goal [m] a straight connection is tried, and how many poses it
+#: expands before it gives up.
+LATTICE_HEADINGS = 16
+LATTICE_STEP = 0.1
+LATTICE_REVERSE_COST = 3.0
+LATTICE_SHOT = 1.0
+#: Length [m] of the lattice's arcs (each turns by one heading).
+LATTICE_ARC = 0.2
+LATTICE_EXPANSIONS = 60000
 #: Weight of A*'s distance heuristic: above 1 it expands far fewer cells, for a path at most
 #: this factor longer than the cheapest on the grid (before shortening: `_shorten` straightens
 #: it wherever the straight line is free).
@@ -250,6 +261,35 @@ def _squared_distances(mask: np.ndarray, reach: int) -> np.ndarray:
 
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _merged(start: BasePose, moves: list[BasePose], max_reverse: float) -> list[BasePose]:
+    """`moves` (each a turn on the spot or a straight drive from the one before, the first from
+    `start`) without moves that go nowhere, with consecutive turns the same way round (less
+    than half a turn together), and consecutive drives the same way along one heading, merged
+    into one (backwards only up to `max_reverse` [m] together)."""
+    out: list[BasePose] = []
+    for move in moves:
+        last = out[-1] if out else start
+        if _same_place(last, move) and abs(_wrap(move.yaw - last.yaw)) < 1e-9:
+            continue
+        if out:
+            before, last = (out[-2] if len(out) > 1 else start), out[-1]
+            if _same_place(before, last) and _same_place(last, move):
+                t1, t2 = _wrap(last.yaw - before.yaw), _wrap(move.yaw - last.yaw)
+                if t1 * t2 > 0 and abs(t1) + abs(t2) < math.pi - 1e-6:
+                    out[-1] = move
+                    continue
+            elif not _same_place(before, last) and not _same_place(last, move):
+                yaw = last.yaw
+                same_heading = abs(_wrap(yaw - before.yaw)) < 1e-9 and abs(_wrap(move.yaw - yaw)) < 1e-9
+                d1 = (last.x - before.x) * math.cos(yaw) + (last.y - before.y) * math.sin(yaw)
+                d2 = (move.x - last.x) * math.cos(yaw) + (move.y - last.y) * math.sin(yaw)
+                if same_heading and d1 * d2 > 0 and (d1 > 0 or -(d1 + d2) <= max_reverse + 1e-9):
+                    out[-1] = move
+                    continue
+        out.append(move)
+    return out
 
 
 def _same_place(a: BasePose, b: BasePose) -> bool:
@@ -447,13 +487,23 @@ class PathPlanner:
         # sample so that neither the centre nor a corner moves more than half a cell per step
         n = max(1, int(math.ceil(max(dist, abs(dyaw) * self._turn_radius) / (0.5 * self.grid.resolution))))
         s = np.linspace(0.0, 1.0, n + 1)
-        xs, ys, yaws = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), a.yaw + s * dyaw
+        xs, ys, yaws = self._along_move(a, b, s)
         if escape is not None:
             keep = np.hypot(xs - escape.x, ys - escape.y) >= ESCAPE_RADIUS
             if not self.kinematics.holonomic:  # a differential drive escapes straight: its turns are checked
                 keep |= np.abs((yaws - escape.yaw + np.pi) % (2.0 * np.pi) - np.pi) > ESCAPE_TURN
             xs, ys, yaws = xs[keep], ys[keep], yaws[keep]
         return self._free(xs, ys, yaws, exact_check)
+
+    def _along_move(self, a: BasePose, b: BasePose, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The poses (xs, ys, yaws) at fractions `s` of the move from ``a`` to ``b``: the straight
+        line turning uniformly, or for a differential drive the arc between them (`arc_radius`)."""
+        dyaw = _wrap(b.yaw - a.yaw)
+        yaws = a.yaw + s * dyaw
+        rho = None if self.kinematics.holonomic else arc_radius(a, b)
+        if rho is None:
+            return a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), yaws
+        return a.x + rho * (np.sin(yaws) - math.sin(a.yaw)), a.y - rho * (np.cos(yaws) - math.cos(a.yaw)), yaws
 
     def _primitives(
         self, start: BasePose, waypoints: list[BasePose], escape: BasePose | None, exact_check: PoseCheck | None
@@ -504,6 +554,22 @@ class PathPlanner:
                 raise NoPathError(
                     "outside_map", f"the {name} (x={pose.x:.2f}, y={pose.y:.2f}) is off the map of the floor", a, b
                 )
+        try:
+            return self._grid_search(a, b, sc, gc, ctx)
+        except NoPathError as exc:
+            if self.kinematics.holonomic or exc.reason != "no_path":
+                raise
+            path = self._lattice(a, b, ctx)  # a differential drive: search headings too
+            if path is None:
+                raise
+            return path
+
+    def _grid_search(
+        self, a: BasePose, b: BasePose, sc: tuple[int, int], gc: tuple[int, int], ctx: _Query
+    ) -> list[BasePose]:
+        """A* over the cells, headings along the cell path, shortening (steps 2-3 of the module
+        docstring). Raises `NoPathError`."""
+        g, escape, exact_check = self.grid, ctx.escape, ctx.exact
         bad: set[tuple[int, int]] = set()
         for _attempt in range(MAX_SEARCHES):
             cells = self._astar(sc, gc, bad, escape is None)
@@ -516,7 +582,10 @@ class PathPlanner:
                 )
             path, misfits = self._shorten(a, b, cells, ctx)
             if not misfits:
-                path = self._primitives(a, path, escape, exact_check) or path
+                moves = self._primitives(a, path, escape, exact_check)
+                if moves is None:  # a differential drive cannot make a step of it
+                    raise NoPathError("no_path", "no path with the turns a differential drive can make", a, b)
+                path = moves
                 hit = self._exact_hit(a, path, escape, exact_check)
                 if hit is None:
                     return path
@@ -530,6 +599,71 @@ class PathPlanner:
                 }
             bad |= misfits  # the footprint fits there at no heading (or cannot turn there)
         raise NoPathError("no_path", "no path where the robot fits at the headings it needs", a, b)
+
+    def _lattice(self, a: BasePose, b: BasePose, ctx: _Query) -> list[BasePose] | None:
+        """A differential drive's path from ``a`` to ``b`` by A* over poses (x, y and one of
+        `LATTICE_HEADINGS` headings): steps of `LATTICE_STEP` forwards or backwards (backwards
+        costing `LATTICE_REVERSE_COST` times more) and turns on the spot of one heading; from
+        every pose within `LATTICE_SHOT` of the goal, the moves of `move_options` straight to
+        it are tried. Each step is checked as `segment_free` checks. Finds the way out of a
+        corner that needs backing up before turning, which the cell search cannot (it knows no
+        headings). None when `LATTICE_EXPANSIONS` poses are expanded without reaching the goal."""
+        n, res = LATTICE_HEADINGS, LATTICE_STEP
+        unit = 2.0 * math.pi / n
+        turn_cost = self._turn_radius * unit
+        escape, exact = ctx.escape, ctx.exact
+
+        def key(p: BasePose, h: int) -> tuple[int, int, int]:
+            return (round(p.x / res), round(p.y / res), h % n)
+
+        h0 = round(a.yaw / unit)
+        first = a  # straight steps keep a pose's own heading; turns go to the lattice's
+        k0 = key(first, h0)
+        best: dict[tuple[int, int, int], float] = {k0: 0.0}
+        parent: dict[tuple[int, int, int], tuple[int, int, int]] = {}  # the start has none
+        poses: dict[tuple[int, int, int], tuple[BasePose, int]] = {k0: (first, h0)}
+        heap = [(math.hypot(b.x - a.x, b.y - a.y), 0.0, k0)]
+        expanded = 0
+        while heap and expanded < LATTICE_EXPANSIONS:
+            _f, cost, k = heapq.heappop(heap)
+            if cost > best[k]:
+                continue
+            expanded += 1
+            pose, h = poses[k]
+            if math.hypot(b.x - pose.x, b.y - pose.y) <= LATTICE_SHOT:
+                shot = self._free_chain(pose, b, escape, exact)
+                if shot is not None:
+                    back: list[BasePose] = []
+                    node = k
+                    while node in parent:
+                        back.append(poses[node][0])
+                        node = parent[node]
+                    return _merged(a, back[::-1] + shot, self.kinematics.max_reverse)
+            yaw = pose.yaw
+            dx, dy = LATTICE_STEP * math.cos(yaw), LATTICE_STEP * math.sin(yaw)
+            steps = [
+                (BasePose(pose.x + dx, pose.y + dy, yaw), h, LATTICE_STEP),
+                (BasePose(pose.x - dx, pose.y - dy, yaw), h, LATTICE_STEP * LATTICE_REVERSE_COST),
+                (BasePose(pose.x, pose.y, (h + 1) * unit), h + 1, turn_cost),
+                (BasePose(pose.x, pose.y, (h - 1) * unit), h - 1, turn_cost),
+            ]
+            for turn in (1, -1):  # arcs: one heading over `LATTICE_ARC` of way, forwards and back
+                for way, weight in ((LATTICE_ARC, 1.0), (-LATTICE_ARC, LATTICE_REVERSE_COST)):
+                    end = (h + turn) * unit
+                    rho = way / (end - yaw)
+                    ax = pose.x + rho * (math.sin(end) - math.sin(yaw))
+                    arc = BasePose(ax, pose.y - rho * (math.cos(end) - math.cos(yaw)), end)
+                    steps.append((arc, h + turn, LATTICE_ARC * weight))
+            for nxt, nh, step_cost in steps:
+                nk = key(nxt, nh)
+                ncost = cost + step_cost
+                if ncost >= best.get(nk, math.inf):
+                    continue
+                if not self._straight_free(pose, nxt, escape, exact):
+                    continue
+                best[nk], parent[nk], poses[nk] = ncost, k, (nxt, nh)
+                heapq.heappush(heap, (ncost + math.hypot(b.x - nxt.x, b.y - nxt.y), ncost, nk))
+        return None
 
     def path_free(self, start: BasePose, waypoints: list[BasePose], exact_check: PoseCheck | None = None) -> bool:
         """Is driving from ``start`` through ``waypoints`` free (footprint, and ``exact_check``)?
@@ -558,10 +692,8 @@ class PathPlanner:
             dyaw = _wrap(w.yaw - prev.yaw)
             step = EXACT_STEP if self.kinematics.holonomic else EXACT_TURN_STEP
             n = max(1, int(math.ceil(max(dist / EXACT_STEP, abs(dyaw) * self._turn_radius / step))))
-            for i in range(1, n + 1):
-                s = i / n
-                x, y = prev.x + s * (w.x - prev.x), prev.y + s * (w.y - prev.y)
-                yaw = prev.yaw + s * dyaw
+            xs, ys, yaws = self._along_move(prev, w, np.arange(1, n + 1) / n)
+            for x, y, yaw in zip(xs.tolist(), ys.tolist(), yaws.tolist()):
                 if self._escaping(escape, x, y, yaw):
                     continue
                 if self._surely_free(x, y):  # no layer's obstacle within any outline's reach

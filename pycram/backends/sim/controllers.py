@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from pycram.world.base_kinematics import BaseKinematics, is_primitive, move_options
+from pycram.world.base_kinematics import BaseKinematics, arc_radius, drive_moves
 from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D, wrap_angle
 
@@ -95,10 +95,10 @@ class BaseDrive(Controller):
     """Drive the base on a straight line to a map pose while turning, with trapezoidal profiles.
 
     A differential drive (the description's ``BASE["kind"]``, `pycram.world.base_kinematics`)
-    never steps sideways: a goal that is not straight ahead, straight behind or a turn on the
-    spot is reached by turning to face it, driving straight and turning to its heading (the
-    references obey the drive's constraint; the joint servos correct millimetres of tracking
-    error).
+    never steps sideways: it reaches a goal by the moves of `drive_moves` -- straight, on an arc
+    (position and heading from one profile, so the base faces along the arc) or turning on the
+    spot (the references obey the drive's constraint; the joint servos correct millimetres of
+    tracking error).
 
     Fails with "collision" when a base link touches the environment, with "blocked" when the base
     lags its reference by more than `max_lag` [m] (or 0.15 rad), and with "timeout" when it does
@@ -115,6 +115,7 @@ class BaseDrive(Controller):
     ) -> None:
         self.goal, self.tol, self.yaw_tol, self.max_lag = goal, tolerance, yaw_tolerance, max_lag
         self._stops: list[Pose2D] = []
+        self.kinematics = BaseKinematics()
 
     def start(self, eng: Engine) -> Outcome | None:
         refused = invalid_input(
@@ -126,10 +127,10 @@ class BaseDrive(Controller):
         if refused is not None:
             return refused
         p = eng.base_pose()
-        kinematics = BaseKinematics.of(eng.desc.BASE)
+        self.kinematics = BaseKinematics.of(eng.desc.BASE)
         here, goal = BasePose(p.x, p.y, p.yaw), BasePose(self.goal.x, self.goal.y, self.goal.yaw)
-        if not kinematics.holonomic and not is_primitive(here, goal, self.yaw_tol):
-            moves = move_options(here, goal, kinematics)[0]  # turn, drive forwards, turn
+        if not self.kinematics.holonomic:
+            moves = drive_moves(here, goal, self.kinematics, self.yaw_tol)
             self._stops = [Pose2D(m.x, m.y, m.yaw) for m in moves[:-1]]
         self._begin(eng, self._stops[0] if self._stops else self.goal)
         return None
@@ -148,8 +149,23 @@ class BaseDrive(Controller):
         self.duration = max(self.lin.duration, self.ang.duration)
         self.t0 = eng.time
         self.x0, self.y0 = eng.q("base_x"), eng.q("base_y")
+        # a differential drive's arc: one profile moves along it and turns (no sideways step)
+        self.arc = None
+        if not self.kinematics.holonomic:
+            here = BasePose(self.x0, self.y0, self.yaw0)
+            self.arc = arc_radius(here, BasePose(target.x, target.y, self.yaw0 + self.dyaw))
+            if self.arc is not None:
+                length = abs(self.arc * self.dyaw)
+                self.lin = Trapezoid(length, b["max_linear_velocity"], b["linear_acceleration"])
+                self.duration = max(self.lin.duration, self.ang.duration)
+                self.profile = self.lin if self.lin.duration >= self.ang.duration else self.ang
 
     def _reference(self, t: float) -> tuple[float, float, float]:
+        if self.arc is not None:
+            s = self.profile.fraction(t - self.t0, self.duration)
+            yaw = self.yaw0 + s * self.dyaw
+            x = self.x0 + self.arc * (math.sin(yaw) - math.sin(self.yaw0))
+            return (x, self.y0 - self.arc * (math.cos(yaw) - math.cos(self.yaw0)), yaw)
         s_lin = self.lin.fraction(t - self.t0, self.duration)
         s_ang = self.ang.fraction(t - self.t0, self.duration)
         return (self.x0 + s_lin * self.dx, self.y0 + s_lin * self.dy, self.yaw0 + s_ang * self.dyaw)
