@@ -606,8 +606,9 @@ class PathPlanner:
 
     def _lattice(self, a: BasePose, b: BasePose, ctx: _Query) -> list[BasePose] | None:
         """A differential drive's path from ``a`` to ``b`` by A* over poses (x, y and one of
-        `LATTICE_HEADINGS` headings): steps of `LATTICE_STEP` forwards or backwards (backwards
-        costing `LATTICE_REVERSE_COST` times more) and turns on the spot of one heading; from
+        `LATTICE_HEADINGS` headings): steps of `LATTICE_STEP` and arcs of `LATTICE_ARC` (turning
+        by one heading), forwards or backwards (backwards costing `LATTICE_REVERSE_COST` times
+        more), and turns on the spot by one heading; from
         every pose within `LATTICE_SHOT` of the goal, the moves of `move_options` straight to
         it are tried. Each step is checked as `segment_free` checks. Finds the way out of a
         corner that needs backing up before turning, which the cell search cannot (it knows no
