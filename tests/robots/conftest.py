@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 
-@pytest.fixture(scope="module", params=["pr2", "tiago"])
+@pytest.fixture(scope="module", params=["pr2", "tiago", "tiago-pro"])
 def robot(request):
     """A world and its robot (loaded with ``pycram.robots.load``), active for the module."""
     pytest.importorskip("mujoco")

@@ -70,10 +70,10 @@ def test_load_builds_the_robot_with_its_modules(robot):
     assert isinstance(robot, SimRobot)
     assert robot.world.robot == robot.name
     expected = {"navigation", "base_stop", "head", "torso", "sensors", "perception", "arm_right", "gripper_right"}
-    if robot.name == "pr2":
+    if "left" in robot.description.ARMS:  # the PR2 and the TIAGo Pro have two arms
         expected |= {"arm_left", "gripper_left"}
     assert set(robot.process_modules) == expected
-    with pytest.raises(ValueError, match="available: pr2, tiago"):
+    with pytest.raises(ValueError, match="available: .*pr2, tiago"):
         robots.load("r2d2", robot.world)
     other = "tiago" if robot.name == "pr2" else "pr2"
     with pytest.raises(ValueError, match="needs a world"):
@@ -92,12 +92,13 @@ def test_reasoning_reaches_the_prospection_of_the_robots_belief_through_the_acti
 
 
 def test_arm_requests_go_to_the_right_module(robot):
-    """Thesis ch. 4.2.2: PR2 dispatches on the arm; TIAGo serves any arm with its only one."""
+    """Thesis ch. 4.2.2: PR2 (and TIAGo Pro) dispatch on the arm; TIAGo serves any arm with its
+    only one."""
 
     def module_for(**properties):
         return ProcessModule.resolve(MotionDesignator(**properties))
 
-    two_armed = robot.name == "pr2"
+    two_armed = "left" in robot.description.ARMS  # the PR2 and the TIAGo Pro
     for name, physical in (("left", "left"), ("0", "left"), ("right", "right"), ("1", "right")):
         arm = physical if two_armed else "right"
         assert module_for(type="reaching", arm=name, target=[0, 0, 1]).name == f"arm_{arm}"

@@ -89,11 +89,21 @@ def test_the_named_configurations_put_the_tools_where_the_description_says(scene
         assert np.allclose(position, (0.75, sign * 0.2, 0.95), atol=0.005), (arm, position)
         assert rotation[:, 0] @ (1.0, 0.0, 0.0) > 0.99  # the approach axis points ahead
         assert abs(rotation[2, 1]) < 0.05  # the fingers open horizontally
+        assert rotation[2, 2] > 0.99  # z up: the orientation `reaching` asks of a side grasp
         assert d.REACH_POINT_IN_BASE[arm] == pytest.approx((0.75, sign * 0.2))
-    # carry_top: the tool pointing down, 0.65 m ahead, 1.07 m high
+    # carry: 0.55 m ahead, in line with the shoulder, 1.2 m high, level with z up (an object
+    # grasped from the side stays upright on its way from the grasp to carry), turned inwards
+    for arm, (position, rotation) in _tool_pose(scene, up, "carry").items():
+        sign = -1.0 if arm == "right" else 1.0
+        assert np.allclose(position, (0.55, sign * 0.2, 1.2), atol=0.005), (arm, position)
+        assert rotation[2, 2] > 0.99
+        assert rotation[1, 0] * -sign > 0.8  # the approach axis turned 60 deg towards the middle
+    # carry_top: the tool pointing down, the fingers opening across the heading, 0.55 m ahead,
+    # 1.15 m high
     for position, rotation in _tool_pose(scene, up, "carry_top").values():
         assert rotation[:, 0] @ (0.0, 0.0, -1.0) > 0.99
-        assert position[0] == pytest.approx(0.65, abs=0.005) and position[2] == pytest.approx(1.07, abs=0.005)
+        assert abs(rotation[1, 1]) > 0.99
+        assert position[0] == pytest.approx(0.55, abs=0.005) and position[2] == pytest.approx(1.15, abs=0.005)
     # park: both arms tucked within the base's circumscribed radius
     for position, _ in _tool_pose(scene, d.TORSO["default"], "park").values():
         assert np.hypot(position[0], position[1]) < d.BASE["radius"]

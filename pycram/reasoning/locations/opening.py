@@ -23,7 +23,7 @@ from pycram.world.environment import Container, Vec3
 from . import doors
 from .costmap import Costmap, FloorGrid, occupancy_layer, ring_layer
 from .grasps import _quat_yaw, _quat_yaw_rolled
-from .search import _ranked
+from .search import NO_WAY_IN, _ranked
 from .solutions import BaseLocation
 from .standing import REACH_SIGMA, StandingSearch, _wrap
 from .targets import Target
@@ -123,8 +123,8 @@ class OpenVocabulary(StandingSearch):
             arrival = self.arrival_configuration(prosp)
             if prosp.in_collision((x, y, yaw), {**arrival, **pulled_out}, self.carried(), objects=True):
                 return None, ("in collision", None)
-            if self.no_way_in(prosp, (x, y, yaw), arrival):  # the drawer is closed as it comes
-                return None, ("no way in for a differential drive", None)
+            if self.cannot_drive_in(prosp, (x, y, yaw), arrival):  # the drawer is closed as it comes
+                return None, (NO_WAY_IN, None)
             back = self.geometry.approach_offsets.get("pre_grasp", (0.1, 0.0))[0]
             hx, hy, hz = trajectory[0]
             c0, s0 = math.cos(headings[0]), math.sin(headings[0])
@@ -233,8 +233,8 @@ class OpenVocabulary(StandingSearch):
                 yaw = _wrap(natural + offset)
                 if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
                     continue
-                if self.no_way_in(prosp, (x, y, yaw), arrival):
-                    failure = ("no way in for a differential drive", None)
+                if self.cannot_drive_in(prosp, (x, y, yaw), arrival):
+                    failure = (NO_WAY_IN, None)
                     continue
                 solved, reason = self._reachable_along(prosp, arm, (x, y, yaw), poses, joint)
                 if reason is None:

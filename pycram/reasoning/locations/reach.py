@@ -42,7 +42,7 @@ from pycram.world.objects import SIDE, Grasp, approach_matches
 
 from .costmap import Costmap, FloorGrid, angle_difference, ring_layer
 from .grasps import PHASES, grasp_sequence
-from .search import _ranked, _Tally
+from .search import NO_WAY_IN, _ranked, _Tally
 from .solutions import BaseLocation
 from .standing import FACING_SCALE, REACH_INSIDE, REACH_OUTSIDE, REACH_SIGMA, StandingSearch, _wrap
 from .targets import Target
@@ -204,8 +204,8 @@ class ReachVocabulary(StandingSearch):
                     if not lifted:
                         return None, ("in collision", None)
                 coming = {**tucked, **dict(zip(self.geometry.arm_joints[arm], lifted))} if lifted else tucked
-                if self.no_way_in(prosp, (x, y, natural), coming):
-                    return None, ("no way in for a differential drive", None)
+                if self.cannot_drive_in(prosp, (x, y, natural), coming):
+                    return None, (NO_WAY_IN, None)
                 if prosp.in_collision((x, y, natural), raised):
                     failure = (f"arm {arm!r} hits the furniture when raised to approach", None)
                     if torsos == "current":
@@ -223,7 +223,7 @@ class ReachVocabulary(StandingSearch):
                 if (
                     prosp.in_collision((x, y, natural), {**tucked, joint: height}, self.carried(), objects=True)
                     or prosp.in_collision((x, y, natural), {**raised, joint: height})
-                    or self.no_way_in(prosp, (x, y, natural), {**tucked, joint: height})
+                    or self.cannot_drive_in(prosp, (x, y, natural), {**tucked, joint: height})
                 ):
                     continue
                 other, why = sequences({**raised, joint: height})

@@ -26,11 +26,31 @@ from .robot_geometry import RobotGeometry
 from .solutions import BaseLocation
 from .targets import KnownObject, Target, as_target
 
-__all__ = ["CandidateSearch", "MAX_CANDIDATES", "SPACING", "FAILED_SPACING", "BASE_CLEARANCE", "LIFT_STEP"]
+__all__ = [
+    "CandidateSearch",
+    "MAX_CANDIDATES",
+    "SPACING",
+    "FAILED_SPACING",
+    "BASE_CLEARANCE",
+    "DRIVE_ROOM",
+    "NO_WAY_IN",
+    "LIFT_STEP",
+]
 
 #: Free space [m] kept between the base's inscribed circle and the furniture: the base must be
 #: able to drive there (navigation keeps its own clearance of a few cm, on a 5 cm grid).
 BASE_CLEARANCE = 0.1
+#: Room [m] a base pose must leave around the robot for navigation to drive there: the robot
+#: moved this far ahead, back or to either side still touches no furniture (`has_no_room`).
+#: Navigation keeps its footprint 3 cm plus half a 5 cm cell's diagonal (6.5 cm) off occupied
+#: cells; prospection tolerates 1.5 cm of penetration, so 8 cm here. The occupancy layer keeps
+#: the base's inscribed circle `BASE_CLEARANCE` off the furniture, room enough around a round or
+#: square base but not ahead of and behind a long one (measured: the TIAGo Pro's 0.72 x 0.50 m
+#: base, offered poses 0.38-0.40 m in front of the furniture behind it -- navigation refused
+#: them, goal_in_collision, in 4 of set-table dev seeds 1-10).
+DRIVE_ROOM = 0.08
+#: Why a candidate failed `CandidateSearch.cannot_drive_in`.
+NO_WAY_IN = "no way in (no room to drive there, or no straight way for a differential drive)"
 #: Candidates checked with prospection per designator before giving up.
 MAX_CANDIDATES = 100
 #: Distance [m] between two solutions of one designator (base poses or spots).
@@ -146,8 +166,8 @@ class CandidateSearch:
         `configuration` with what it carries: it can neither have come straight along its heading
         (the robot touches something `approach`/2 or `approach` behind the pose) nor turn there on
         the spot (it touches something at one of the other seven eighths of a turn). The pose
-        itself is checked by the caller. Always False for an omnidirectional base, which may come
-        in any direction."""
+        itself is checked by the caller (and `has_no_room`). Always False for an omnidirectional
+        base, which may come in any direction."""
         kinematics = self.geometry.base_kinematics
         if kinematics.holonomic:
             return False
@@ -159,6 +179,25 @@ class CandidateSearch:
             return False
         turns = [(x, y, yaw + k * math.pi / 4) for k in range(1, 8)]
         return any(prosp.in_collision(p, configuration, carried, objects=True) for p in turns)
+
+    def cannot_drive_in(self, prosp: Any, base: tuple[float, float, float], configuration: Mapping[str, float]) -> bool:
+        """Whether navigation would not drive the robot into `base` (x [m], y [m], yaw [rad]) in
+        `configuration`: `has_no_room` or `no_way_in`. The pose itself is checked by the caller."""
+        return self.has_no_room(prosp, base, configuration) or self.no_way_in(prosp, base, configuration)
+
+    def has_no_room(self, prosp: Any, base: tuple[float, float, float], configuration: Mapping[str, float]) -> bool:
+        """Whether the robot in `configuration`, with what it carries, touches the furniture when
+        moved `DRIVE_ROOM` from `base` (x [m], y [m], yaw [rad]) ahead, back, left or right:
+        navigation keeps that much room and does not drive into such a pose. The pose itself is
+        checked by the caller."""
+        x, y, yaw = base
+        c, s = math.cos(yaw), math.sin(yaw)
+        carried = self.carried()
+        for ahead, left in ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
+            dx, dy = DRIVE_ROOM * (c * ahead - s * left), DRIVE_ROOM * (s * ahead + c * left)
+            if prosp.in_collision((x + dx, y + dy, yaw), configuration, carried):
+                return True
+        return False
 
     def carried(self) -> list[str]:
         """The names of the objects the robot holds now (believed), to check base poses with:

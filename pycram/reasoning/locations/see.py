@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from .costmap import Costmap, FloorGrid, occupancy_layer, ring_layer
-from .search import CandidateSearch, _ranked
+from .search import NO_WAY_IN, CandidateSearch, _ranked
 from .solutions import BaseLocation
 
 __all__ = ["SeeVocabulary", "VIEW_RING"]
@@ -48,8 +48,8 @@ class SeeVocabulary(CandidateSearch):
             arrival = self.arrival_configuration(prosp)
             if prosp.in_collision((x, y, yaw), arrival, self.carried(), objects=True):
                 return None, ("in collision", None)
-            if self.no_way_in(prosp, (x, y, yaw), arrival):
-                return None, ("no way in for a differential drive", None)
+            if self.cannot_drive_in(prosp, (x, y, yaw), arrival):
+                return None, (NO_WAY_IN, None)
             seen = prosp.visible(what, (x, y, yaw), 0.5, arrival)
             if seen:
                 return BaseLocation(x, y, yaw, cost=cost, visible=seen.fraction), None

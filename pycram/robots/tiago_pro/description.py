@@ -98,11 +98,18 @@ def _gripper(side: str) -> dict:
 GRIPPERS = {"right": _gripper("right"), "left": _gripper("left")}
 
 #: Named arm configurations of the right arm (joint order as in ARMS["right"]["joints"]), found
-#: by IK on the model (damped least squares on the tool site, many random seeds, the solution
-#: farthest from the joint limits or nearest to ``pre_grasp``); the left arm mirrors them
-#: (`_mirror`: joints 1, 3, 5 and 7 negated -- checked on the model: the tool poses mirror).
-#: The arm is long (shoulder to tool ~0.95 m) and its elbow bends only to -2.44 rad, so poses
-#: close in front of the torso are hard to reach: ``carry`` keeps the elbow 0.21 rad from its limit.
+#: by IK on the model (mink on the tool site, the torso "up", the base on free floor, 30-100
+#: random seeds per target; of the collision-free solutions the one whose arm stays highest ahead
+#: of the base's front edge, then farthest from the joint limits); the left arm mirrors them
+#: (`_mirror`: joints 1, 3, 5 and 7 negated -- checked on the model: the tool poses mirror, the
+#: tool's z axis keeps its sign). As on the PR2 and the TIAGo, a tool held level has its z axis
+#: up (the orientation `reaching` asks of a side grasp: the base's heading, fingers opening
+#: horizontally): an earlier carry and pre_grasp had it down, so every object picked up was
+#: turned upside down on the way to carry and back when put down (set-table: the milk carton
+#: came down tilted and was knocked over, 5 of dev seeds 1-10).
+#: The arm is long (shoulder to tool ~0.95 m) and its elbow bends only to -2.44 rad: the tool
+#: comes no closer than ~0.55 m ahead of the base centre at carrying height, and only turned
+#: inwards (pointing ahead, 0.6 m is the closest, with the elbow at its limit).
 ARM_CONFIGURATIONS = {
     "right": {
         #: tucked: elbow down beside the torso, forearm up, the gripper upright by the shoulder;
@@ -110,13 +117,14 @@ ARM_CONFIGURATIONS = {
         #: below 0.45 m with the torso down, none across the robot's middle (random search over
         #: 150,000 configurations at least 0.2 rad inside the joint limits)
         "park": (-0.209, -2.036, 2.416, -2.002, 0.483, -0.385, -1.163),
-        #: the tool 0.70 m ahead, in line with the shoulder (0.20 m right), 1.02 m high (torso
-        #: "up"), level, turned 15 deg inwards. Its elbow hangs to 0.79 m ahead of the base's
-        #: front (a counter is ~0.9 m high); a carry with the whole arm above 1.05 m there
-        #: (-3.24, -1.702, -0.076, -2.257, 2.063, -1.418, 0.522) made IK in the thesis kitchen
-        #: find only colliding grasp solutions from it (no base pose for the mug: the thesis demo
-        #: failed), for 2 of set-table seeds 1-5 set against 1 with this one (within the noise).
-        "carry": (-0.906, -0.707, 0.235, -2.238, 0.395, 0.808, 0.463),
+        #: the tool 0.55 m ahead (0.19 m beyond the base's front), in line with the shoulder
+        #: (0.20 m right), 1.20 m high (torso "up"), level (z up), pointing 60 deg inwards; every
+        #: arm link ahead of the base's front stays above 1.14 m (a counter is 0.9 m high, a milk
+        #: carton on it 1.1 m), 0.44 rad inside the joint limits. The carry before (the tool 0.70
+        #: m ahead, 1.02 m high) stood just short of the objects on the counter at a grasping
+        #: pose: with the arm raised to carry the robot touched the milk there, and navigation
+        #: refused the standing pose (goal_in_collision).
+        "carry": (-2.191, -1.675, 0.897, -2.003, 0.635, -0.616, -1.508),
         "zero": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     },
 }
@@ -126,12 +134,15 @@ def _mirror(q: tuple) -> tuple:
     return tuple(-v if i in (0, 2, 4, 6) else v for i, v in enumerate(q))
 
 
-#: Reaching at counter height: the tool 0.75 m ahead of the base, in line with the shoulder,
-#: 0.95 m high (torso "up"), pointing forward, fingers opening horizontally.
-ARM_CONFIGURATIONS["right"]["pre_grasp"] = (-0.798, -0.686, 0.003, -2.095, -0.103, 0.818, 0.753)
-#: Carrying an object held from the top (bowl, plate): the tool pointing down, 0.65 m ahead of
-#: the base, in line with the shoulder, 1.07 m high (torso "up"), so that the object stays level.
-ARM_CONFIGURATIONS["right"]["carry_top"] = (-2.471, -1.342, 1.189, -1.796, 2.238, 1.714, 1.304)
+#: Reaching at counter height (an IK seed for grasps, `reaching`'s orientation): the tool 0.75 m
+#: ahead of the base, in line with the shoulder, 0.95 m high (torso "up"), pointing forward, z
+#: up, fingers opening horizontally; 0.31 rad inside the joint limits (the most of 38 solutions).
+ARM_CONFIGURATIONS["right"]["pre_grasp"] = (-1.998, -0.969, 0.548, -2.133, -0.093, 0.938, -1.451)
+#: Carrying an object held from the top (bowl, plate): the tool pointing down, its fingers
+#: opening across the base's heading (the orientation of a top grasp with the base's heading),
+#: 0.55 m ahead of the base, in line with the shoulder, 1.15 m high (torso "up"), so that the
+#: object stays level; the arm ahead of the base's front above 1.11 m, 0.40 rad inside the limits.
+ARM_CONFIGURATIONS["right"]["carry_top"] = (-3.117, -1.976, 0.507, -1.591, -0.061, -1.481, 0.15)
 
 ARM_CONFIGURATIONS["left"] = {name: _mirror(q) for name, q in ARM_CONFIGURATIONS["right"].items()}
 
