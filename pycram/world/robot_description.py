@@ -18,7 +18,8 @@ Optional keys and their defaults (the defaults the readers used before this sche
 ``GRIPPER_MODEL`` (None: the URDF has its own gripper), ``GRASP_CONTACT_MARGIN`` (0.0),
 ``DOOR_PUSH``, ``DOOR_PULL_LIMIT``, ``DOOR_GRIP_OPENING`` (None: the robot does not push doors,
 pulls them all the way, opens its gripper fully), ``FINGERTIP_REACH`` and
-``TOP_GRASP_CLEARANCE`` (0.0), ``ROS`` (None: no ROS interface).
+``TOP_GRASP_CLEARANCE`` (0.0), ``ROS`` (None: no ROS interface), ``COMPOSITION`` (None: the
+URDF is the whole robot; see :mod:`pycram.world.robot_composition`).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from types import ModuleType
 from typing import Any
 
 from .base_kinematics import BaseKinematics
+from .robot_composition import CompositionError, validate_composition
 from .robot_model_file import ModelFileError, infer_from_model
 
 __all__ = ["RobotDescription", "RobotDescriptionError", "ARM_KEYS", "ARM_OPTIONAL_KEYS", "GRIPPER_KEYS"]
@@ -133,6 +135,10 @@ class RobotDescription:
     #: `pycram.backends.ros.config.RosRobotConfig` without ``robot``, arms and grippers as
     #: mappings of their fields (None: no ROS interface).
     ROS: dict[str, Any] | None = None
+    #: A robot composed from an arm's model file (``URDF``) and a base, torso lift column and
+    #: camera mast built from primitives (`pycram.world.robot_composition`; None: the URDF is
+    #: the whole robot).
+    COMPOSITION: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if not self.DEFAULT_ARM and isinstance(self.ARMS, Mapping) and self.ARMS:
@@ -202,6 +208,11 @@ class RobotDescription:
         self._validate_grippers()
         self._validate_arms()
         self._validate_base()
+        if self.COMPOSITION is not None:
+            try:
+                validate_composition(self.COMPOSITION, {k: getattr(self, k) for k in self.keys()})
+            except CompositionError as exc:
+                raise RobotDescriptionError(str(self.NAME), "COMPOSITION", str(exc)) from None
         if self.DEFAULT_ARM not in self.ARMS:
             raise self._fail("DEFAULT_ARM", f"{self.DEFAULT_ARM!r} is no arm; arms: {', '.join(self.ARMS)}")
         for key, valid in (("ARM_ALIASES", self.ARMS), ("GRIPPER_ALIASES", self.GRIPPERS)):

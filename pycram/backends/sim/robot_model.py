@@ -18,6 +18,7 @@ from pycram.world.robot_registry import robot_description, robot_names
 
 from . import collision
 from .assets import urdf_text
+from .composition import composed_urdf_text, paint_composed
 from .errors import UnknownNameError
 
 #: Names of the robots the simulator can load: the registered robots
@@ -134,8 +135,14 @@ def _add_parallel_gripper(spec: mujoco.MjSpec, desc: RobotDescription, g: dict[s
 
 
 def build_robot_spec(desc: RobotDescription) -> mujoco.MjSpec:
-    """The robot's own spec: URDF with collision groups, gravity compensation, camera and sites."""
-    spec = mujoco.MjSpec.from_string(urdf_text(desc.URDF))
+    """The robot's own spec: URDF (or, for a description with a ``COMPOSITION``, the arm's URDF
+    composed with a base, torso and head: `pycram.backends.sim.composition`) with collision
+    groups, gravity compensation, camera and sites."""
+    if desc.COMPOSITION is None:
+        spec = mujoco.MjSpec.from_string(urdf_text(desc.URDF))
+    else:
+        spec = mujoco.MjSpec.from_string(composed_urdf_text(desc))
+        paint_composed(spec)
     if desc.GRIPPER_MODEL is not None:
         _add_parallel_gripper(spec, desc, desc.GRIPPER_MODEL)
     for geom in spec.geoms:
