@@ -37,10 +37,10 @@ from .core import (
     RECOVERABLE,
     ActionParameterError,
     action_plan,
-    arm_name,
     arms,
     attempt,
     check_object_type,
+    gripper_name,
     make_action,
     motion,
     unwrap,
@@ -243,7 +243,7 @@ def setting_gripper(designator: ActionDesignator) -> Any:
     gripper, position = designator.prop_value("gripper"), designator.prop_value("position")
     if gripper is None or position is None:
         raise ActionParameterError("setting_gripper", "gripper" if gripper is None else "position", "missing")
-    arm_name("setting_gripper", gripper)  # a clear error for a gripper the robot does not have
+    gripper = gripper_name("setting_gripper", gripper)  # a clear error for a gripper it does not have
     return motion(type="setting_gripper", gripper=gripper, position=position)
 
 

@@ -59,6 +59,7 @@ __all__ = [
     "while_driving",
     "arms",
     "arm_name",
+    "gripper_name",
     "gripper_of",
     "gripper_opening",
     "opening_fluent",
@@ -212,6 +213,19 @@ def arm_name(action: str, requested: Any) -> str | None:
     if requested not in aliases:
         raise ActionParameterError(
             action, "arm", f"the robot has no arm {requested!r}", sorted(str(a) for a in aliases)
+        )
+    return str(aliases[requested])
+
+
+def gripper_name(action: str, requested: Any) -> str | None:
+    """The robot's name for the gripper `requested` (its ``GRIPPER_ALIASES`` allowed; None stays
+    None). A gripper's names need not be its arm's (a ``'hand'`` on the arm ``'arm'``)."""
+    if requested is None:
+        return None
+    aliases = _description().GRIPPER_ALIASES
+    if requested not in aliases:
+        raise ActionParameterError(
+            action, "gripper", f"the robot has no gripper {requested!r}", sorted(str(a) for a in aliases)
         )
     return str(aliases[requested])
 

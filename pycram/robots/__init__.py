@@ -13,22 +13,24 @@ May import: every layer above (core to backends). Nothing but the apps imports a
 from __future__ import annotations
 
 import importlib
+from collections.abc import Sequence
 from typing import Any
 
-from pycram.world.robot_registry import robot_names, robot_package
+from pycram.world.robot_registry import RegisteredRobots, robot_package
 
 __all__ = ["ROBOT_NAMES", "load"]
 
-#: Robots with a simulated implementation: the registered robots.
-ROBOT_NAMES = robot_names()
+#: Robots with a simulated implementation: the registered robots, sorted -- read from the registry
+#: whenever it is used (a `RegisteredRobots`), so a robot registered after this import is in it.
+ROBOT_NAMES: Sequence[str] = RegisteredRobots()
 
 
 def load(name: str, world: Any) -> Any:
     """The robot ``name`` (one of `ROBOT_NAMES`) of the simulated ``world``, as a
     :class:`pycram.robots.common.sim_modules.SimRobot` with all process modules online and its motion,
     process-module and location resolvers registered. Activate it with ``with robot:``; stop it
-    with ``robot.shutdown()``. Raises ``ValueError`` for an unknown name or a world built for
-    another robot.
+    with ``robot.shutdown()``. Raises ``ValueError`` for an unknown name (listing the robots
+    registered now) or a world built for another robot.
     """
     if name not in ROBOT_NAMES:
         raise ValueError(f"unknown robot {name!r}; available: {', '.join(ROBOT_NAMES)}")

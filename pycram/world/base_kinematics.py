@@ -50,7 +50,9 @@ __all__ = [
     "HEADING_EPS",
 ]
 
+#: The kind of a base that moves in any direction and turns at once (PR2, TIAGo Pro).
 OMNIDIRECTIONAL = "omnidirectional"
+#: The kind of a base that drives along its heading and turns on the spot or on arcs (TIAGo).
 DIFFERENTIAL = "differential"
 #: The base kinematics a robot description may name (``BASE["kind"]``).
 KINDS = (OMNIDIRECTIONAL, DIFFERENTIAL)

@@ -59,8 +59,9 @@ COMPOSED_NAMES: dict[tuple[str, str], str] = {
 }
 #: Shapes of the base.
 BASE_SHAPES = ("box", "cylinder")
-#: Joint ranges [rad] of the composed head (pan about z; tilt about y, positive looks down).
+#: Joint range [rad] of the composed head's pan (about z).
 HEAD_PAN_RANGE = (-2.6, 2.6)
+#: Joint range [rad] of the composed head's tilt (about y, positive looks down).
 HEAD_TILT_RANGE = (-0.8, 1.3)
 
 

@@ -91,16 +91,11 @@ def register_robot(tmp_path, monkeypatch):
         dist.mkdir()
         (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package.name}\nVersion: 0.1\n")
         (dist / "entry_points.txt").write_text(f"[pycram.robots]\n{name} = {package.name}\n")
-        monkeypatch.syspath_prepend(str(tmp_path))
-        robot_registry._packages.cache_clear()
-        robot_registry._description.cache_clear()
-        monkeypatch.setattr("pycram.robots.ROBOT_NAMES", robot_registry.robot_names())
+        monkeypatch.syspath_prepend(str(tmp_path))  # the registry reads the entry points again
         return name
 
     yield register
     monkeypatch.undo()
-    robot_registry._packages.cache_clear()
-    robot_registry._description.cache_clear()
     for module in [m for m in sys.modules if m.split(".")[0] in packages]:
         del sys.modules[module]  # the next test's package of the same name is its own
 

@@ -5,9 +5,11 @@ composition fails naming the robot and the key."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -23,29 +25,32 @@ DESCRIPTION = EXAMPLE / "mobile_panda" / "description.py"
 ROBOT = "mobile-panda"
 
 
-@pytest.fixture
-def mobile_panda(tmp_path, monkeypatch):
+@contextlib.contextmanager
+def registered_example(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """The example package on the path with the distribution metadata `pip install
-    examples/byo_robot` writes (its pyproject's entry point), the registry re-read."""
+    examples/byo_robot` writes (its pyproject's entry point, into `folder`), registered after
+    `pycram` was imported: nothing but the import path is touched; undone on exit."""
     entry = re.search(r'\[project\.entry-points\."pycram\.robots"\]\n(.+?)\n', (EXAMPLE / "pyproject.toml").read_text())
     assert entry is not None and entry.group(1).replace(" ", "") == f'{ROBOT}="mobile_panda"'
-    dist = tmp_path / "mobile_panda-0.1.0.dist-info"
+    dist = folder / "mobile_panda-0.1.0.dist-info"
     dist.mkdir()
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: mobile-panda\nVersion: 0.1.0\n")
     (dist / "entry_points.txt").write_text(f"[pycram.robots]\n{ROBOT} = mobile_panda\n")
     monkeypatch.syspath_prepend(str(EXAMPLE))
-    monkeypatch.syspath_prepend(str(tmp_path))
-    robot_registry._packages.cache_clear()
-    robot_registry._description.cache_clear()
-    # `pycram.robots` lists the robots registered when it was first imported (as in
-    # tests/apps/test_robot_check.py): a robot registered later is added to that list
-    monkeypatch.setattr("pycram.robots.ROBOT_NAMES", robot_registry.robot_names())
-    yield
-    monkeypatch.undo()
-    robot_registry._packages.cache_clear()
-    robot_registry._description.cache_clear()
-    for module in [m for m in sys.modules if m.split(".")[0] == "mobile_panda"]:
-        del sys.modules[module]
+    monkeypatch.syspath_prepend(str(folder))
+    try:
+        yield
+    finally:
+        monkeypatch.undo()
+        for module in [m for m in sys.modules if m.split(".")[0] == "mobile_panda"]:
+            del sys.modules[module]
+
+
+@pytest.fixture
+def mobile_panda(tmp_path, monkeypatch):
+    """The example registered (`registered_example`) for the test."""
+    with registered_example(tmp_path, monkeypatch):
+        yield
 
 
 def test_the_description_is_at_most_80_lines_of_data():
@@ -58,6 +63,23 @@ def test_the_docs_page_shows_the_description_as_it_is():
     page = (REPO / "docs" / "byo-robot.md").read_text(encoding="utf-8")
     blocks = re.findall(r"^```python\n(.*?)^```", page, re.S | re.M)
     assert DESCRIPTION.read_text(encoding="utf-8") in blocks, "docs/byo-robot.md: copy the description again"
+
+
+def test_a_robot_registered_after_import_is_known_everywhere_and_gone_with_its_package(tmp_path, monkeypatch):
+    import pycram.backends.sim.robot_model as robot_model
+    import pycram.robots as robots
+    from pycram.apps.experiments.scenarios import ROBOTS as SCENARIO_ROBOTS
+
+    lists = (robots.ROBOT_NAMES, robot_model.ROBOTS, SCENARIO_ROBOTS)
+    assert all(ROBOT not in names for names in lists)
+    with registered_example(tmp_path, monkeypatch):
+        for names in lists:
+            assert ROBOT in names and tuple(names) == robot_registry.robot_names() and names[len(names) - 1]
+        assert robot_registry.robot_package(ROBOT) == "mobile_panda"
+        assert robot_registry.robot_description(ROBOT).NAME == ROBOT
+    assert all(ROBOT not in names for names in lists)
+    with pytest.raises(robot_registry.UnknownRobotError, match="'mobile-panda' does not exist"):
+        robot_registry.robot_description(ROBOT)
 
 
 def test_the_short_robot_check_passes(mobile_panda):
@@ -74,6 +96,28 @@ def test_the_short_robot_check_passes(mobile_panda):
     assert checks["camera sees a test object"].result == PASS
     assert checks["action: transporting"].result == PASS
     assert checks["reach: arm arm"].data["at_counter_height"][0] > 0
+
+
+def test_set_gripper_takes_the_grippers_name_which_is_no_arm_name(mobile_panda):
+    from pycram.actions import ActionParameterError, SetGripper
+    from pycram.apps.robot_check.scene import CheckScene
+    from pycram.designator import perform
+
+    description = robot_registry.robot_description(ROBOT)
+    gripper = description.ARMS["arm"]["gripper"]
+    assert gripper == "hand" and "hand" not in description.ARM_ALIASES
+    scene = CheckScene.open(ROBOT)
+    try:
+        with scene.robot:
+            perform(SetGripper(gripper, 0.0))
+            closed = scene.world.gripper_states[gripper].get_value().opening
+            perform(SetGripper(gripper, 1.0))
+            opened = scene.world.gripper_states[gripper].get_value().opening
+            with pytest.raises(ActionParameterError, match="no gripper 'claw'"):
+                perform(SetGripper("claw", 1.0))
+    finally:
+        scene.close()
+    assert closed < 0.005 and opened > 0.8 * description.GRIPPERS[gripper]["max_opening"]
 
 
 def test_the_composed_model_has_the_base_torso_and_head(mobile_panda):

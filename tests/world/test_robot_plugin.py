@@ -40,13 +40,9 @@ def installed_robot_package(tmp_path, monkeypatch):
             """
         )
     )
-    monkeypatch.syspath_prepend(str(tmp_path))
-    robot_registry._packages.cache_clear()
-    robot_registry._description.cache_clear()
+    monkeypatch.syspath_prepend(str(tmp_path))  # the registry reads the entry points again
     yield
     monkeypatch.undo()
-    robot_registry._packages.cache_clear()
-    robot_registry._description.cache_clear()
 
 
 def test_a_robot_package_outside_pycram_is_registered_by_its_entry_point(installed_robot_package):

@@ -48,12 +48,12 @@ GRIPPERS = {
         "default_effort": 25.0,
     },
 }
-ARM_ALIASES = {"arm": "arm", "hand": "arm", "left": "arm", "right": "arm", "0": "arm", "1": "arm", 0: "arm", 1: "arm"}
+ARM_ALIASES = {"arm": "arm", "left": "arm", "right": "arm", "0": "arm", "1": "arm", 0: "arm", 1: "arm"}
 GRIPPER_ALIASES = {**{k: "hand" for k in ARM_ALIASES}, "hand": "hand"}
 ARM_CONFIGURATIONS = {  # found by IK on the composed model, the torso "up"
     "arm": {
         "park": (-2.178, 0.222, -0.547, -2.902, -1.767, 3.407, -0.964),  # within 0.33 m, not in view
-        "carry": (-0.224, 0.509, 0.179, -2.347, -0.293, 2.836, 0.213),  # tool 0.6 m ahead, 1.05 m high
+        "carry": (-0.079, -0.27, 0.082, -2.685, 0.033, 2.414, -0.024),  # tool 0.5 m ahead, 1.25 m high
         "pre_grasp": (-0.153, 0.853, 0.11, -2.048, -0.328, 2.885, 0.237),  # 0.65 m ahead, 0.95 m high
         "carry_top": (-0.13, 1.089, 0.244, -0.842, -0.04, 0.345, 0.178),  # pointing down, 1.1 m high
     },

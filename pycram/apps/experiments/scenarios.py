@@ -30,12 +30,12 @@ import importlib
 import inspect
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from pycram.core.runtime.lockstep import DEFAULT_STEPPING
-from pycram.world.robot_registry import robot_names
+from pycram.world.robot_registry import RegisteredRobots
 
 log = logging.getLogger(__name__)
 
@@ -59,8 +59,8 @@ __all__ = [
 ScenarioFunction = Callable[..., dict[str, Any]]
 
 #: The robots every built-in scenario runs on: the registered robots
-#: (:func:`pycram.world.robot_registry.robot_names`).
-ROBOTS = robot_names()
+#: (:func:`pycram.world.robot_registry.robot_names`), read from the registry whenever it is used.
+ROBOTS: Sequence[str] = RegisteredRobots()
 
 #: The faults of the thesis scenario: `steal` takes the item from the gripper during transport
 #: (once or twice, by the seed); `misplaced` puts the item at position 2 or 3 (by the seed), so
@@ -90,7 +90,7 @@ class Scenario:
     name: str
     target: ScenarioFunction | str
     faults: tuple[str, ...] | None = None
-    robots: tuple[str, ...] = ROBOTS
+    robots: Sequence[str] = ROBOTS
     description: str = ""
     demo: str | None = None
     #: The environment the scenario is written for (None: it does not say). A scenario whose
@@ -154,7 +154,7 @@ def register_scenario(
     target: ScenarioFunction | str,
     *,
     faults: tuple[str, ...] | None = None,
-    robots: tuple[str, ...] = ROBOTS,
+    robots: Sequence[str] = ROBOTS,
     description: str = "",
     demo: str | None = None,
     environment: str | None = None,

@@ -8,13 +8,14 @@ into MJCF elements.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import mujoco
 import numpy as np
 
 from pycram.world.robot_description import RobotDescription, RobotDescriptionError
-from pycram.world.robot_registry import robot_description, robot_names
+from pycram.world.robot_registry import RegisteredRobots, robot_description, robot_names
 
 from . import collision
 from .assets import urdf_text
@@ -22,8 +23,8 @@ from .composition import composed_urdf_text, paint_composed
 from .errors import UnknownNameError
 
 #: Names of the robots the simulator can load: the registered robots
-#: (:func:`pycram.world.robot_registry.robot_names`).
-ROBOTS = robot_names()
+#: (:func:`pycram.world.robot_registry.robot_names`), read from the registry whenever it is used.
+ROBOTS: Sequence[str] = RegisteredRobots()
 
 #: Names of the base joints added on the mount body.
 BASE_JOINTS = ("base_x", "base_y", "base_yaw")
