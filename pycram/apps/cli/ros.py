@@ -13,7 +13,7 @@ from pycram.apps.cli.app import (
     fail,
 )
 from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_HELP
-from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
+from pycram.world.robot_registry import DEFAULT_ROBOT
 
 
 def object_items(values: list[str]) -> list:
@@ -115,8 +115,12 @@ def sim_ros_bridge_command(
     """Serve the simulated robot over ROS 1 (move_base, PointHead, arm/torso trajectories, grippers,
     /amcl_pose, /joint_states, /clock, the head camera's detections), as a real robot's drivers
     would. Needs ROS_MASTER_URI."""
-    if robot not in robot_names():
-        fail(f"--robot must be {robot_choices()}, not {robot!r}", code=2)
+    from pycram.backends.ros.config import ROBOT_CONFIGS
+
+    if robot not in ROBOT_CONFIGS:  # the robots whose description has a ROS interface
+        names = [repr(n) for n in sorted(ROBOT_CONFIGS)]
+        choices = " or ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else "".join(names)
+        fail(f"--robot must be {choices}, not {robot!r}", code=2)
     from pycram.apps.demos.ros_kitchen_world import bridge_environment
 
     try:
