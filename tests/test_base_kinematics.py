@@ -68,8 +68,12 @@ def test_a_bad_base_kind_names_the_key_and_the_choices():
         RobotDescription.from_mapping(data)
 
 
-def test_the_tiago_is_a_differential_drive_the_pr2_omnidirectional():
-    assert robot_description("tiago").base_kinematics.kind == "differential"
+def test_every_registered_robot_names_a_base_kind():
+    from pycram.world.base_kinematics import KINDS
+    from pycram.world.robot_registry import robot_names
+
+    for name in robot_names():
+        assert robot_description(name).base_kinematics.kind in KINDS
     assert robot_description("pr2").base_kinematics.holonomic
 
 

@@ -3,8 +3,11 @@ appears during a drive, and a named failure when there is no way."""
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import sys
 
+import pytest
 from sim_helpers import Recorder, T, ok, wait_wall
 
 OBSTACLE_HALF = 0.15  # [m] half width of `place_obstacle`'s box
@@ -99,25 +102,82 @@ def test_a_door_left_open_across_the_route_is_driven_around():
         world.close()
 
 
-def test_each_base_moves_as_its_kinematics_allow(world):
-    """The PR2's omnidirectional base steps sideways; the TIAGo's differential drive never does:
-    asked to move 0.4 m to its left it turns, drives along its heading and turns back."""
+DIFFERENTIAL_TWIN = "tiago_differential"
+
+
+@pytest.fixture(scope="module")
+def differential_tiago(tmp_path_factory):
+    """A world with the TIAGo on the differential drive its real base is (its description with
+    ``BASE["kind"] = "differential"``, registered through an entry point as another package
+    would; the TIAGo itself stays omnidirectional by default, see its description)."""
+    from pycram.sim import World
+    from pycram.world import robot_registry
+
+    root = tmp_path_factory.mktemp("twin")
+    package = root / "differential_tiago"
+    package.mkdir()
+    (package / "__init__.py").write_text('"""The TIAGo on its differential drive."""\n')
+    source = importlib.util.find_spec(robot_registry.robot_package("tiago") + ".description").origin
+    text = open(source, encoding="utf-8").read()
+    assert 'NAME = "tiago"\n' in text and '"kind": "omnidirectional",' in text
+    text = text.replace('NAME = "tiago"\n', f'NAME = "{DIFFERENTIAL_TWIN}"\n')
+    (package / "description.py").write_text(text.replace('"kind": "omnidirectional",', '"kind": "differential",'))
+    dist = root / "differential_tiago-0.1.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: differential-tiago\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text(f"[pycram.robots]\n{DIFFERENTIAL_TWIN} = differential_tiago\n")
+    sys.path.insert(0, str(root))
+    try:
+        assert robot_registry.robot_description(DIFFERENTIAL_TWIN).base_kinematics.kind == "differential"
+        with World(DIFFERENTIAL_TWIN) as w:
+            yield w
+    finally:
+        sys.path.remove(str(root))
+
+
+def _moves_left(world) -> tuple[float, float]:
+    """Drive 0.4 m to the robot's left (same heading) and back; (metres travelled along the base's
+    own y axis, largest heading change [rad]) on the way there."""
     start = world.base_pose.get_value()
     left = (-math.sin(start.yaw), math.cos(start.yaw))
     poses = Recorder(world.base_pose)
     ok(world.drive_to(start.x + 0.4 * left[0], start.y + 0.4 * left[1], start.yaw))
     samples = [start, *poses.samples]
-    sideways = 0.0  # [m] travelled along the base's own y axis
+    sideways = 0.0
     for a, b in zip(samples, samples[1:]):
         dx, dy = b.x - a.x, b.y - a.y
         sideways += abs(-math.sin(a.yaw) * dx + math.cos(a.yaw) * dy)
     turned = max(abs(math.remainder(p.yaw - start.yaw, 2 * math.pi)) for p in samples)
     final = world.base_pose.get_value()
     assert math.hypot(final.x - start.x - 0.4 * left[0], final.y - start.y - 0.4 * left[1]) < 0.01
-    if world.description.BASE.get("kind", "omnidirectional") == "differential":
-        assert sideways < 0.02, sideways
-        assert turned > 1.2  # it faced the way it went (about 90 deg)
-    else:
-        assert sideways > 0.35, sideways
-        assert turned < 0.05
+    ok(world.drive_to(start.x, start.y, start.yaw))
+    return sideways, turned
+
+
+def test_an_omnidirectional_base_steps_sideways(world):
+    assert world.description.BASE.get("kind", "omnidirectional") == "omnidirectional"
+    sideways, turned = _moves_left(world)
+    assert sideways > 0.35, sideways
+    assert turned < 0.05
+
+
+def test_a_differential_drive_never_steps_sideways(differential_tiago):
+    """Asked to move 0.4 m to its left, the differential TIAGo turns, drives along its heading and
+    turns back: it faces the way it goes (about 90 deg) and travels less than 2 cm sideways."""
+    sideways, turned = _moves_left(differential_tiago)
+    assert sideways < 0.02, sideways
+    assert turned > 1.2
+
+
+def test_a_differential_drive_drives_around_an_obstacle(differential_tiago):
+    world = differential_tiago
+    start = world.base_pose.get_value()
+    c, s = math.cos(start.yaw), math.sin(start.yaw)
+    obstacle = ok(world.place_obstacle(start.x + 0.9 * c, start.y + 0.9 * s))
+    try:
+        ok(world.drive_to(start.x + 1.8 * c, start.y + 1.8 * s, start.yaw))
+        final = world.base_pose.get_value()
+        assert math.hypot(final.x - start.x - 1.8 * c, final.y - start.y - 1.8 * s) < 0.02
+    finally:
+        ok(world.remove_obstacle(obstacle))
     ok(world.drive_to(start.x, start.y, start.yaw))

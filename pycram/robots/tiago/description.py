@@ -14,12 +14,17 @@ NAME = "tiago"
 URDF = "robots/tiago_description/robots/tiago_no_hand.urdf"
 ROOT_LINK = "base_footprint"
 
-#: TIAGo's base is a differential drive (two driven wheels and casters): it drives along its
-#: heading or turns on the spot, never sideways (`pycram.world.base_kinematics`). It backs up
-#: at most `max_reverse` (no laser behind it) and arrives at / leaves a pose straight along its
-#: heading over `approach` where turning on the spot would not fit.
+#: TIAGo's real base is a differential drive (two driven wheels and casters). The simulated one
+#: is still omnidirectional by default: `"differential"` (`pycram.world.base_kinematics`; it
+#: would back up at most `max_reverse` -- no laser behind it -- and arrive at / leave a pose
+#: straight along its heading over `approach`) is built and measured -- set-table development
+#: seeds 11-40 30/30, as omnidirectional -- but with it two end-to-end tests fail: on set-table
+#: seed 205 the retreat after placing the cup tips it over (it was grasped at another height
+#: after a different approach), and the run with the stuck drawer overruns its 300-s transport
+#: budget (turning on the spot costs ~1.5x the simulated time); the robot check's transport lets
+#: a side-held cup slip in the fingers while turning on the spot. See issue 34's notes.
 BASE = {
-    "kind": "differential",
+    "kind": "omnidirectional",
     "max_reverse": 0.5,  # [m]
     "approach": 0.3,  # [m]
     "max_linear_velocity": 0.6,  # [m/s]
