@@ -86,7 +86,7 @@ def test_no_item_ends_with_a_clear_failure(tmp_path):
 @pytest.mark.parametrize(
     "option, value, expected",
     [
-        ("robot", "nao", "--robot must be 'pr2' or 'tiago'"),
+        ("robot", "nao", "--robot must be 'pr2', 'tiago' or 'tiago-pro'"),
         ("item_at", 4, "--item-at must be 0 (no item) or a position 1, 2 or 3"),
     ],
 )
