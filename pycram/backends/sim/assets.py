@@ -7,10 +7,10 @@ installed `example-robot-data` package at load time.
 from __future__ import annotations
 
 import functools
-import os
 import re
-import sys
 from pathlib import Path
+
+from pycram.world.robot_model_file import ModelFileError, model_dir
 
 from .errors import SimulationError
 
@@ -20,20 +20,16 @@ _COMPILER = (
 )
 
 
-@functools.cache
 def robot_data_dir() -> Path:
-    """The `share/example-robot-data` directory of the installed `example-robot-data` package.
+    """The `share/example-robot-data` directory of the installed `example-robot-data` package
+    (`pycram.world.robot_model_file.model_dir`).
 
     `PYCRAM_ROBOT_DATA` overrides the search. Raises `SimulationError` when it is not installed.
     """
-    override = os.environ.get("PYCRAM_ROBOT_DATA")
-    candidates = [Path(override)] if override else []
-    candidates += [Path(p) / "cmeel.prefix" / "share" / "example-robot-data" for p in sys.path if p]
-    candidates.append(Path(sys.prefix) / "share" / "example-robot-data")
-    for c in candidates:
-        if (c / "robots").is_dir():
-            return c
-    raise SimulationError("example-robot-data is not installed (pip install 'pycram[sim]')")
+    try:
+        return model_dir()
+    except ModelFileError as exc:
+        raise SimulationError(str(exc)) from None
 
 
 def _fix_inertia(text: str) -> str:
