@@ -45,6 +45,7 @@ __all__ = [
     "is_primitive",
     "arc_radius",
     "arc_pose",
+    "arc_point",
     "drive_moves",
     "POSITION_EPS",
     "HEADING_EPS",
@@ -205,7 +206,14 @@ def arc_pose(a: BasePose, b: BasePose, s: float) -> BasePose:
     yaw = a.yaw + s * _wrap(b.yaw - a.yaw)
     if rho is None:
         return BasePose(a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), yaw)
-    return BasePose(a.x + rho * (math.sin(yaw) - math.sin(a.yaw)), a.y - rho * (math.cos(yaw) - math.cos(a.yaw)), yaw)
+    x, y = arc_point(a.x, a.y, a.yaw, rho, yaw)
+    return BasePose(x, y, yaw)
+
+
+def arc_point(x0: float, y0: float, yaw0: float, rho: float, yaw: float) -> tuple[float, float]:
+    """The position [m] reached on the arc that leaves (`x0`, `y0`) at heading `yaw0` [rad] with
+    the signed ratio `rho` [m/rad] of distance to turn (`arc_radius`) once the heading is `yaw`."""
+    return x0 + rho * (math.sin(yaw) - math.sin(yaw0)), y0 - rho * (math.cos(yaw) - math.cos(yaw0))
 
 
 def drive_moves(here: BasePose, goal: BasePose, kinematics: BaseKinematics, tolerance: float = 0.02) -> list[BasePose]:

@@ -56,7 +56,7 @@ import numpy as np
 
 from pycram.execution.failures import GoalUnreachable, NavigationFailure
 
-from .base_kinematics import POSITION_EPS, BaseKinematics, arc_radius, move_options
+from .base_kinematics import POSITION_EPS, BaseKinematics, arc_point, arc_radius, move_options
 from .prospection import BasePose, as_base_pose
 
 __all__ = [
@@ -501,7 +501,8 @@ class PathPlanner:
 
     def _along_move(self, a: BasePose, b: BasePose, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The poses (xs, ys, yaws) at fractions `s` of the move from ``a`` to ``b``: the straight
-        line turning uniformly, or for a differential drive the arc between them (`arc_radius`)."""
+        line turning uniformly, or for a differential drive the arc between them (`arc_radius`;
+        `arc_point` over arrays)."""
         dyaw = _wrap(b.yaw - a.yaw)
         yaws = a.yaw + s * dyaw
         rho = None if self.kinematics.holonomic else arc_radius(a, b)
@@ -656,8 +657,7 @@ class PathPlanner:
                 for way, weight in ((LATTICE_ARC, 1.0), (-LATTICE_ARC, LATTICE_REVERSE_COST)):
                     end = (h + turn) * unit
                     rho = way / (end - yaw)
-                    ax = pose.x + rho * (math.sin(end) - math.sin(yaw))
-                    arc = BasePose(ax, pose.y - rho * (math.cos(end) - math.cos(yaw)), end)
+                    arc = BasePose(*arc_point(pose.x, pose.y, yaw, rho, end), end)
                     steps.append((arc, h + turn, LATTICE_ARC * weight))
             for nxt, nh, step_cost in steps:
                 nk = key(nxt, nh)

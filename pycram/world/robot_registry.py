@@ -32,7 +32,7 @@ import importlib.util
 import os
 import sys
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from typing import overload
 
 from .errors import UnknownNameError
@@ -129,9 +129,10 @@ def robot_names() -> tuple[str, ...]:
     return tuple(sorted(_packages()))
 
 
-def robot_choices() -> str:
-    """The registered robots for a message: ``'pr2'``, ``'pr2' or 'tiago'``, ``'a', 'b' or 'c'``."""
-    quoted = [repr(n) for n in robot_names()]
+def robot_choices(names: Iterable[str] | None = None) -> str:
+    """Robot names for a message -- the registered robots, or `names`: ``'pr2'``,
+    ``'pr2' or 'tiago'``, ``'a', 'b' or 'c'``."""
+    quoted = [repr(n) for n in (robot_names() if names is None else names)]
     return " or ".join([", ".join(quoted[:-1]), quoted[-1]]) if len(quoted) > 1 else "".join(quoted)
 
 

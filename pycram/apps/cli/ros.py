@@ -13,7 +13,7 @@ from pycram.apps.cli.app import (
     fail,
 )
 from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_HELP
-from pycram.world.robot_registry import DEFAULT_ROBOT
+from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices
 
 
 def object_items(values: list[str]) -> list:
@@ -118,9 +118,7 @@ def sim_ros_bridge_command(
     from pycram.backends.ros.config import ROBOT_CONFIGS
 
     if robot not in ROBOT_CONFIGS:  # the robots whose description has a ROS interface
-        names = [repr(n) for n in sorted(ROBOT_CONFIGS)]
-        choices = " or ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else "".join(names)
-        fail(f"--robot must be {choices}, not {robot!r}", code=2)
+        fail(f"--robot must be {robot_choices(sorted(ROBOT_CONFIGS))}, not {robot!r}", code=2)
     from pycram.apps.demos.ros_kitchen_world import bridge_environment
 
     try:

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from pycram.world.base_kinematics import BaseKinematics, arc_radius, drive_moves
+from pycram.world.base_kinematics import BaseKinematics, arc_point, arc_radius, drive_moves
 from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D, wrap_angle
 
@@ -164,8 +164,7 @@ class BaseDrive(Controller):
         if self.arc is not None:
             s = self.profile.fraction(t - self.t0, self.duration)
             yaw = self.yaw0 + s * self.dyaw
-            x = self.x0 + self.arc * (math.sin(yaw) - math.sin(self.yaw0))
-            return (x, self.y0 - self.arc * (math.cos(yaw) - math.cos(self.yaw0)), yaw)
+            return (*arc_point(self.x0, self.y0, self.yaw0, self.arc, yaw), yaw)
         s_lin = self.lin.fraction(t - self.t0, self.duration)
         s_ang = self.ang.fraction(t - self.t0, self.duration)
         return (self.x0 + s_lin * self.dx, self.y0 + s_lin * self.dy, self.yaw0 + s_ang * self.dyaw)
