@@ -188,3 +188,25 @@ def test_pycram_view_serves_a_run_from_the_database_until_ctrl_c(set_table_run):
         code = child.wait(60)
     assert code == 0
     assert set(Path(tempfile.gettempdir()).glob("pycram-view-*/run-1-db.rrd")) <= before
+
+
+def test_attach_views_logs_the_world_before_the_plan_starts(tmp_path):
+    """`attach_views` attaches every active session to a world and returns once its geometry is
+    logged (the start-up a run pays before its plan); attached sessions, closed sessions and no
+    session at all make it do nothing."""
+    from pycram.backends.sim import World
+    from pycram.trace.view.session import ViewSession, attach_views
+
+    attach_views(object())  # no active session: not even looked at
+    with World("pr2", []) as world:
+        session = ViewSession(rrd=tmp_path / "run.rrd").start()
+        try:
+            assert "geoms" not in session.counts
+            attach_views(world)
+            assert session.counts["geoms"] > 20  # the kitchen's and the robot's shapes
+            assert session._attached
+            attach_views(object())  # attached before: left as it is
+        finally:
+            session.close()
+        attach_views(object())  # closed: no longer active
+    assert RecordingContents.read(tmp_path / "run.rrd").rows

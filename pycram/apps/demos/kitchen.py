@@ -370,6 +370,10 @@ def _run_in_world(options: DemoOptions, result: DemoResult, recorder: Any, stop:
                 camera, fps=ANIMATION_FPS, width=ANIMATION_SIZE[0], height=ANIMATION_SIZE[1], caption=story.caption
             )
         run = PlanRun(plan, robot, facts)
+        if isinstance(world, World):
+            from pycram.trace.view.session import attach_views
+
+            attach_views(world, robot.belief, robot)  # a view's start-up is paid before the plan runs
         if options.until is not None and isinstance(world, World):  # (--until is refused over ROS)
             world.hold_at(options.until)
         thief.start()
@@ -686,7 +690,7 @@ def main(
     console.print()
     console.print(task_tree_display(result.plan_task, result.run_id, options.db, result.tree_text))
     console.print(
-        f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.1f} s of wall time "
+        f"\nthe plan simulated {result.sim_time:.1f} s in {result.plan_wall_time:.2f} s of wall time "
         f"({result.speed_factor:.1f}x real time); the whole run took {result.wall_time:.1f} s"
     )
     console.print(f"failed grasps: {result.failed_grasps}, recoveries: {result.recoveries}")

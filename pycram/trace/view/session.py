@@ -8,19 +8,24 @@ What it logs is listed in `pycram.trace.view.paths`. How, so that viewing change
 run and costs it little:
 
 - Every hook that runs in a plan thread or in the simulation thread only puts a tuple on a queue
-  (O(1), never blocks); the session's own thread turns the queue into Rerun data. No hook
-  changes a value the run reads, so a lock-step run has the same fingerprint with a view as
-  without one (`pycram.trace.fingerprint`).
+  (O(1), never blocks); the session's own thread hands the queue on, as plain values in
+  batches, to a `ViewWriter` in a process of its own (`pycram.trace.view.writer`), which turns
+  them into Rerun data -- so the view's work does not hold this process's interpreter lock
+  while the run computes (`process=False`, or a process that cannot start: the writer runs in
+  the session's thread). No hook changes a value the run reads, so a lock-step run has the
+  same fingerprint with a view as without one (`pycram.trace.fingerprint`). A writer that dies
+  costs the rest of the recording, never the run.
 - The task tree comes from the runtime's task listeners (like the trace recorder); log lines from
   a `logging` record factory (what the run logs at the levels it set, INFO and above).
 - The world: once a task starts while a simulated robot is active (`current_robot()`, with a
-  ``world`` and a ``belief``), the session attaches to that world: a child fluent of its
+  ``world`` and a ``belief``) -- or before the plan starts, by `attach_views` --, the session
+  attaches to that world: a child fluent of its
   ``sim_time`` (set by the simulation thread at every sensor publication) takes, at most every
   1/`world_rate_hz` s of simulated time (10 Hz by default), the state the simulation thread last
   published (`StateSnapshot`, already a copy) and a snapshot of the belief; a child fluent of
-  the belief's ``updated`` takes each look of the camera. The session's thread computes the
-  bodies' poses from the state in its own `MjData` and renders the camera image with its own
-  renderer. The location reasoner's latest costmaps (and candidates, where it keeps them) and
+  the belief's ``updated`` takes each look of the camera. The writer computes the bodies' poses
+  from the state in its own `MjData` and renders the camera image with its own renderer. The
+  location reasoner's latest costmaps (and candidates, where it keeps them) and
   each arm's latest motion plan (the tool path, by forward kinematics in the view's own data)
   are taken at the same ticks.
 - Times: the ``sim`` timeline is the run's clock (simulated time in a simulation), ``wall`` the
@@ -42,7 +47,7 @@ from typing import Any
 from pycram.core.fluent import Fluent
 from pycram.core.runtime import Task, add_task_listener, current_clock, remove_task_listener
 
-from . import paths
+from .writer import FLUSH_TIMEOUT, TRANSFORM_BATCH, ViewWriter, costmap_data, read_message, send_message
 
 __all__ = [
     "ViewSession",
@@ -50,6 +55,7 @@ __all__ = [
     "FLUSH_TIMEOUT",
     "TRANSFORM_BATCH",
     "find_run_folder",
+    "attach_views",
     "viewed_run",
     "VIEW_CONNECT_ENV",
     "VIEW_RUN_ENV",
@@ -59,13 +65,13 @@ log = logging.getLogger(__name__)
 
 #: How often [Hz of simulated time] the world's state is logged by default.
 DEFAULT_WORLD_RATE = 10.0
-#: At most this many [s of the sim timeline] between two logs of the task tree's graph.
-GRAPH_PERIOD = 1.0
-#: Body poses and task-status changes are logged in columns every this many [s] of wall time (a
-#: live view lags by as much): one Rerun call per body (and one for the statuses) per batch.
-TRANSFORM_BATCH = 1.0
-#: Wall time [s] closing a session waits for its data to reach the file and the viewer.
-FLUSH_TIMEOUT = 60.0
+#: At most this many events go to the writer in one batch.
+BATCH_LIMIT = 500
+#: Wall time [s] `attach_views` waits at most for a session to log the world's geometry.
+ATTACH_TIMEOUT = 30.0
+
+_active: list[ViewSession] = []  # the started, not yet closed sessions (in start order)
+_active_lock = threading.Lock()
 
 
 class _Tick(Fluent):
@@ -112,7 +118,10 @@ class ViewSession:
     server to stream to (`ViewerServer.grpc_url`; None: none); at least one of the two.
     `recording_id`: the recording's id (default: a new one; recordings with the same id are
     merged by the viewer); `name`: the recording's name as the viewer shows it;
-    `world_rate_hz`: how often the world's state is logged [Hz of simulated time]."""
+    `world_rate_hz`: how often the world's state is logged [Hz of simulated time]; `process`:
+    write the recording in a process of its own (the default: the run's threads then do not
+    share Python's interpreter lock with the view's work; see `pycram.trace.view.writer`), else
+    in a thread of this process (also the fallback when no process can be started)."""
 
     def __init__(
         self,
@@ -122,6 +131,7 @@ class ViewSession:
         recording_id: str | None = None,
         name: str = "pycram run",
         world_rate_hz: float = DEFAULT_WORLD_RATE,
+        process: bool = True,
     ) -> None:
         if rrd is None and connect is None:
             raise ValueError("a view needs somewhere to go: an .rrd file (rrd=...) or a viewer (connect=...)")
@@ -132,7 +142,8 @@ class ViewSession:
         self.recording_id = recording_id or f"pycram-{uuid.uuid4()}"
         self.name = name
         self.period = 1.0 / world_rate_hz
-        self.rec: Any = None
+        self.process = process
+        self._sink: _ProcessSink | _ThreadSink | None = None
         self._queue: queue.SimpleQueue[tuple[Any, ...]] = queue.SimpleQueue()
         self._put = self._queue.put
         self._thread: threading.Thread | None = None
@@ -153,47 +164,48 @@ class ViewSession:
         self.started_wall = 0.0
         #: The trace database's run this view belongs to (found when it attaches), or None.
         self.run_id: int | None = None
-        #: What the session's thread logged: counts by kind (for tests and the benchmark).
+        #: What the writer logged: counts by kind (known once the session is closed; "geoms" as
+        #: soon as `attach_views` returned).
         self.counts: dict[str, int] = {}
-        #: Wall time [s] the session's thread spent per kind of event ("task", "world", "look",
-        #: "log", "attach"), for the benchmark.
+        #: Wall time [s] the writer spent per kind of event ("task", "world", "look", "log",
+        #: "attach"), known once the session is closed.
         self.spent: dict[str, float] = {}
-        #: Why the session's thread stopped logging, if it failed (None: it did not).
-        self.error: BaseException | None = None
+        #: Why the writer stopped logging, if it failed ("Type: message"; None: it did not).
+        self.error: str | None = None
 
     # -- life cycle ------------------------------------------------------------------------------
 
     def start(self) -> ViewSession:
         """Open the recording (its sinks: the file, the viewer), send the layout, start listening.
         Raises `ViewError` if the ``view`` extra is missing or the file cannot be written."""
-        from .blueprint import default_blueprint
         from .server import ViewError
 
         try:
-            import rerun as rr
+            import rerun  # noqa: F401 - the writer needs it: fail here, with a clear message
         except ImportError as e:
             raise ViewError(f"the view needs the 'view' extra (pip install 'pycram[view]'): {e}") from None
         self.started_wall = time.time()
-        rec = rr.RecordingStream(paths.APPLICATION_ID, recording_id=self.recording_id)
-        sinks: list[Any] = []
         if self.rrd is not None:
             try:
                 self.rrd.parent.mkdir(parents=True, exist_ok=True)
                 self.rrd.touch()
             except OSError as e:
                 raise ViewError(f"cannot write the recording {self.rrd}: {e.strerror or e}") from None
-            sinks.append(rr.FileSink(str(self.rrd)))
-        if self.connect is not None:
-            sinks.append(rr.GrpcSink(self.connect))
-        rec.set_sinks(*sinks)
-        rec.send_recording_name(self.name)
-        rec.send_blueprint(default_blueprint())
-        self.rec = rec
-        self._thread = threading.Thread(target=self._main, name="pycram-view", daemon=True)
+        opening = (str(self.rrd) if self.rrd is not None else None, self.connect, self.recording_id, self.name)
+        sink: _ProcessSink | _ThreadSink | None = None
+        if self.process:
+            try:
+                sink = _ProcessSink(opening)
+            except OSError as e:
+                log.warning("cannot start the view's writer process (%s); writing in a thread", e)
+        self._sink = sink or _ThreadSink(opening)
+        self._thread = threading.Thread(target=self._forward, name="pycram-view", daemon=True)
         self._thread.start()
         add_task_listener(self)
         self._records = _LogRecords(self)
         logging.setLogRecordFactory(self._records)
+        with _active_lock:
+            _active.append(self)
         return self
 
     def close(self, timeout: float = 120.0) -> Path | None:
@@ -202,6 +214,9 @@ class ViewSession:
         if self._closed:
             return self.rrd
         self._closed = True
+        with _active_lock:
+            if self in _active:
+                _active.remove(self)
         remove_task_listener(self)
         if self._records is not None:
             self._records.active = False  # (another factory may have wrapped ours since)
@@ -215,12 +230,8 @@ class ViewSession:
             self._thread.join(timeout)
             if self._thread.is_alive():
                 log.warning("the view did not finish logging within %.0f s; the recording may be incomplete", timeout)
-        if self.rec is not None:
-            try:
-                self.rec.flush(timeout_sec=FLUSH_TIMEOUT)
-                self.rec.disconnect()
-            except Exception as e:  # noqa: BLE001 - the run is over; say it, do not fail it
-                log.warning("closing the view's recording: %s", e)
+                if isinstance(self._sink, _ProcessSink):
+                    self._sink.kill()
         return self.rrd
 
     def move_rrd(self, folder: Path, name: str = "run.rrd") -> Path | None:
@@ -253,13 +264,17 @@ class ViewSession:
             return
         self.attach(world, getattr(robot, "belief", None), robot)
 
-    def attach(self, world: Any, belief: Any = None, robot: Any = None) -> None:
+    def attach(self, world: Any, belief: Any = None, robot: Any = None) -> threading.Event:
         """Log `world` (a simulated `World`) from now on, with `belief` (the robot's
         `BeliefState`) and the location reasoner of `robot`; once per session (later calls do
-        nothing). Called by itself when a task starts with a simulated robot active."""
+        nothing). Called by itself when a task starts with a simulated robot active, or before
+        the plan starts by `attach_views`. Returns an event set once the session's thread logged
+        the world's geometry (already set when the session was attached before or is closed)."""
+        ready = threading.Event()
         with self._attach_lock:
             if self._attached or self._closed:
-                return
+                ready.set()
+                return ready
             self._attached = True
         from pycram.trace.recorder import active_recorders
 
@@ -289,6 +304,7 @@ class ViewSession:
                 camera,
                 str(getattr(robot, "name", scene.robot)),
                 self.run_id,
+                ready,
             )
         )
         self._next_tick = 0.0
@@ -302,6 +318,7 @@ class ViewSession:
             self._ticks.append(look)
             belief.updated.add_child(look)
         self._on_tick()  # the world as it stands when the view attaches
+        return ready
 
     def _on_tick(self) -> None:
         """(Simulation thread, at every sensor publication.) Take the state at most every
@@ -352,148 +369,212 @@ class ViewSession:
 
     # -- the session's thread ----------------------------------------------------------------------
 
-    def _count(self, kind: str, n: int = 1) -> None:
-        self.counts[kind] = self.counts.get(kind, 0) + n
+    def _forward(self) -> None:
+        """(The session's thread.) Hand the queued events on to the writer as plain values, in
+        batches of what is queued; set each attach's event once the writer logged the geometry;
+        at "stop", finish the writer and keep what it reports."""
+        from pycram.trace.recorder import error_origin
 
-    def _main(self) -> None:
-        from .tree import TreeLog
+        sink = self._sink
+        assert sink is not None
+        announced: set[int] = set()  # tasks whose first status went out
+        broken = False
 
-        rec = self.rec
-        world_log: Any = None
-        belief_names: list[str] = []
-        tree = TreeLog(rec, objects=lambda: belief_names, graph_period=GRAPH_PERIOD)
-        now = 0.0
-        flushed_at = -1e18  # time.monotonic() of the last flush of body poses
-        failing = False
+        def task_rows(task: Task, status: str, t: float | None, wall: float) -> list[tuple[Any, ...]]:
+            # ancestors never announced (a thread's root task): as the trace recorder does, they
+            # enter the tree as running from their start
+            rows: list[tuple[Any, ...]] = []
+            chain, node = [], task.parent
+            while node is not None and node.id not in announced:
+                chain.append(node)
+                node = node.parent
+            for ancestor in reversed(chain):
+                if ancestor.start_time is not None:
+                    above = ancestor.parent
+                    announced.add(ancestor.id)
+                    rows.append(
+                        (
+                            ancestor.start_time,
+                            wall,
+                            ancestor.id,
+                            above.id if above is not None else None,
+                            ancestor.name,
+                            ancestor.kind,
+                            ancestor.path,
+                            "running",
+                            None,
+                            False,
+                        )
+                    )
+            error = origin = None
+            if status in ("failed", "evaporated") and task.exception is not None:
+                error = f"{type(task.exception).__name__}: {task.exception}"
+                origin = error_origin(task) == task.id
+            parent = task.parent
+            announced.add(task.id)
+            rows.append(
+                (
+                    t,
+                    wall,
+                    task.id,
+                    parent.id if parent is not None else None,
+                    task.name,
+                    task.kind,
+                    task.path,
+                    status,
+                    error,
+                    bool(origin),
+                )
+            )
+            return rows
+
+        def plain(item: tuple[Any, ...]) -> tuple[Any, ...]:
+            tag = item[0]
+            if tag == "task":
+                _, task, status, t, wall = item
+                return ("task", task_rows(task, status, t, wall))
+            if tag == "world":
+                _, t, wall, state, belief, maps, candidates = item
+                if maps:
+                    maps = costmap_data(maps)
+                if candidates is not None:
+                    candidates = [
+                        (float(c[0]), float(c[1]), c[2], None if c[3] is None else str(c[3]), *c[4:5])
+                        for c in candidates
+                    ]
+                return ("world", t, wall, state, belief, maps, candidates)
+            if tag == "attach":
+                return item[:-1]  # (its event stays here)
+            return item
+
         while True:
             item = self._queue.get()
-            tag = item[0]
-            if tag == "stop":
-                break
-            began = time.perf_counter()
-            try:
-                if tag == "task":
-                    _, task, status, t, wall = item
-                    # ancestors never announced (a thread's root task): as the trace recorder
-                    # does, they enter the tree as running from their start
-                    chain, node = [], task.parent
-                    while node is not None and node.id not in tree.tasks:
-                        chain.append(node)
-                        node = node.parent
-                    for ancestor in reversed(chain):
-                        if ancestor.start_time is not None:
-                            self._times(ancestor.start_time, wall)
-                            above = ancestor.parent
-                            tree.change(
-                                ancestor.start_time,
-                                wall,
-                                ancestor.id,
-                                above.id if above is not None else None,
-                                ancestor.name,
-                                ancestor.kind,
-                                ancestor.path,
-                                "running",
-                            )
-                            self._count("task status")
-                    now = self._times(t if t is not None else now, wall)
-                    parent = task.parent
-                    error = origin = None
-                    if status in ("failed", "evaporated") and task.exception is not None:
-                        from pycram.trace.recorder import error_origin
-
-                        error = f"{type(task.exception).__name__}: {task.exception}"
-                        origin = error_origin(task) == task.id
-                    tree.change(
-                        now,
-                        wall,
-                        task.id,
-                        parent.id if parent is not None else None,
-                        task.name,
-                        task.kind,
-                        task.path,
-                        status,
-                        error,
-                        bool(origin),
-                    )
-                    self._count("task status")
-                elif tag == "world":
-                    _, t, wall, state, belief, maps, candidates = item
-                    now = self._times(t, wall)
-                    if world_log is not None and state is not None:
-                        self._count("body poses", world_log.log_state(state, t, wall))
-                    if world_log is not None and belief is not None:
-                        objects, containers = belief
-                        belief_names = [o.name for o in objects]
-                        world_log.log_belief(objects, containers)
-                    if maps:
-                        from .reasoning import log_costmaps
-
-                        log_costmaps(rec, maps)
-                        self._count("costmaps")
-                    if candidates is not None:
-                        from .reasoning import log_candidates
-
-                        log_candidates(rec, candidates)
-                        self._count("candidates")
-                    tree.log_current()
-                    tree.log_graph(now)
-                    self._count("world states")
-                elif tag == "motion":
-                    _, t, wall, arm, joints, path, tool = item
-                    now = self._times(t, wall)
-                    if world_log is not None and world_log.log_motion(arm, joints, path, tool):
-                        self._count("motion plans")
-                elif tag == "look":
-                    _, t, wall, state, seen = item
-                    now = self._times(t, wall)
-                    if world_log is not None and world_log.log_look(state, seen):
-                        self._count("camera images")
-                elif tag == "log":
-                    _, t, wall, level, text = item
-                    now = self._times(t if t is not None else now, wall)
-                    import rerun as rr
-
-                    rec.log(paths.LOG, rr.TextLog(text, level=level))
-                    self._count("log lines")
-                elif tag == "attach":
-                    _, model, root, items, camera, robot, run_id = item
-                    from .world import WorldLog
-
-                    world_log = WorldLog(rec, model, root, items, camera)
-                    self._count("geoms", world_log.log_geometry())
-                    import rerun as rr
-
-                    about = f"robot: {robot}" + (f"  \ntrace database run: {run_id}" if run_id is not None else "")
-                    rec.log(paths.RUN, rr.TextDocument(about, media_type="text/markdown"), static=True)
-            except Exception as error:  # never fail the run; say once why the view is missing parts
-                if not failing:
-                    log.warning("the view could not log a %s event: %s", tag, error, exc_info=True)
-                    self.error = error
-                failing = True
-            if time.monotonic() - flushed_at >= TRANSFORM_BATCH:  # what was noted, in columns
+            batch, ready, stop = [], [], None
+            while True:
+                if item[0] == "stop":
+                    stop = item[1]
+                    break
+                if item[0] == "attach":
+                    ready.append(item[-1])
                 try:
-                    tree.flush()
-                    if world_log is not None:
-                        self._count("pose columns", world_log.flush())
+                    batch.append(plain(item))
                 except Exception as error:  # noqa: BLE001 - never fail the run
-                    log.warning("the view could not log a batch: %s", error)
-                flushed_at = time.monotonic()
-            self.spent[tag] = self.spent.get(tag, 0.0) + time.perf_counter() - began
-        tree.flush()
-        tree.log_current()
-        tree.log_graph(now, force=True)
-        if world_log is not None:
-            try:
-                world_log.flush()
-            except Exception as error:  # noqa: BLE001 - closing: say it, do not fail the run
-                log.warning("the view could not log the last poses: %s", error)
-            world_log.close()
-        item[1].set()
+                    log.warning("the view could not take a %s event: %s", item[0], error)
+                if len(batch) >= BATCH_LIMIT:
+                    break
+                try:
+                    item = self._queue.get_nowait()
+                except queue.Empty:
+                    break
+            if batch and not broken:
+                try:
+                    sink.send(batch)
+                    if ready:
+                        sink.wait_ready()
+                        self.counts.update(sink.counts)
+                except (OSError, EOFError, ValueError) as error:
+                    log.warning("the view's writer stopped (%s); the rest of the run is not logged", error)
+                    self.error = self.error or f"{type(error).__name__}: {error}"
+                    broken = True
+            for event in ready:
+                event.set()
+            if stop is not None:
+                try:
+                    sink.finish()
+                except (OSError, EOFError, ValueError) as error:
+                    log.warning("the view's writer did not close the recording (%s)", error)
+                self.counts.update(sink.counts)
+                self.spent.update(sink.spent)
+                self.error = self.error or sink.error
+                stop.set()
+                return
 
-    def _times(self, t: float, wall: float) -> float:
-        self.rec.set_time(paths.SIM_TIMELINE, duration=float(t))
-        self.rec.set_time(paths.WALL_TIMELINE, timestamp=wall)
-        return float(t)
+
+class _ThreadSink:
+    """The writer in this process: the session's thread logs each batch itself."""
+
+    def __init__(self, opening: tuple[Any, ...]) -> None:
+        self.writer = ViewWriter(*opening)
+
+    @property
+    def counts(self) -> dict[str, int]:
+        return self.writer.counts
+
+    @property
+    def spent(self) -> dict[str, float]:
+        return self.writer.spent
+
+    @property
+    def error(self) -> str | None:
+        return self.writer.error
+
+    def send(self, batch: list[tuple[Any, ...]]) -> None:
+        for item in batch:
+            self.writer.handle(item)
+
+    def wait_ready(self) -> None:
+        pass
+
+    def finish(self) -> None:
+        self.writer.finish()
+
+
+class _ProcessSink:
+    """The writer in a process of its own (``python -m pycram.trace.view.writer``), fed through
+    its standard input; raises OSError when the process cannot be started."""
+
+    def __init__(self, opening: tuple[Any, ...]) -> None:
+        import os
+        import subprocess
+        import sys
+
+        import pycram
+
+        here = str(Path(pycram.__file__).resolve().parent.parent)  # this pycram, not another one
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH", "")) if p)
+        self.counts: dict[str, int] = {}
+        self.spent: dict[str, float] = {}
+        self.error: str | None = None
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "pycram.trace.view.writer"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            env=env,
+        )
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self._in, self._out = self.process.stdin, self.process.stdout
+        send_message(self._in, opening)
+
+    def send(self, batch: list[tuple[Any, ...]]) -> None:
+        send_message(self._in, batch)
+
+    def _answer(self, kind: str) -> tuple[Any, ...]:
+        answer = read_message(self._out)
+        if not (isinstance(answer, tuple) and answer and answer[0] == kind):
+            raise ValueError(f"the view's writer answered {answer!r}, not {kind!r}")
+        return answer
+
+    def wait_ready(self) -> None:
+        self.counts = dict(self._answer("ready")[1])
+
+    def finish(self, timeout: float = FLUSH_TIMEOUT + 30.0) -> None:
+        try:
+            send_message(self._in, "stop")
+            self._in.close()
+            _, counts, spent, error = self._answer("done")
+            self.counts, self.spent, self.error = dict(counts), dict(spent), error
+        finally:
+            try:
+                self.process.wait(timeout)
+            except Exception:  # noqa: BLE001 - a writer that does not end is stopped
+                self.kill()
+
+    def kill(self) -> None:
+        """Stop the writer process at once (the recording may be incomplete)."""
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
 
 
 _LEVELS = {
@@ -503,6 +584,23 @@ _LEVELS = {
     logging.ERROR: "ERROR",
     logging.CRITICAL: "CRITICAL",
 }
+
+
+def attach_views(world: Any, belief: Any = None, robot: Any = None, timeout: float = ATTACH_TIMEOUT) -> None:
+    """Attach every active view session to `world` (with `belief` and `robot`, as
+    `ViewSession.attach`) and wait until each has logged the world's geometry, at most `timeout`
+    [s of wall time] in all. A run calls it after building its world and before starting its
+    plan, so that this one-time start-up cost (~0.1 s for the apartment) is paid before the plan
+    runs rather than by the plan's first seconds. Does nothing (and imports nothing) without an
+    active session; a session that attached before is left as it is."""
+    with _active_lock:
+        sessions = list(_active)
+    deadline = time.monotonic() + timeout
+    for session in sessions:
+        ready = session.attach(world, belief, robot)
+        if not ready.wait(max(0.0, deadline - time.monotonic())):
+            log.warning("the view did not log the world's geometry within %.0f s; the run goes on", timeout)
+            return
 
 
 def find_run_folder(since: float, root: Path = Path("output")) -> Path | None:
