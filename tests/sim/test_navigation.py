@@ -3,9 +3,7 @@ appears during a drive, and a named failure when there is no way."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 
 import pytest
 from sim_helpers import Recorder, T, ok, wait_wall
@@ -111,28 +109,19 @@ def differential_tiago(tmp_path_factory):
     ``BASE["kind"] = "differential"``, registered through an entry point as another package
     would; the TIAGo itself stays omnidirectional by default, see its description)."""
     from pycram.sim import World
+    from pycram.testing.robot_packages import installed_robot_package
     from pycram.world import robot_registry
 
-    root = tmp_path_factory.mktemp("twin")
-    package = root / "differential_tiago"
-    package.mkdir()
-    (package / "__init__.py").write_text('"""The TIAGo on its differential drive."""\n')
-    source = importlib.util.find_spec(robot_registry.robot_package("tiago") + ".description").origin
-    text = open(source, encoding="utf-8").read()
-    assert 'NAME = "tiago"\n' in text and '"kind": "omnidirectional",' in text
-    text = text.replace('NAME = "tiago"\n', f'NAME = "{DIFFERENTIAL_TWIN}"\n')
-    (package / "description.py").write_text(text.replace('"kind": "omnidirectional",', '"kind": "differential",'))
-    dist = root / "differential_tiago-0.1.dist-info"
-    dist.mkdir()
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: differential-tiago\nVersion: 0.1\n")
-    (dist / "entry_points.txt").write_text(f"[pycram.robots]\n{DIFFERENTIAL_TWIN} = differential_tiago\n")
-    sys.path.insert(0, str(root))
-    try:
+    with installed_robot_package(
+        tmp_path_factory.mktemp("twin"),
+        DIFFERENTIAL_TWIN,
+        like="tiago",
+        package="differential_tiago",
+        overrides={"BASE": {"kind": "differential"}},
+    ):
         assert robot_registry.robot_description(DIFFERENTIAL_TWIN).base_kinematics.kind == "differential"
         with World(DIFFERENTIAL_TWIN) as w:
             yield w
-    finally:
-        sys.path.remove(str(root))
 
 
 def _moves_left(world) -> tuple[float, float]:

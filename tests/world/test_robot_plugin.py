@@ -4,12 +4,12 @@ it -- no module of PyCRAM names it."""
 
 from __future__ import annotations
 
-import importlib.util
 import os
-import textwrap
+import sys
 
 import pytest
 
+from pycram.testing.robot_packages import installed_robot_package
 from pycram.world import robot_registry
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -18,34 +18,16 @@ ROBOT = "tiago_twin"
 
 
 @pytest.fixture
-def installed_robot_package(tmp_path, monkeypatch):
+def installed_robot(tmp_path):
     """A package ``twin_robot`` with a description (the TIAGo's data under another name), and the
     distribution metadata that registers it (what `pip install` writes for a package whose
-    pyproject.toml says ``[project.entry-points."pycram.robots"] tiago_twin = "twin_robot"``)."""
-    package = tmp_path / "twin_robot"
-    package.mkdir()
-    (package / "__init__.py").write_text('"""A robot package outside PyCRAM."""\n')
-    source = importlib.util.find_spec(robot_registry.robot_package("tiago") + ".description").origin
-    text = open(source, encoding="utf-8").read()
-    assert 'NAME = "tiago"\n' in text
-    (package / "description.py").write_text(text.replace('NAME = "tiago"\n', f'NAME = "{ROBOT}"\n'))
-    dist = tmp_path / "twin_robot-0.1.dist-info"
-    dist.mkdir()
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: twin-robot\nVersion: 0.1\n")
-    (dist / "entry_points.txt").write_text(
-        textwrap.dedent(
-            f"""\
-            [pycram.robots]
-            {ROBOT} = twin_robot
-            """
-        )
-    )
-    monkeypatch.syspath_prepend(str(tmp_path))  # the registry reads the entry points again
-    yield
-    monkeypatch.undo()
+    pyproject.toml says ``[project.entry-points."pycram.robots"] tiago_twin = "twin_robot"``),
+    on the import path while the test runs."""
+    with installed_robot_package(tmp_path, ROBOT, like="tiago", package="twin_robot") as package:
+        yield package
 
 
-def test_a_robot_package_outside_pycram_is_registered_by_its_entry_point(installed_robot_package):
+def test_a_robot_package_outside_pycram_is_registered_by_its_entry_point(installed_robot):
     assert ROBOT in robot_registry.robot_names()
     assert {"pr2", "tiago"} <= set(robot_registry.robot_names())
     description = robot_registry.robot_description(ROBOT)
@@ -53,7 +35,7 @@ def test_a_robot_package_outside_pycram_is_registered_by_its_entry_point(install
     assert description.ARMS == robot_registry.robot_description("tiago").ARMS
 
 
-def test_the_simulator_builds_a_world_with_the_registered_robot(installed_robot_package):
+def test_the_simulator_builds_a_world_with_the_registered_robot(installed_robot):
     from pycram.backends.sim.scene import build_scene
 
     scene = build_scene(robot=ROBOT)
@@ -64,3 +46,39 @@ def test_the_simulator_builds_a_world_with_the_registered_robot(installed_robot_
 def test_without_its_entry_point_the_robot_is_unknown_and_the_error_lists_the_registered_ones():
     with pytest.raises(robot_registry.UnknownRobotError, match="Available: pr2, tiago"):
         robot_registry.robot_description(ROBOT)
+
+
+def test_leaving_the_block_unregisters_the_robot_and_forgets_its_modules(tmp_path):
+    with installed_robot_package(tmp_path, ROBOT, like="tiago", package="twin_robot"):
+        assert robot_registry.robot_description(ROBOT).NAME == ROBOT  # imports twin_robot.description
+        assert "twin_robot.description" in sys.modules
+    assert ROBOT not in robot_registry.robot_names()
+    assert str(tmp_path) not in sys.path
+    assert not [m for m in sys.modules if m.split(".")[0] == "twin_robot"]
+
+
+def test_overrides_update_a_dict_key_or_replace_a_value(tmp_path):
+    tiago = robot_registry.robot_description("tiago")
+    overrides = {"BASE": {"kind": "differential"}, "ROS": None}
+    with installed_robot_package(tmp_path, "tiago-differential", like="tiago", overrides=overrides):
+        twin = robot_registry.robot_description("tiago-differential")
+    assert twin.base_kinematics.kind == "differential" and tiago.base_kinematics.kind == "omnidirectional"
+    assert {k: v for k, v in twin.BASE.items() if k != "kind"} == {k: v for k, v in tiago.BASE.items() if k != "kind"}
+    assert twin.ROS is None and tiago.ROS is not None
+    assert twin.ARMS == tiago.ARMS
+
+
+def test_a_wrong_override_is_a_clear_error_and_writes_nothing(tmp_path):
+    from pycram.testing.robot_packages import write_robot_package
+
+    with pytest.raises(ValueError, match="override 'URDF': a mapping updates a dict of the description of 'tiago'"):
+        write_robot_package(tmp_path, "bad", overrides={"URDF": {"x": 1}})
+    with pytest.raises(ValueError, match="override 'NAME': the robot's name is the `name` argument"):
+        write_robot_package(tmp_path, "bad", overrides={"NAME": "other"})
+    with pytest.raises(ValueError, match="override 'BASE': .* is not plain data"):
+        write_robot_package(tmp_path, "bad", overrides={"BASE": {"kind": object()}})
+    with pytest.raises(ValueError, match="override 'base': description keys are UPPERCASE names"):
+        write_robot_package(tmp_path, "bad", overrides={"base": {}})
+    with pytest.raises(robot_registry.UnknownRobotError):
+        write_robot_package(tmp_path, "bad", like="nao")
+    assert list(tmp_path.iterdir()) == []

@@ -1,7 +1,7 @@
 """The `pycram` command line (typer + rich).
 
     pycram run FILE.py [ARGS...]        run a plan script (block syntax on), recorded by default
-    pycram demo [--robot pr2|tiago]...  the thesis demo in the simulated kitchen, recorded by default
+    pycram demo [--robot NAME]...       the thesis demo in the simulated kitchen, recorded by default
     pycram scene --env apartment --seed 3 -o scene.png   a labelled picture of a random scene
     pycram runs                         recorded runs, newest first, one line each (with why they failed)
     pycram show [RUN]                   a run's task tree with statuses, durations, failures

@@ -7,14 +7,16 @@ import datetime as _dt
 import logging
 import os
 import tempfile
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 import typer
 from rich.console import Console
 from rich.markup import escape
+from typer.models import OptionInfo
 
-from pycram.world.robot_registry import robot_names
+from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_names
 
 #: The `pycram` command line; each module of `pycram.apps.cli` registers its commands on it.
 app = typer.Typer(
@@ -24,8 +26,6 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-#: The help text of every `--robot` option: the registered robots.
-ROBOT_HELP = f"Robot: {' or '.join(robot_names())}."
 #: Standard output of the commands (tables, trees, results).
 console = Console(highlight=False)
 #: Standard error of the commands (errors, warnings, where a run was recorded).
@@ -111,6 +111,47 @@ def write_errors(fn: Any, *args: Any) -> Any:
         return fn(*args)
     except OSError as e:
         fail(f"cannot write {e.filename or 'the picture'}: {e.strerror or e}")
+
+
+class LiveHelpOption(OptionInfo):
+    """A `typer.Option` whose help text is ``text()`` when the command line is built -- each time
+    `pycram` runs (typer builds its click command per call, before parsing) -- rather than when
+    the module defining the option was imported: e.g. the robots registered at that time.
+    ``option`` are `typer.Option`'s keyword arguments (``default``, ``param_decls``, ...)."""
+
+    def __init__(self, text: Callable[[], str], **option: Any) -> None:
+        self._text = text
+        super().__init__(**option)
+
+    @property  # type: ignore[override]
+    def help(self) -> str:
+        """The help text, made now."""
+        return self._text()
+
+    @help.setter
+    def help(self, value: str | None) -> None:
+        """`OptionInfo.__init__` sets the static text; ``text()`` stands in for it."""
+
+
+def robot_option_help(names: Iterable[str] | None = None) -> str:
+    """The help text of a ``--robot`` option: ``Robot: 'pr2', 'tiago' or 'tiago-pro'.`` -- the
+    registered robots now, or `names`."""
+    return f"Robot: {robot_choices(names) or '(none registered)'}."
+
+
+def check_robot(name: str) -> str:
+    """`name` if a robot of that name is registered now; else a one-line error naming the
+    registered robots, exit code 2 (the callback of `RobotOption`)."""
+    if name not in robot_names():
+        fail(f"--robot must be {robot_choices()}, not {name!r}; see `pycram robot list`", code=2)
+    return name
+
+
+#: The ``--robot NAME`` option of the commands that run one robot (default: the PR2): its help
+#: lists, and its check accepts, the robots registered when the command runs.
+RobotOption: Any = LiveHelpOption(
+    robot_option_help, default=DEFAULT_ROBOT, param_decls=("--robot",), callback=check_robot
+)
 
 
 def local_time(when: _dt.datetime | None) -> str:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import typer
 
 from pycram.apps.cli.app import (
-    ROBOT_HELP,
     DbOption,
+    RobotOption,
     app,
     check_output_folder,
     fail,
@@ -15,7 +15,6 @@ from pycram.apps.cli.app import (
 )
 from pycram.apps.cli.view import LiveView, ViewHostOption, ViewOption, ViewPortOption, ViewWaitOption
 from pycram.apps.run_options import check_until
-from pycram.world.robot_registry import DEFAULT_ROBOT
 
 #: `--steal` above this is refused: the plan gives up long before (it retries a few times).
 _MAX_STEALS = 100
@@ -23,7 +22,7 @@ _MAX_STEALS = 100
 
 @app.command("demo")
 def demo_command(
-    robot: str = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP),
+    robot: str = RobotOption,
     output: str | None = typer.Option(
         None,
         "--output",

@@ -12,6 +12,7 @@ from rich.markup import escape
 
 from pycram.apps.cli.app import (
     DbOption,
+    LiveHelpOption,
     app,
     check_output_folder,
     console,
@@ -24,6 +25,16 @@ from pycram.apps.cli.view import ExperimentView, ViewHostOption, ViewPortOption,
 from pycram.world.robot_registry import DEFAULT_ROBOT, robot_names
 
 
+def _robots_help() -> str:
+    """The help text of `experiment --robot`: the robots registered now."""
+    return f"Robots, comma-separated (registered: {', '.join(robot_names())}; default: {DEFAULT_ROBOT})."
+
+
+#: `experiment --robot`: its help lists the robots registered when the command runs (the runner
+#: checks the names, exit code 2 for an unknown one).
+_RobotsOption: Any = LiveHelpOption(_robots_help, default=None, param_decls=("--robot",))
+
+
 @app.command("experiment")
 def experiment_command(
     scenario: str | None = typer.Option(
@@ -32,11 +43,7 @@ def experiment_command(
         help="Scenario: thesis (default), set-table, set-table-open, clear-table, put-away, serve, or an import "
         "path package.module:function.",
     ),
-    robot: str | None = typer.Option(
-        None,
-        "--robot",
-        help=f"Robots, comma-separated: {','.join(robot_names())} [default: {DEFAULT_ROBOT}].",
-    ),
+    robot: str | None = _RobotsOption,
     seeds: str | None = typer.Option(None, "--seeds", help="Seeds: a range 1-200, a list 1,5,9 or both (1,5,10-20)."),
     env: str | None = typer.Option(
         None,

@@ -2,18 +2,42 @@
 
 from __future__ import annotations
 
+import logging
 import math
 import os
+from typing import Any
 
 import typer
 
 from pycram.apps.cli.app import (
-    ROBOT_HELP,
+    LiveHelpOption,
     app,
     fail,
+    robot_option_help,
 )
 from pycram.environments import DEFAULT_ENVIRONMENT, ENVIRONMENT_HELP
-from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices
+from pycram.world.robot_registry import DEFAULT_ROBOT, robot_choices, robot_description, robot_names
+
+_log = logging.getLogger(__name__)
+
+
+def _ros_robots_help() -> str:
+    """The help text of `sim-ros-bridge --robot`: the registered robots whose description has a
+    ROS interface (its ``ROS`` key), now. A description that does not load is left out (the
+    help of every command is made on each `pycram` call; `pycram robot check` tells what is
+    wrong with it)."""
+    names = []
+    for name in robot_names():
+        try:
+            if robot_description(name).ROS is not None:
+                names.append(name)
+        except Exception as error:  # any error of a robot package: its own check reports it
+            _log.debug("robot %r left out of the help: %s", name, error)
+    return robot_option_help(names)
+
+
+#: `sim-ros-bridge --robot`: its help lists the robots with a ROS interface when the command runs.
+_RosRobotOption: Any = LiveHelpOption(_ros_robots_help, default=DEFAULT_ROBOT, param_decls=("--robot",))
 
 
 def object_items(values: list[str]) -> list:
@@ -55,7 +79,7 @@ def _base_pose(value: str) -> tuple[float, float, float]:
 
 @app.command("sim-ros-bridge")
 def sim_ros_bridge_command(
-    robot: str = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP),
+    robot: str = _RosRobotOption,
     item_at: int | None = typer.Option(
         None,
         "--item-at",

@@ -10,13 +10,12 @@ import typer
 from rich.markup import escape
 
 from pycram.apps.cli.app import (
-    ROBOT_HELP,
+    RobotOption,
     app,
     console,
     fail,
 )
 from pycram.environments import ENVIRONMENT_HELP
-from pycram.world.robot_registry import DEFAULT_ROBOT
 
 #: The objects `pycram scene` places by default (a breakfast).
 _SCENE_OBJECTS = "cup,bowl,spoon,cereal,milk,plate"
@@ -26,7 +25,6 @@ _SceneSeedOption = typer.Option(0, "--seed", help="Random seed of the scene (sam
 _SceneObjectsOption = typer.Option(
     _SCENE_OBJECTS, "--objects", help="Comma-separated object types to place at random ('' for none)."
 )
-_SceneRobotOption = typer.Option(DEFAULT_ROBOT, "--robot", help=ROBOT_HELP)
 _SceneSupportsOption = typer.Option(
     "",
     "--supports",
@@ -40,7 +38,7 @@ def scene_command(
     env: str = _SceneEnvOption,
     seed: int = _SceneSeedOption,
     objects: str = _SceneObjectsOption,
-    robot: str = _SceneRobotOption,
+    robot: str = RobotOption,
     supports: str = _SceneSupportsOption,
     output: Path = typer.Option(Path("scene.png"), "--output", "-o", help="PNG file to write."),
     costmap: str = typer.Option(
@@ -123,7 +121,7 @@ def costmap_command(
     env: str = _SceneEnvOption,
     seed: int = _SceneSeedOption,
     objects: str = _SceneObjectsOption,
-    robot: str = _SceneRobotOption,
+    robot: str = RobotOption,
     output: Path = typer.Option(Path("costmap.png"), "--output", "-o", help="PNG file to write."),
 ) -> None:
     """The costmap layers of a location designator over the floor plan, and the poses it chose."""
