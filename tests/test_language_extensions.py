@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import threading
 
 import pytest
@@ -441,6 +442,28 @@ def test_suspensions_count_and_evaporation_wakes_a_suspended_task() -> None:
     assert not thread.is_alive() and task.status.get_value() is TaskStatus.EVAPORATED
     wake_up(task)
     assert not is_suspended(task)
+
+
+def test_sync_suspend_leaves_no_watcher_on_the_status_fluents() -> None:
+    """The fluent a synchronous `suspend` waits on is gone when it returns, not left for the
+    garbage collector: until collected it was pulsed by every status change of the subtree
+    (issue 31: dozens piled up over 2,000 suspend/wake cycles and doubled the wake-up latency)."""
+    never = Fluent()
+    tags, thread, box = _spawn_tagged("t", lambda: never.wait_for())
+    task = tags.wait_task("t", TIMEOUT)
+    gc.disable()  # a collection would hide what is left behind
+    try:
+        for _ in range(3):
+            suspend(task)
+            assert task.status.get_value() is TaskStatus.SUSPENDED
+            wake_up(task)
+        live = [ref() for ref in task.status._children if ref() is not None]
+    finally:
+        gc.enable()
+        task.evaporate()
+        thread.join(TIMEOUT)
+    assert live == []
+    assert task.status.get_value() is TaskStatus.EVAPORATED
 
 
 def test_check_evaporation_is_a_suspension_point_and_hooks_run() -> None:
