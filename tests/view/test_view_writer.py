@@ -76,3 +76,26 @@ def test_an_unknown_event_is_reported_once_and_logging_goes_on(tmp_path):
     _, counts, _, error = read_message(answers)
     assert error == "ValueError: unknown view event 'nonsense'"
     assert counts["log lines"] == 1
+
+
+def test_ctrl_c_does_not_kill_the_writer_before_the_run_closes_it(tmp_path):
+    """The writer runs in a session of its own (a terminal's Ctrl-C reaches the run, not the
+    writer) and ignores SIGINT: the run, interrupted, still closes a whole recording."""
+    import os
+    import signal
+
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body name='b'><geom size='.1'/></body></worldbody></mujoco>"
+    )
+    session = ViewSession(rrd=tmp_path / "run.rrd").start()
+    sink = session._sink
+    assert os.getsid(sink.process.pid) != os.getsid(0)
+    sink.send([("attach", model, "b", [], None, "a robot", None)])
+    sink.wait_ready()  # (the writer is up: its signal handling is in place)
+    os.kill(sink.process.pid, signal.SIGINT)
+    _plan()
+    session.close()
+    assert session.error is None and sink.process.returncode == 0
+    assert RecordingContents.read(tmp_path / "run.rrd").rows["/tree/status"] == 13

@@ -280,7 +280,12 @@ def serve(incoming: IO[bytes], outgoing: IO[bytes]) -> int:
 
 
 def main() -> int:
-    """``python -m pycram.trace.view.writer``: serve the frames of standard input."""
+    """``python -m pycram.trace.view.writer``: serve the frames of standard input. Ctrl-C in a
+    terminal reaches the whole process group: the writer ignores it and ends with its input, so
+    an interrupted run still closes its recording."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     logging.basicConfig(level=logging.WARNING, format="pycram view writer: %(levelname)s %(name)s: %(message)s")
     incoming, outgoing = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # nothing but frames on the answer pipe
