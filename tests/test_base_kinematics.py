@@ -158,3 +158,17 @@ def test_a_differential_drive_moves_on_arcs_or_turns_then_drives():
     aside = BasePose(0.0, 1.0, 0.0)
     assert len(drive_moves(here, aside, DIFF)) == 3  # turn, drive, turn
     assert drive_moves(here, aside, BaseKinematics()) == [aside]
+
+
+def test_a_goal_within_reach_is_reached_by_turning_on_the_spot():
+    """Measured on the TIAGo: a drive stopped 1.3 mm beside its goal, whose heading was 76 deg
+    away; the next move turned 110 deg towards that offset (the direction of 1.3 mm), drove it
+    and turned back, swinging a held cup into the fridge. A goal within `reach` is one turn."""
+    from pycram.world.base_kinematics import drive_moves
+
+    here = BasePose(2.27414, 3.87399, 2.7952)
+    goal = BasePose(2.275, 3.875, 1.5282)
+    assert len(drive_moves(here, goal, DIFF)) == 3  # without a reach: towards the offset and back
+    (turn,) = drive_moves(here, goal, DIFF, reach=0.005)
+    assert (turn.x, turn.y, turn.yaw) == (here.x, here.y, goal.yaw)
+    assert len(drive_moves(here, BasePose(2.4, 3.875, 1.5282), DIFF, reach=0.005)) > 1  # farther: driven

@@ -216,17 +216,25 @@ def arc_point(x0: float, y0: float, yaw0: float, rho: float, yaw: float) -> tupl
     return x0 + rho * (math.sin(yaw) - math.sin(yaw0)), y0 - rho * (math.cos(yaw) - math.cos(yaw0))
 
 
-def drive_moves(here: BasePose, goal: BasePose, kinematics: BaseKinematics, tolerance: float = 0.02) -> list[BasePose]:
+def drive_moves(
+    here: BasePose, goal: BasePose, kinematics: BaseKinematics, tolerance: float = 0.02, reach: float = 0.0
+) -> list[BasePose]:
     """The moves a differential drive makes from where it is (``here``) to ``goal``, ``goal``
     last: the move itself when it is one a differential drive makes (`is_primitive`, within
-    `tolerance` [rad]); else, when ``goal`` lies within `MAX_TANGENT` of straight ahead (or
-    behind, up to ``max_reverse``), the arc that leaves ``here`` along its heading through
-    ``goal``'s position, then a turn to ``goal``'s heading (how a drive that ended a little off
-    its line makes its next straight move); else turn, drive, turn (`move_options`). An
-    omnidirectional base makes the move itself."""
+    `tolerance` [rad]); a turn on the spot to ``goal``'s heading, ending at ``here``'s position,
+    when ``goal``'s position is within `reach` [m] (it counts as reached: a drive that stopped
+    a few millimetres off its goal must not turn towards that offset, drive it and turn back --
+    such turns, up to half a circle, were never checked for what the arm holds); else, when
+    ``goal`` lies within `MAX_TANGENT` of straight ahead (or behind, up to ``max_reverse``),
+    the arc that leaves ``here`` along its heading through ``goal``'s position, then a turn to
+    ``goal``'s heading (how a drive that ended a little off its line makes its next straight
+    move); else turn, drive, turn (`move_options`). An omnidirectional base makes the move
+    itself."""
     if kinematics.holonomic or is_primitive(here, goal, tolerance):
         return [goal]
     dist = math.hypot(goal.x - here.x, goal.y - here.y)
+    if dist <= reach:
+        return [BasePose(here.x, here.y, goal.yaw)]
     chord = math.atan2(goal.y - here.y, goal.x - here.x)
     for backwards in (False, True):
         off = _wrap(chord - here.yaw - (math.pi if backwards else 0.0))

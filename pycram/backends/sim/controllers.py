@@ -115,6 +115,7 @@ class BaseDrive(Controller):
     ) -> None:
         self.goal, self.tol, self.yaw_tol, self.max_lag = goal, tolerance, yaw_tolerance, max_lag
         self._stops: list[Pose2D] = []
+        self._last = goal  # the last move's target: `goal`, or the turn on the spot that reaches it
         self.kinematics = BaseKinematics()
 
     def start(self, eng: Engine) -> Outcome | None:
@@ -129,10 +130,13 @@ class BaseDrive(Controller):
         p = eng.base_pose()
         self.kinematics = BaseKinematics.of(eng.desc.BASE)
         here, goal = BasePose(p.x, p.y, p.yaw), BasePose(self.goal.x, self.goal.y, self.goal.yaw)
+        self._last = self.goal
         if not self.kinematics.holonomic:
-            moves = drive_moves(here, goal, self.kinematics, self.yaw_tol)
+            # a goal within the tolerance is reached by turning on the spot (`drive_moves`)
+            moves = drive_moves(here, goal, self.kinematics, self.yaw_tol, reach=self.tol)
             self._stops = [Pose2D(m.x, m.y, m.yaw) for m in moves[:-1]]
-        self._begin(eng, self._stops[0] if self._stops else self.goal)
+            self._last = Pose2D(moves[-1].x, moves[-1].y, moves[-1].yaw)
+        self._begin(eng, self._stops[0] if self._stops else self._last)
         return None
 
     def _begin(self, eng: Engine, target: Pose2D) -> None:
@@ -191,7 +195,7 @@ class BaseDrive(Controller):
                 tol, yaw_tol = self.STOP_TOLERANCE
                 if err <= tol and yerr <= yaw_tol:
                     self._stops.pop(0)
-                    self._begin(eng, self._stops[0] if self._stops else self.goal)
+                    self._begin(eng, self._stops[0] if self._stops else self._last)
                 elif elapsed > self.duration + 3.0:
                     return fail("timeout", f"base settled {err:.3f} m / {math.degrees(yerr):.1f} deg off a stop", p)
                 return None

@@ -18,11 +18,12 @@ ROOT_LINK = "base_footprint"
 #: is still omnidirectional by default: `"differential"` (`pycram.world.base_kinematics`; it
 #: would back up at most `max_reverse` -- no laser behind it -- and arrive at / leave a pose
 #: straight along its heading over `approach`) is built and measured -- set-table development
-#: seeds 11-40 30/30, as omnidirectional -- but with it two end-to-end tests fail: on set-table
-#: seed 205 the retreat after placing the cup tips it over (it was grasped at another height
-#: after a different approach), and the run with the stuck drawer overruns its 300-s transport
-#: budget (turning on the spot costs ~1.5x the simulated time); the robot check's transport lets
-#: a side-held cup slip in the fingers while turning on the spot. See issue 34's notes.
+#: seeds 11-40 30/30, as omnidirectional; the robot check passes 31/31 and set-table seed 205
+#: is set since a drive that stops millimetres off its goal turns on the spot instead of turning
+#: towards that offset and back (that swing knocked a held cup against the fridge) -- but one
+#: end-to-end test still fails with it: the run with the stuck drawer overruns its 300-s
+#: transport round (turning on the spot costs ~1.5x the simulated time) and its second round's
+#: reach into the drawer is blocked. See issue 34's notes.
 BASE = {
     "kind": "omnidirectional",
     "max_reverse": 0.5,  # [m]
