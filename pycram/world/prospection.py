@@ -331,6 +331,15 @@ class Prospection(abc.ABC):
     ) -> list[tuple[str, str]]:
         """Like :meth:`in_collision`, but the touching pairs (robot part, environment part)."""
 
+    def drivable(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+    ) -> bool:
+        """Would navigation take ``base_pose`` as a goal, the robot arriving in
+        ``joint_configuration`` with the objects ``carried`` -- judged with navigation's own model
+        of the floor and of the robot's footprint and clearance, in this prospection's world?
+        A backend without such a model answers True (the caller's own checks decide)."""
+        return True
+
     @abc.abstractmethod
     def reachable(
         self, arm: str, poses: Sequence[Any], base_pose: Any, joint_configuration: Mapping[str, float] | None = None

@@ -252,3 +252,22 @@ def test_eight_threads_give_the_same_answers_as_one(world):
     assert not errors, errors
     for r in results:
         assert r == alone
+
+
+def test_drivable_is_the_drives_own_verdict_on_a_goal(world):
+    """Approaching the back counter head-on: where the robot still touches nothing, the drive
+    keeps its clearance and refuses a goal; `drivable` says so before the drive does (location
+    reasoning asks it, so it never offers such a goal), and agrees with it just outside."""
+    p = world.prospection()
+    start = world.base_pose.get_value()
+    poses = [(0.2, -0.3 - 0.01 * k, -math.pi / 2) for k in range(80)]  # towards the counter
+    touching = next(i for i, pose in enumerate(poses) if p.in_collision(pose))
+    refused = next(i for i, pose in enumerate(poses) if not p.drivable(pose))
+    assert all(p.drivable(pose) for pose in poses[:refused])
+    assert refused < touching  # a gap: free in 3D, but too close for the drive
+    gap, outside = poses[refused], poses[refused - 1]
+    assert not p.in_collision(gap)
+    out = world.drive_to(*gap).wait(T)
+    assert out is not None and not out.succeeded and out.reason == "no_path" and "goal_in_collision" in out.message
+    ok(world.drive_to(*outside))
+    ok(world.drive_to(start.x, start.y, start.yaw))

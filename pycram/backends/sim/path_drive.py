@@ -20,13 +20,14 @@ import mujoco
 import numpy as np
 
 from pycram.world.base_kinematics import BaseKinematics
-from pycram.world.navigation import Footprint, NoPathError, OccupancyGrid, PathPlanner
+from pycram.world.navigation import Footprint, NoPathError, PathPlanner
 from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D
 
 from .controllers import BaseDrive, Controller, fail, invalid_input
+from .drive_check import band_outlines, layered_planner
 from .engine import Engine
-from .occupancy import FloorMap, base_footprint, body_outlines, build_floor_map, local_vertices, robot_parts
+from .occupancy import FloorMap, base_footprint, build_floor_map, local_vertices, robot_parts
 from .occupancy import _add as rasterize
 from .prospection import SimProspection
 from .recording import StateSnapshot
@@ -135,9 +136,7 @@ class Navigation:
         if self._bands_of is None or not np.array_equal(state, self._bands_of):
             self._bands, self._bands_of = self._with_items(eng, self.floor.bands(eng.model, eng.data)), state
         bands = self._bands
-        parts = self._parts(eng)
-        below = body_outlines(eng.scene, eng.data, [top + 0.02 for top in bands], parts)
-        outlines = {top: below[top + 0.02] for top in bands}
+        outlines = band_outlines(eng.scene, eng.data, bands, self._parts(eng))
         # the robot's pose, to the cm
         key = np.round(np.concatenate([np.asarray(p.vertices).ravel() for o in outlines.values() for p in o]), 2)
         if (
@@ -148,9 +147,7 @@ class Navigation:
         ):
             return self._planner, False
         self._state, self._outline = state, key
-        layers = [(mask, outlines[top]) for top, mask in bands.items()]
-        nothing = OccupancyGrid(self.floor.origin, self.floor.resolution, np.zeros(self.floor.shape, bool))
-        self._planner = PathPlanner(nothing, self.footprint, layers=layers, kinematics=self.kinematics)
+        self._planner = layered_planner(self.floor, self.footprint, self.kinematics, bands, outlines)
         return self._planner, True
 
 

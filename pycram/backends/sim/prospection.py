@@ -268,6 +268,39 @@ class SimProspection(Prospection):
                 obstacles = (self._is_env | self._object_geoms()) & ~robot
             return bool(self._touching(d, robot, obstacles)[3].any())
 
+    def drivable(
+        self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
+    ) -> bool:
+        """The drive's own goal check (`PathPlanner.pose_free` of `drive_check.DriveCheck`: the
+        floor map's bands, the footprint grown by the drive's clearance, the robot's outline in
+        `joint_configuration`) in this prospection's world, the objects not `carried` in the
+        bands of their tops; where only an arm's outline is in the way, `in_collision` with the
+        objects decides, as the drive's exact check does. The planner is kept per state and
+        configuration (one designator resolution asks many poses of one state)."""
+        from .drive_check import DriveCheck
+
+        pose = as_base_pose(base_pose)
+        snap = self._snapshot()
+        configuration = tuple(sorted((str(k), float(v)) for k, v in (joint_configuration or {}).items()))
+        key = (snap.qpos.tobytes(), snap.mocap_pos.tobytes(), snap.mocap_quat.tobytes(), configuration, tuple(carried))
+        cached = getattr(self, "_drive_planner", None)
+        if cached is None or cached[0] != key:
+            with self._data() as d:
+                self._prepare(d, pose, joint_configuration)
+                check = getattr(self, "_drive_check", None)
+                if check is None:
+                    check = self._drive_check = DriveCheck(self.scene, d)
+                bodies = self.model.geom_bodyid
+                held = {self._object_body(name) for name in carried}
+                objects = [int(g) for g in np.flatnonzero(self._object_geoms()) if int(bodies[g]) not in held]
+                cached = self._drive_planner = (key, check.planner(d, objects))
+        planner = cached[1]
+
+        def exact(x: float, y: float, yaw: float) -> bool:
+            return not self.in_collision((x, y, yaw), joint_configuration, carried, objects=True)
+
+        return planner.pose_free(pose.x, pose.y, pose.yaw, exact)
+
     def _carry(self, d: mujoco.MjData, base_pose: Any, carried: Sequence[str]) -> np.ndarray:
         """Move the objects `carried` in `d` (prepared: base and joints as asked, kinematics
         computed) with the hand that holds them -- the arm whose tool frame is nearest to the

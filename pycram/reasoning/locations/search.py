@@ -182,8 +182,15 @@ class CandidateSearch:
 
     def cannot_drive_in(self, prosp: Any, base: tuple[float, float, float], configuration: Mapping[str, float]) -> bool:
         """Whether navigation would not drive the robot into `base` (x [m], y [m], yaw [rad]) in
-        `configuration`: `has_no_room` or `no_way_in`. The pose itself is checked by the caller."""
-        return self.has_no_room(prosp, base, configuration) or self.no_way_in(prosp, base, configuration)
+        `configuration`: `has_no_room`, `no_way_in`, or navigation's own goal check refuses it
+        (`Prospection.drivable`: its floor model, footprint and clearance in the believed world).
+        The pose itself is checked by the caller."""
+        drivable = getattr(prosp, "drivable", None)  # (a prospection without it: the checks above)
+        return (
+            self.has_no_room(prosp, base, configuration)
+            or self.no_way_in(prosp, base, configuration)
+            or (drivable is not None and not drivable(base, configuration, self.carried()))
+        )
 
     def has_no_room(self, prosp: Any, base: tuple[float, float, float], configuration: Mapping[str, float]) -> bool:
         """Whether the robot in `configuration`, with what it carries, touches the furniture when
