@@ -2,7 +2,8 @@
 
 Which robots exist is the robot registry's business (:mod:`pycram.world.robot_registry`: the
 ``pycram.robots`` entry points); each robot package holds ``description.py`` (data) and
-``robot.py`` (``make_robot(world)``). ``load(name, world)`` builds the :class:`pycram.robot.Robot`
+``robot.py`` (``make_robot(world)``; a package without one gets the robot every simulated robot
+is, `make_sim_robot`). ``load(name, world)`` builds the :class:`pycram.robot.Robot`
 of a simulated world; importing this package stays cheap (the robot modules, which need the
 simulation, are imported by ``load``). :mod:`pycram.robots.common` holds what every robot
 shares.
@@ -34,5 +35,15 @@ def load(name: str, world: Any) -> Any:
     """
     if name not in ROBOT_NAMES:
         raise ValueError(f"unknown robot {name!r}; available: {', '.join(ROBOT_NAMES)}")
-    module = importlib.import_module(f"{robot_package(name)}.robot")
+    robot_module = f"{robot_package(name)}.robot"
+    try:
+        module = importlib.import_module(robot_module)
+    except ModuleNotFoundError as e:
+        if e.name != robot_module:
+            raise  # the package's robot.py exists and imports something missing: say so
+        # a package with a description alone: the robot every simulated robot is
+        from pycram.robots.common.sim_robot import make_sim_robot
+        from pycram.world.robot_registry import robot_description
+
+        return make_sim_robot(world, robot_description(name))
     return module.make_robot(world)

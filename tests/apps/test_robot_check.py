@@ -10,10 +10,9 @@ the TIAGo's description changed where the test says.
 
 from __future__ import annotations
 
-import importlib.util
+import contextlib
 import json
 import os
-import sys
 import textwrap
 
 import pytest
@@ -21,6 +20,7 @@ import pytest
 from pycram.apps.robot_check import FAIL, PASS, SKIP, CheckReport, CheckResult, report_table, run_robot_check
 from pycram.apps.robot_check.motions import MOTION_CASES, motion_cases
 from pycram.apps.robot_check.reach import COUNTER_HEIGHT, SHORT_STEP, ArmEnvelope, grid
+from pycram.testing.robot_packages import installed_robot_package
 from pycram.world import robot_registry
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -57,47 +57,20 @@ def test_the_short_form_passes_for_every_registered_robot(robot_name):
 
 # -- broken robots ----------------------------------------------------------------------------------
 
-_ROBOT_PY = '''\
-"""A robot package outside PyCRAM: the robot of a simulated world, from its description."""
-from pycram.robots.common.sim_robot import make_sim_robot
-from pycram.world.robot_registry import robot_description
-
-
-def make_robot(world):
-    return make_sim_robot(world, robot_description({name!r}))
-'''
-
 
 @pytest.fixture
-def register_robot(tmp_path, monkeypatch):
+def register_robot(tmp_path):
     """Registers a robot package ``NAME`` with the TIAGo's description under that name plus
     `changes` (module code appended to the description), as `pip install` of a package
-    declaring ``[project.entry-points."pycram.robots"] NAME = "<package>"`` would."""
+    declaring ``[project.entry-points."pycram.robots"] NAME = "<package>"`` would
+    (`pycram.testing.robot_packages`; each in a folder of its own, forgotten after the test)."""
+    with contextlib.ExitStack() as registered:
 
-    packages: list[str] = []
+        def register(name: str, changes: str) -> str:
+            registered.enter_context(installed_robot_package(tmp_path / name, name, changes=textwrap.dedent(changes)))
+            return name
 
-    def register(name: str, changes: str) -> str:
-        package = tmp_path / name.replace("-", "_")
-        packages.append(package.name)
-        package.mkdir()
-        (package / "__init__.py").write_text('"""A robot package outside PyCRAM."""\n')
-        source = importlib.util.find_spec(robot_registry.robot_package("tiago") + ".description").origin
-        text = open(source, encoding="utf-8").read()
-        assert 'NAME = "tiago"\n' in text
-        text = text.replace('NAME = "tiago"\n', f'NAME = "{name}"\n') + "\n" + textwrap.dedent(changes)
-        (package / "description.py").write_text(text)
-        (package / "robot.py").write_text(_ROBOT_PY.format(name=name))
-        dist = tmp_path / f"{package.name}-0.1.dist-info"
-        dist.mkdir()
-        (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {package.name}\nVersion: 0.1\n")
-        (dist / "entry_points.txt").write_text(f"[pycram.robots]\n{name} = {package.name}\n")
-        monkeypatch.syspath_prepend(str(tmp_path))  # the registry reads the entry points again
-        return name
-
-    yield register
-    monkeypatch.undo()
-    for module in [m for m in sys.modules if m.split(".")[0] in packages]:
-        del sys.modules[module]  # the next test's package of the same name is its own
+        yield register
 
 
 #: An arm whose joint chain lists only the wrist: the description names two of its seven joints,

@@ -82,3 +82,21 @@ def test_a_wrong_override_is_a_clear_error_and_writes_nothing(tmp_path):
     with pytest.raises(robot_registry.UnknownRobotError):
         write_robot_package(tmp_path, "bad", like="nao")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_package_with_a_description_alone_loads_as_a_simulated_robot(installed_robot, tmp_path):
+    """`pycram.robots.load` makes the robot every simulated robot is (`make_sim_robot`) when the
+    package has no ``robot.py``; a ``robot.py`` that fails to import says why."""
+    from pycram import robots
+    from pycram.sim import World
+
+    with World(ROBOT) as world:
+        robot = robots.load(ROBOT, world)
+        try:
+            assert robot.description.NAME == ROBOT
+            assert {"navigation", "perception"} <= set(robot.process_modules)
+        finally:
+            robot.shutdown()
+        (installed_robot / "robot.py").write_text("import no_such_module_for_pycram\n")
+        with pytest.raises(ModuleNotFoundError, match="no_such_module_for_pycram"):
+            robots.load(ROBOT, world)
