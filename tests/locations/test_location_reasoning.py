@@ -317,3 +317,22 @@ def test_pushing_a_door_checks_each_tool_pose_with_the_door_where_it_will_be_and
         next(no_push.generator(LocationDesignator([("to_open", "fridge"), ("pushing", "outside")])))
     with pytest.raises(NoSolutionError, match="only doors are pushed"):
         next(reasoner.generator(LocationDesignator([("to_open", "drawer 1"), ("pushing", "outside")])))
+
+
+def test_a_grasp_that_turns_the_base_is_checked_facing_where_it_turns():
+    """A directional grasp (the milk's) sets the base's heading; the pose is checked at that
+    heading, not only facing the object: where the robot collides at every heading a milk grasp
+    would turn it to, no pose is offered (measured: the TIAGo Pro's rectangular base was checked
+    at 1.79 rad and offered at 1.57 rad, which navigation refused)."""
+    milk = KnownObject("milk", "milk", (4.3, 1.7, 0.85), yaw=0.3)
+    headings = [0.3 + side + math.pi for side in (0.0, math.pi, math.pi / 2, -math.pi / 2)]
+
+    def turned(pose):
+        return any(abs((pose[2] - h + math.pi) % (2 * math.pi) - math.pi) < 1e-6 for h in headings)
+
+    rs, _ = resolver_set(prospection=ScriptedProspection(collides=turned))
+    with rs, pytest.raises(NoSolutionError, match="in collision"):
+        LocationDesignator([("to_reach", milk)]).reference()
+    rs, _ = resolver_set()  # free everywhere: the same designator has its solutions
+    with rs:
+        assert LocationDesignator([("to_reach", milk)]).reference().grasp in ("+x", "-x", "+y", "-y")

@@ -166,9 +166,19 @@ class ReachVocabulary(StandingSearch):
                 best = float(maps[arm].layers["grasp"][r, c])
                 options = [o for o in options if o[5] is None or o[0] <= best + RANK_SLACK]
 
-            def sequences(configuration: dict[str, float]) -> tuple[BaseLocation | None, tuple[str, str | None]]:
+            def sequences(
+                configuration: dict[str, float], arrival: dict[str, float]
+            ) -> tuple[BaseLocation | None, tuple[str, str | None]]:
+                """The first option whose grasp sequence the arm reaches in `configuration`;
+                `arrival`: the robot as it comes (the base pose was checked with it facing
+                `natural`: an option that turns the base otherwise is checked anew)."""
                 failure: tuple[str, str | None] = ("no fitting grasp", None)
                 for _, grasp, yaw, point, heading, candidate in options:
+                    if abs(_wrap(yaw - natural)) > 1e-6:
+                        turned = self._base_refused(prosp, (x, y, yaw), arrival, configuration)
+                        if turned is not None:
+                            failure = (turned, None)
+                            continue
                     poses = grasp_sequence(self.geometry, point, heading, grasp.approach, action)
                     if drawer is not None:
                         poses = self._clear_of_the_rim(poses, grasp, drawer.rim_height, action)
@@ -211,7 +221,7 @@ class ReachVocabulary(StandingSearch):
                     if torsos == "current":
                         return None, failure
                 else:
-                    found, failure = sequences(raised)
+                    found, failure = sequences(raised, coming)
                     if found is not None and lifted:
                         found = replace(found, arrival=lifted)
                     if found is not None or torsos == "current":
@@ -226,7 +236,7 @@ class ReachVocabulary(StandingSearch):
                     or self.cannot_drive_in(prosp, (x, y, natural), {**tucked, joint: height})
                 ):
                     continue
-                other, why = sequences({**raised, joint: height})
+                other, why = sequences({**raised, joint: height}, {**tucked, joint: height})
                 if other is not None:
                     return replace(other, torso=torso), None
                 failure = why
@@ -273,6 +283,26 @@ class ReachVocabulary(StandingSearch):
             raise NoSolutionError(
                 f"{why}; with the torso higher: {str(error).split(': ', 1)[-1]}", designator=desig
             ) from error
+
+    def _base_refused(
+        self,
+        prosp: Any,
+        base: tuple[float, float, float],
+        arrival: dict[str, float],
+        raised: dict[str, float],
+    ) -> str | None:
+        """Why the robot may not stand at `base` (x [m], y [m], yaw [rad]) -- coming in
+        `arrival`, the arm raised to `raised` there -- or None: what `to_reach` checks of a base
+        pose facing the object, for a grasp that turns the base to another heading (measured: the
+        TIAGo Pro's rectangular base checked facing the milk carton, 1.79 rad, offered at 1.57
+        rad, which navigation refused)."""
+        if prosp.in_collision(base, arrival, self.carried(), objects=True):
+            return "in collision"
+        if self.cannot_drive_in(prosp, base, arrival):
+            return NO_WAY_IN
+        if prosp.in_collision(base, raised):
+            return f"arm hits the furniture when raised to approach (base turned to {base[2]:.2f} rad)"
+        return None
 
     def _gripper(self, arm: str) -> GripperGeometry:
         """The gripper of `arm` as grasp planning needs it (the robot's description)."""
