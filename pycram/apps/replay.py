@@ -1,7 +1,7 @@
 """Replaying a recorded run: what a run stores to run again, running it again, comparing.
 
-A run recorded by `pycram demo` (thesis, set-table, set-table-open) or by `pycram experiment`
-keeps two objects in its ``info`` (`pycram.trace.fingerprint.recording_info`):
+A run recorded by `pycram demo` (thesis, set-table, set-table-open, set-table-anywhere) or by
+`pycram experiment` keeps two objects in its ``info`` (`pycram.trace.fingerprint.recording_info`):
 
 * ``replay``: what defines the run -- ``scenario``, ``robot``, ``environment``, ``seed``,
   ``stepping``, ``backend``, the scenario's ``options`` (e.g. ``item_at``, ``steal``,
@@ -42,7 +42,15 @@ __all__ = [
 log = logging.getLogger("pycram.replay")
 
 #: The scenarios a recorded run can be replayed for (`pycram demo --scenario`).
-REPLAYABLE_SCENARIOS = ("thesis", "set-table", "set-table-open", "clear-table", "put-away", "serve")
+REPLAYABLE_SCENARIOS = (
+    "thesis",
+    "set-table",
+    "set-table-open",
+    "set-table-anywhere",
+    "clear-table",
+    "put-away",
+    "serve",
+)
 #: The household tasks of the suite among them, by name -> the module holding their `TASK`.
 _TASKS = {
     "clear-table": "pycram.apps.scenarios.clear_table.driver",
@@ -206,7 +214,8 @@ def rerun(
                     int(replay["seed"]),
                     frozenset(options.get("faults", ())),
                     output=folder if pictures else None,
-                    in_containers=scenario == "set-table",
+                    in_containers=scenario != "set-table-open",
+                    starts="anywhere" if scenario == "set-table-anywhere" else "narrow",
                     stepping=replay["stepping"],
                     until=until,
                     until_folder=folder,

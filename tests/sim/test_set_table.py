@@ -148,23 +148,30 @@ def test_the_demo_command_runs_a_scenario_through_its_registered_front_end(tmp_p
     from pycram.apps.experiments.scenarios import demo_scenario_names
     from pycram.apps.scenarios.set_table import display
 
-    assert demo_scenario_names() == ["set-table", "set-table-open", "clear-table", "put-away", "serve"]
+    assert demo_scenario_names() == [
+        "set-table",
+        "set-table-open",
+        "set-table-anywhere",
+        "clear-table",
+        "put-away",
+        "serve",
+    ]
     started = []
 
     class Stopped(Exception):
         pass
 
     def run_scenario(robot, seed, kinds, **options):
-        started.append((robot, seed, options["in_containers"]))
+        started.append((robot, seed, options["in_containers"], options["starts"]))
         raise Stopped
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(display, "run_scenario", run_scenario)
-    for scenario in ("set-table", "set-table-open"):
+    for scenario in ("set-table", "set-table-open", "set-table-anywhere"):
         args = ["demo", "--scenario", scenario, "--robot", "tiago", "--seed", "3", "--no-record", "-q"]
         result = CliRunner().invoke(app, args)
         assert isinstance(result.exception, Stopped), result.output
-    assert started == [("tiago", 3, True), ("tiago", 3, False)]
+    assert started == [("tiago", 3, True, "narrow"), ("tiago", 3, False, "narrow"), ("tiago", 3, True, "anywhere")]
 
 
 def _assert_set(out: dict, objects: tuple[str, ...] = OBJECTS) -> None:
@@ -358,7 +365,7 @@ def test_the_pr2_carries_two_objects_at_once_and_looks_for_the_next_while_drivin
 
 
 def test_the_two_scenarios_write_the_pictures_of_a_seed_to_folders_of_their_own(monkeypatch):
-    """`set-table` and `set-table-open` runs of the same seed and robot do not overwrite each
+    """`set-table`, `set-table-open` and `set-table-anywhere` runs of the same seed and robot do not overwrite each
     other's pictures (the run itself is replaced: only the folder it is given is under test)."""
     folders = []
 
@@ -370,10 +377,14 @@ def test_the_two_scenarios_write_the_pictures_of_a_seed_to_folders_of_their_own(
         raise Stopped
 
     monkeypatch.setattr(driver, "run_scenario", run_scenario)
-    for run in (set_table.run_set_table, set_table.run_set_table_on_open_surfaces):
+    for run in (set_table.run_set_table, set_table.run_set_table_on_open_surfaces, set_table.run_set_table_anywhere):
         with pytest.raises(Stopped):
             run("pr2", 7, pictures=True)
-    assert folders == [Path("output") / "set-table-pr2-7", Path("output") / "set-table-open-pr2-7"]
+    assert folders == [
+        Path("output") / "set-table-pr2-7",
+        Path("output") / "set-table-open-pr2-7",
+        Path("output") / "set-table-anywhere-pr2-7",
+    ]
 
 
 def test_the_stuck_fault_sticks_a_drawer_the_one_holding_the_cup_if_any():

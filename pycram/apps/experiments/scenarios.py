@@ -355,6 +355,14 @@ register_scenario(
     environment="apartment",
 )
 register_scenario(
+    "set-table-anywhere",
+    "pycram.apps.scenarios.set_table:run_set_table_anywhere",
+    demo="pycram.apps.scenarios.set_table.display:main_anywhere",
+    description="set the table, all six breakfast types starting anywhere the robot reaches: whole worktops, "
+    "drawers, fridge shelves, cupboard (issue 33)",
+    environment="apartment",
+)
+register_scenario(
     "clear-table",
     "pycram.apps.scenarios.clear_table:run_clear_table",
     demo="pycram.apps.scenarios.clear_table.display:main",

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import random
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -94,26 +94,30 @@ def draw_starts(
     environment: Environment,
     stream: str,
     types: Sequence[str],
-    surfaces: Sequence[str],
+    surfaces: Sequence[str] | Mapping[str, Sequence[str]],
     reach: Any = None,
+    among_placed: bool = False,
 ) -> tuple[list[Any], dict[tuple[str, bool], int]]:
     """Start spots (`Placement`s, each object named by its type) for `types`, one after the
-    other, drawn from `random.Random(stream)` uniformly over the union of `surfaces`, clear of the
-    objects drawn before and -- with `reach` (a `ReachabilityFilter`) -- where some standing pose
-    grasps the object. The same stream gives the same spots. Raises `NoStartSpot` naming the
-    object when none is found."""
+    other, drawn from `random.Random(stream)` uniformly over the union of `surfaces` (surface
+    names -- open surfaces or insides of containers --, or per object type: type -> names), clear
+    of the objects drawn before and -- with `reach` (a `ReachabilityFilter`) -- where some
+    standing pose grasps the object; with `among_placed`, the filter counts the objects drawn
+    before as the robot's location reasoning counts believed objects (`draw_spot`). The same
+    stream gives the same spots. Raises `NoStartSpot` naming the object when none is found."""
     from pycram.apps.scenarios.reachability import draw_spot
 
     rng = random.Random(stream)
     placed: list[Any] = []
     checked: dict[tuple[str, bool], int] = {}
     for type_name in types:
-        spot, counts = draw_spot(rng, environment, type_name, surfaces, placed, reach)
+        sources = surfaces[type_name] if isinstance(surfaces, Mapping) else surfaces
+        spot, counts = draw_spot(rng, environment, type_name, sources, placed, reach, among_placed=among_placed)
         for key, n in counts.items():
             checked[key] = checked.get(key, 0) + n
         if spot is None:
             raise NoStartSpot(
-                f"no free spot on {', '.join(surfaces)} of {environment.name} where the robot reaches a "
+                f"no free spot on {', '.join(sources)} of {environment.name} where the robot reaches a "
                 f"{type_name} (beside {', '.join(p.name for p in placed) or 'nothing'}); try another seed"
             )
         placed.append(spot)

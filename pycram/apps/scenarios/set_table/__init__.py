@@ -3,7 +3,10 @@
 From a seed, the objects of `OBJECTS` start at random spots on the kitchen counter and the
 drawer cabinet's top (`START_REGIONS`), the cup in about a third of the seeds inside the closed
 drawer 2 or the closed cupboard instead (`START_CONTAINERS`; not in the ``set-table-open``
-scenario; nothing starts in the fridge yet, see `docs/set-table.md`). The robot starts at the
+scenario; nothing starts in the fridge yet, see `docs/set-table.md`). The ``set-table-anywhere``
+scenario (start mode ``anywhere``, `STARTS`) draws all six breakfast types (`ANYWHERE_OBJECTS`)
+over the whole worktops and inside the drawers, the fridge and the cupboard, wherever some
+standing pose of the robot reaches them (`anywhere_scene`). The robot starts at the
 apartment's start pose, knowing nothing about the objects, and runs `plan.set_table` for the
 place settings of `SETTINGS` (stated relative to the table's edge at the seat). The simulator's
 ground truth is used for judging only (`judge`): every object upright at its place setting
@@ -37,6 +40,7 @@ The modules, one concept each:
 """
 
 from pycram.apps.scenarios.set_table.data import (
+    ANYWHERE_OBJECTS,
     FAULTS,
     MAX_TILT,
     OBJECTS,
@@ -46,16 +50,27 @@ from pycram.apps.scenarios.set_table.data import (
     START_CONTAINERS,
     START_REGIONS,
     START_SPACING,
+    STARTS,
     TOLERANCE,
 )
 from pycram.apps.scenarios.set_table.display import main
-from pycram.apps.scenarios.set_table.driver import run_scenario, run_set_table, run_set_table_on_open_surfaces
+from pycram.apps.scenarios.set_table.driver import (
+    run_scenario,
+    run_set_table,
+    run_set_table_anywhere,
+    run_set_table_on_open_surfaces,
+)
 from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import ObjectResult, SetTableResult, judge
-from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
+from pycram.apps.scenarios.set_table.scene import anywhere_scene, anywhere_sources, place_settings, start_scene
 
 __all__ = [
     "OBJECTS",
+    "ANYWHERE_OBJECTS",
+    "STARTS",
+    "anywhere_scene",
+    "anywhere_sources",
+    "run_set_table_anywhere",
     "START_REGIONS",
     "START_CONTAINERS",
     "START_SPACING",

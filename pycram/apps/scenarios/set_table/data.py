@@ -13,6 +13,9 @@ import math
 __all__ = [
     "SCENARIOS",
     "OBJECTS",
+    "STARTS",
+    "ANYWHERE_OBJECTS",
+    "ANYWHERE_SOURCE_KINDS",
     "START_REGIONS",
     "START_CONTAINERS",
     "START_SPACING",
@@ -29,10 +32,25 @@ __all__ = [
 ]
 
 #: The scenarios of `pycram demo --scenario`.
-SCENARIOS = ("thesis", "set-table", "set-table-open")
+SCENARIOS = ("thesis", "set-table", "set-table-open", "set-table-anywhere")
+#: The start modes of the scene (`start_scene(..., starts=)`): ``narrow`` -- the measured strips
+#: of `START_REGIONS` and the containers of `START_CONTAINERS` (the ``set-table`` and
+#: ``set-table-open`` scenarios); ``anywhere`` -- the ``set-table-anywhere`` scenario: every
+#: object of `ANYWHERE_OBJECTS` anywhere on the worktops and inside every container it is found
+#: in, wherever some standing pose of the robot reaches it
+#: (`pycram.apps.scenarios.reachability.ReachabilityFilter`).
+STARTS = ("narrow", "anywhere")
 #: The objects of the breakfast setting, in the order they are brought (types both robots grasp
 #: reliably: spoons are too thin for the fingers, cereal boxes push away; see the docs).
 OBJECTS = ("plate", "bowl", "cup", "milk")
+#: The objects of the breakfast setting in the ``anywhere`` starts, in the order they are
+#: brought: all six breakfast types.
+ANYWHERE_OBJECTS = ("plate", "bowl", "cup", "spoon", "cereal", "milk")
+#: Where objects start in the ``anywhere`` starts: the whole of the environment's open surfaces
+#: of these kinds (`pycram.world.environment.Surface.kind`: the counters, the cabinet top, the
+#: cookers; front to back) and the insides of every container (drawers, fridge shelves, the
+#: cupboard) of a kind the object type is found on (`pycram.world.objects.ObjectType.found_on`).
+ANYWHERE_SOURCE_KINDS = ("counter", "cooker")
 #: Where objects start, as data: object type -> the supports (surface names) it may start on,
 #: each with the region (x0, y0, x1, y1) [m, map] where it may stand: the front strips of the
 #: kitchen counter and of the drawer cabinet's top. Measured: the counter's back half is out of
@@ -73,12 +91,15 @@ SCENE_DRAWS = 20
 SEAT = "table south"
 #: The place settings, as data: object type -> (sideways [m], to the right of the seat's
 #: heading; inwards [m], from the table's edge at the seat). The plate in front of the seat, the
-#: bowl left of it, the cup right, the milk beyond the cup.
+#: bowl left of it, the cup right, the milk beyond the cup; the spoon left of the bowl, the
+#: cereal beyond the bowl (brought in the ``anywhere`` starts only).
 SETTINGS: dict[str, tuple[float, float]] = {
     "plate": (0.0, 0.2),
     "bowl": (-0.3, 0.2),
     "cup": (0.28, 0.18),
     "milk": (0.5, 0.2),
+    "spoon": (-0.47, 0.18),  # left of the bowl (a top grasp reaches about 0.25 m in from the edge)
+    "cereal": (-0.3, 0.45),  # beyond the bowl (a side grasp reaches that far in)
 }
 #: The fault kinds `run_set_table` / `pycram demo --faults` accept.
 FAULTS = ("moved", "taken", "stuck", "obstacle", "missed")

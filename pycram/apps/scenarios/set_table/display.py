@@ -13,16 +13,22 @@ from pathlib import Path
 from typing import Any
 
 from pycram.apps.run_options import check_stepping, check_until
-from pycram.apps.scenarios.set_table.data import OBJECTS
-from pycram.apps.scenarios.set_table.driver import _check, record_replay_info, run_scenario
+from pycram.apps.scenarios.set_table.driver import (
+    _check,
+    check_starts,
+    default_objects,
+    record_replay_info,
+    run_scenario,
+    scenario_name,
+)
 from pycram.apps.scenarios.set_table.judge import SetTableResult
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
-__all__ = ["main", "main_on_open_surfaces"]
+__all__ = ["main", "main_on_open_surfaces", "main_anywhere"]
 
 
-def _output_folder(robot: str, seed: int, run_id: Any) -> Path:
-    stem = f"set-table-{robot}-{seed}"
+def _output_folder(robot: str, seed: int, run_id: Any, scenario: str = "set-table") -> Path:
+    stem = f"{scenario}-{robot}-{seed}"
     return Path("output") / (f"{stem}-{run_id}" if run_id is not None else f"{stem}-{time.strftime('%Y%m%d-%H%M%S')}")
 
 
@@ -38,6 +44,7 @@ def main(
     in_containers: bool = True,
     stepping: str | None = None,
     until: float | None = None,
+    starts: str = "narrow",
 ) -> int:
     """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
     tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
@@ -56,6 +63,7 @@ def main(
 
     def checks() -> tuple[frozenset[str], str]:
         kinds = _check(robot, seed, faults)
+        check_starts(starts)
         checked_stepping = check_stepping(stepping)
         check_until(until)
         return kinds, checked_stepping
@@ -65,8 +73,8 @@ def main(
         return 2
     (kinds, stepping), recorder = started
     run_id = recorder.run_id if recorder is not None else None
-    folder = Path(output) if output else _output_folder(robot, seed, run_id)
-    live, progress = live_line(quiet, len(OBJECTS))
+    folder = Path(output) if output else _output_folder(robot, seed, run_id, scenario_name(in_containers, starts))
+    live, progress = live_line(quiet, len(default_objects(starts)))
     result: SetTableResult | None = None
     task = None
     try:
@@ -83,13 +91,21 @@ def main(
             in_containers=in_containers,
             stepping=stepping,
             until=until,
+            starts=starts,
         )
     finally:
         if live is not None:
             live.stop()
         if recorder is not None:
             record_replay_info(
-                recorder, result, task, in_containers=in_containers, stepping=stepping, pictures=True, until=until
+                recorder,
+                result,
+                task,
+                in_containers=in_containers,
+                stepping=stepping,
+                pictures=True,
+                until=until,
+                starts=starts,
             )
             run_id = finish_recording(recorder, result)
     return report_run(
@@ -109,3 +125,10 @@ def main_on_open_surfaces(**options: Any) -> int:
     """`pycram demo --scenario set-table-open`: :func:`main` with every object starting on an open
     surface (none in a closed container)."""
     return main(in_containers=False, **options)
+
+
+def main_anywhere(**options: Any) -> int:
+    """`pycram demo --scenario set-table-anywhere`: :func:`main` with the ``anywhere`` starts --
+    all six breakfast types anywhere on the worktops and inside the containers, wherever some
+    standing pose of the robot reaches them."""
+    return main(starts="anywhere", **options)

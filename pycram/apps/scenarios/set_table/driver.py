@@ -5,8 +5,10 @@ time limits, the faults alongside, then the judge.
 the start pose; `run_scenario` runs the plan (`plan.set_table`) once, with the faults of
 `FAULTS`, within `SIM_TIME_LIMIT` [s of simulated time] and `WALL_TIME_LIMIT` [s of wall time],
 and judges the outcome with the simulator's truth (`judge`); it never raises for a failure of
-the plan. `run_set_table` and `run_set_table_on_open_surfaces` are the ``set-table`` and
-``set-table-open`` scenarios of `pycram experiment` (headless, JSON-serialisable results).
+the plan. `run_set_table`, `run_set_table_on_open_surfaces` and `run_set_table_anywhere` are the
+``set-table``, ``set-table-open`` and ``set-table-anywhere`` scenarios of `pycram experiment`
+(headless, JSON-serialisable results): the ``narrow`` starts of `START_REGIONS` (with or without
+`START_CONTAINERS`), or the ``anywhere`` starts of `anywhere_scene`.
 """
 
 from __future__ import annotations
@@ -14,16 +16,25 @@ from __future__ import annotations
 import logging
 import random
 import time
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 from pycram.apps.run_options import check_until
 from pycram.apps.scenarios.common.driver import ScenarioPlan, play, start_pictures
-from pycram.apps.scenarios.set_table.data import FAULTS, MISS_PROBABILITY, OBJECTS, SIM_TIME_LIMIT, WALL_TIME_LIMIT
+from pycram.apps.scenarios.set_table.data import (
+    ANYWHERE_OBJECTS,
+    FAULTS,
+    MISS_PROBABILITY,
+    OBJECTS,
+    SIM_TIME_LIMIT,
+    STARTS,
+    WALL_TIME_LIMIT,
+)
 from pycram.apps.scenarios.set_table.faults import Faults, check_faults
 from pycram.apps.scenarios.set_table.judge import SetTableResult, judge
 from pycram.apps.scenarios.set_table.plan import PlaceSetting, PlanRecord, SettingOutcome
-from pycram.apps.scenarios.set_table.scene import place_settings, start_scene
+from pycram.apps.scenarios.set_table.scene import anywhere_scene, place_settings, start_scene
 from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 
 __all__ = [
@@ -32,6 +43,9 @@ __all__ = [
     "run_scenario",
     "run_set_table",
     "run_set_table_on_open_surfaces",
+    "run_set_table_anywhere",
+    "scenario_name",
+    "default_objects",
 ]
 
 log = logging.getLogger("pycram.demo")
@@ -51,26 +65,55 @@ class _PlanThread(ScenarioPlan):
         return set_table(self.settings, record)
 
 
+def check_starts(starts: str) -> str:
+    """`starts` checked: one of `STARTS` (ValueError naming them otherwise)."""
+    if starts not in STARTS:
+        raise ValueError(f"unknown start mode {starts!r}; valid start modes: {', '.join(STARTS)}")
+    return starts
+
+
+def default_objects(starts: str) -> tuple[str, ...]:
+    """The object types brought by default with the start mode `starts`: `OBJECTS` (``narrow``)
+    or all six breakfast types, `ANYWHERE_OBJECTS` (``anywhere``)."""
+    return ANYWHERE_OBJECTS if check_starts(starts) == "anywhere" else OBJECTS
+
+
+def scenario_name(in_containers: bool = True, starts: str = "narrow") -> str:
+    """The scenario's name for these options: ``set-table``, ``set-table-open`` or
+    ``set-table-anywhere`` (output folders, recorded runs, experiments)."""
+    if check_starts(starts) == "anywhere":
+        return "set-table-anywhere"
+    return "set-table" if in_containers else "set-table-open"
+
+
 def open_world(
     robot: str,
     seed: int,
     faults: frozenset[str] = frozenset(),
-    objects: tuple[str, ...] = OBJECTS,
+    objects: tuple[str, ...] | None = None,
     in_containers: bool = True,
     stepping: str = DEFAULT_STEPPING,
     offscreen_size: tuple[int, int] | None = None,
+    starts: str = "narrow",
 ) -> tuple[Any, list[Any]]:
-    """The apartment with the scenario's objects at random spots from `seed` (`start_scene`,
-    some inside closed containers with `in_containers`) and `robot` at the start pose
-    (perception misses detections with the ``missed`` fault), simulated with `stepping` ("free"
-    or "lockstep", see `pycram.sim.World`; `offscreen_size` [px]: the largest picture it renders,
-    None for the world's default). Returns the world and the placements."""
+    """The apartment with the scenario's objects (default: `default_objects`) at random spots
+    from `seed` and `robot` at the start pose (perception misses detections with the ``missed``
+    fault), simulated with `stepping` ("free" or "lockstep", see `pycram.sim.World`;
+    `offscreen_size` [px]: the largest picture it renders, None for the world's default). The
+    spots: with `starts` ``narrow`` those of `start_scene` (some inside closed containers with
+    `in_containers`), with ``anywhere`` those of `anywhere_scene` for `robot`. Returns the world
+    and the placements."""
     from pycram.backends.sim import ItemSpec, World
     from pycram.backends.sim.perception import PerceptionFaults
     from pycram.environments import load as load_environment
     from pycram.world.objects import object_type
 
-    placements = start_scene(load_environment("apartment"), seed, objects, in_containers)
+    objects = default_objects(starts) if objects is None else tuple(objects)
+    environment = load_environment("apartment")
+    if starts == "anywhere":
+        placements = anywhere_scene(environment, seed, robot, objects)
+    else:
+        placements = start_scene(environment, seed, objects, in_containers)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
     size: dict[str, Any] = {"offscreen_size": offscreen_size} if offscreen_size is not None else {}
@@ -97,17 +140,20 @@ def run_scenario(
     output: Path | None = None,
     animation: bool = False,
     progress: Any = None,
-    objects: tuple[str, ...] = OBJECTS,
+    objects: tuple[str, ...] | None = None,
     in_containers: bool = True,
     stepping: str = DEFAULT_STEPPING,
     until: float | None = None,
     until_folder: Path | None = None,
+    starts: str = "narrow",
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
     `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
     faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
-    objects may start inside closed containers (`start_scene`); `stepping`: "lockstep" for a
+    objects may start inside closed containers (`start_scene`); `starts`: the start mode
+    (`STARTS`: ``narrow`` or ``anywhere``, see `open_world`); `objects`: the types to bring
+    (default: `default_objects`); `stepping`: "lockstep" for a
     run that depends on the seed alone (see `pycram.sim.World`); `until` [s of simulated time]:
     stop the world there, write the scene and belief pictures and the task tree of that moment
     (`write_stop_pictures`) into a folder ``until-T.Ts`` below `until_folder` (default: `output`,
@@ -118,10 +164,14 @@ def run_scenario(
 
     kinds = _check(robot, seed, faults)
     check_until(until)
+    objects = default_objects(starts) if objects is None else tuple(objects)
+    scenario = scenario_name(in_containers, starts)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
     size = STOP_PICTURE_SIZE if until is not None else None
-    world, placements = open_world(robot, seed, kinds, objects, in_containers, stepping, offscreen_size=size)
+    world, placements = open_world(
+        robot, seed, kinds, objects, in_containers, stepping, offscreen_size=size, starts=starts
+    )
     result.started_in = {p.name: p.container for p in placements if p.container is not None}
     plan: _PlanThread | None = None
     injector: Faults | None = None
@@ -132,7 +182,7 @@ def run_scenario(
         if recorder is not None:
             recorder.set_run_info(robot=robot)
         camera = "overview"
-        start_pictures(world, output, camera, animation, _caption)
+        start_pictures(world, output, camera, animation, partial(_caption, len(settings)))
         injector = Faults(world, kinds, random.Random(seed * 7919 + 17), settings, placements)
         plan = _PlanThread(robot_handle, settings)
         play(
@@ -144,7 +194,7 @@ def run_scenario(
             wall_limit=WALL_TIME_LIMIT,
             progress=progress,
             until=until,
-            folder=lambda: until_folder or output or Path("output") / f"set-table-{robot}-{seed}",
+            folder=lambda: until_folder or output or Path("output") / f"{scenario}-{robot}-{seed}",
             title=f"set table · {robot} · seed {seed}",
             belief=robot_handle.belief,
             judge=lambda outcomes: judge(world, settings, outcomes, result),
@@ -171,6 +221,7 @@ def record_replay_info(
     stepping: str,
     pictures: bool,
     until: float | None = None,
+    starts: str = "narrow",
 ) -> None:
     """Store in the recorded run's info what `pycram replay` needs to run it again and -- for a
     run that ended by itself (not stopped by `until`) -- its fingerprint
@@ -184,7 +235,7 @@ def record_replay_info(
         options["until"] = until
     finished = result.stopped_at is None and task is not None
     info = recording_info(
-        "set-table" if in_containers else "set-table-open",
+        scenario_name(in_containers, starts),
         result.robot,
         "apartment",
         result.seed,
@@ -195,13 +246,11 @@ def record_replay_info(
     recorder.set_run_info(**info)
 
 
-def _caption() -> str:
+def _caption(total: int) -> str:
     from pycram.apps.scenarios.set_table.plan import current_object, objects_done
 
     current = current_object.get_value()
-    return f"set table: {objects_done.get_value()}/{len(OBJECTS)} done" + (
-        f", bringing the {current}" if current else ""
-    )
+    return f"set table: {objects_done.get_value()}/{total} done" + (f", bringing the {current}" if current else "")
 
 
 def run_set_table(
@@ -210,9 +259,10 @@ def run_set_table(
     faults: frozenset[str] = frozenset(),
     db_url: str | None = None,
     pictures: bool = False,
-    objects: tuple[str, ...] = OBJECTS,
+    objects: tuple[str, ...] | None = None,
     in_containers: bool = True,
     stepping: str = DEFAULT_STEPPING,
+    starts: str = "narrow",
 ) -> dict[str, Any]:
     """Run the set-table scenario once, headless and without animation, simulated with
     `stepping` (see `pycram.sim.World`), for `pycram experiment`.
@@ -220,8 +270,10 @@ def run_set_table(
     `faults`: names of `FAULTS`; `db_url`: record the run in that trace database (None: not
     recorded); `pictures`: write start/end pictures to ``output/set-table-ROBOT-SEED``
     (``output/set-table-open-ROBOT-SEED`` without `in_containers`); `objects`: the object types
-    to bring (a subset of `OBJECTS`, in that order); `in_containers`: objects may start inside
-    closed containers (`start_scene`). Returns a JSON-serialisable dict: ``success``,
+    to bring (default: `default_objects`: `OBJECTS`, or with `starts` ``anywhere``
+    `ANYWHERE_OBJECTS`; a subset, in that order); `in_containers`: objects may start inside
+    closed containers (`start_scene`); `starts`: the start mode (`STARTS`; ``anywhere``: the
+    ``set-table-anywhere`` scenario, `anywhere_scene`). Returns a JSON-serialisable dict: ``success``,
     ``objects`` (per object: ``placed``, ``failure`` (a failure type's name or None),
     ``reason``), ``failure_causes``, ``sim_time`` [s], ``wall_time`` [s], ``robot``, ``seed``,
     ``faults``, ``faults_injected``, ``run_id``, ``started_in`` (object -> the closed container
@@ -234,12 +286,13 @@ def run_set_table(
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     kinds = _check(robot, seed, faults)
+    objects = default_objects(starts) if objects is None else tuple(objects)
     recorder = None
     if db_url is not None:
         from pycram.trace import start_recording
 
         recorder = start_recording(url=db_url, plan=f"set table ({robot}, seed {seed})")
-    scenario = "set-table" if in_containers else "set-table-open"
+    scenario = scenario_name(in_containers, starts)
     output = Path("output") / f"{scenario}-{robot}-{seed}" if pictures else None
     result: SetTableResult | None = None
     task = None
@@ -253,13 +306,20 @@ def run_set_table(
             objects=tuple(objects),
             in_containers=in_containers,
             stepping=stepping,
+            starts=starts,
         )
     finally:
         run_id = None
         if recorder is not None:
-            if tuple(objects) == OBJECTS:  # a replay brings every object
+            if tuple(objects) == default_objects(starts):  # a replay brings every object
                 record_replay_info(
-                    recorder, result, task, in_containers=in_containers, stepping=stepping, pictures=pictures
+                    recorder,
+                    result,
+                    task,
+                    in_containers=in_containers,
+                    stepping=stepping,
+                    pictures=pictures,
+                    starts=starts,
                 )
             ok = result is not None and result.success
             run_id = recorder.finish(
@@ -268,6 +328,7 @@ def run_set_table(
     out = result.as_dict()
     out["run_id"] = run_id
     out["stepping"] = stepping
+    out["starts"] = starts
     return out
 
 
@@ -284,6 +345,22 @@ def run_set_table_on_open_surfaces(
     return run_set_table(robot, seed, faults, db_url, pictures, in_containers=False, stepping=stepping)
 
 
+def run_set_table_anywhere(
+    robot: str,
+    seed: int,
+    faults: frozenset[str] = frozenset(),
+    db_url: str | None = None,
+    pictures: bool = False,
+    stepping: str = DEFAULT_STEPPING,
+) -> dict[str, Any]:
+    """The ``set-table-anywhere`` scenario of `pycram experiment`: `run_set_table` with the
+    ``anywhere`` starts -- all six breakfast types anywhere on the worktops, in the drawers, on
+    the fridge's shelves and in the cupboard, wherever some standing pose of `robot` reaches
+    them (`anywhere_scene`)."""
+    return run_set_table(robot, seed, faults, db_url, pictures, stepping=stepping, starts="anywhere")
+
+
 # the fault names `pycram experiment --faults all` expands to (read by the scenario registry)
 run_set_table.FAULTS = FAULTS  # type: ignore[attr-defined]
 run_set_table_on_open_surfaces.FAULTS = FAULTS  # type: ignore[attr-defined]
+run_set_table_anywhere.FAULTS = FAULTS  # type: ignore[attr-defined]

@@ -2,7 +2,9 @@
 
 `start_scene` draws, from a seed, where each object starts (`pycram.world.scenes.Placement`s:
 open surfaces of `START_REGIONS`, some objects inside closed containers of `START_CONTAINERS`);
-the same seed always gives the same scene. `place_settings` turns the place settings of
+`anywhere_scene` draws the ``anywhere`` starts: the six breakfast types anywhere on the worktops
+and inside the containers, wherever some standing pose of the robot reaches them (the task
+suite's `draw_starts`); the same seed always gives the same scene. `place_settings` turns the place settings of
 `SETTINGS` (relative to the table's edge at the seat) into points [m, map] where each object's
 centre should stand. Both read the environment's description only, never a simulator.
 """
@@ -13,8 +15,10 @@ import math
 import random
 from typing import Any
 
-from pycram.apps.scenarios.common.scene import table_edge
+from pycram.apps.scenarios.common.scene import NoStartSpot, draw_starts, open_surfaces, reachability, table_edge
 from pycram.apps.scenarios.set_table.data import (
+    ANYWHERE_OBJECTS,
+    ANYWHERE_SOURCE_KINDS,
     OBJECTS,
     SCENE_DRAWS,
     SEAT,
@@ -27,6 +31,8 @@ from pycram.apps.scenarios.set_table.plan import PlaceSetting
 
 __all__ = [
     "start_scene",
+    "anywhere_scene",
+    "anywhere_sources",
     "place_settings",
 ]
 
@@ -135,3 +141,43 @@ def _start_spot(
         if not any(candidate.overlaps(other, GAP + START_SPACING) for other in placed):
             return candidate
     return None
+
+
+def anywhere_sources(environment: Any, type_name: str) -> list[str]:
+    """The surfaces an object of `type_name` may start on in the ``anywhere`` starts: the
+    environment's open surfaces of `ANYWHERE_SOURCE_KINDS` (whole), then the insides of its
+    containers of a kind the type is found on (`ObjectType.found_on`), in the description's
+    order."""
+    from pycram.world.objects import object_type
+
+    found_on = object_type(type_name).found_on
+    inside = [s.name for c in environment.containers for s in c.interior if s.kind in found_on]
+    return open_surfaces(environment, ANYWHERE_SOURCE_KINDS) + inside
+
+
+def anywhere_scene(environment: Any, seed: int, robot: str, objects: tuple[str, ...] = ANYWHERE_OBJECTS) -> list[Any]:
+    """The ``anywhere`` starts of `seed` for `robot` (`pycram.world.scenes.Placement`s, each
+    object named by its type): each of `objects` drawn uniformly over the union of its
+    `anywhere_sources` (the whole worktops, drawers, fridge shelves, the cupboard; inside a
+    container it starts closed: `Placement.container`), clear of the others, and kept only where
+    some standing pose of `robot` grasps it among the objects drawn before while each of those
+    stays graspable (the task suite's `draw_starts` with the reachability filter counting the
+    other objects as the robot's location reasoning counts believed ones). The same seed, robot
+    and environment give the same scene. When the objects drawn first leave no reachable room
+    for the next one, the scene is drawn again from another stream of the seed (at most
+    `SCENE_DRAWS` times); then `NoStartSpot` is raised."""
+    from pycram.apps.scenarios.common.scene import check_types
+
+    listed = check_types(objects, ANYWHERE_OBJECTS, "set-table-anywhere")
+    sources = {t: anywhere_sources(environment, t) for t in listed}
+    reach = reachability(robot, environment.name)
+    failure: NoStartSpot | None = None
+    for attempt in range(SCENE_DRAWS):
+        stream = f"set-table-anywhere/{seed}" + (f"/{attempt}" if attempt else "")
+        try:
+            placed, _ = draw_starts(environment, stream, listed, sources, reach, among_placed=True)
+        except NoStartSpot as error:
+            failure = error
+            continue
+        return placed
+    raise NoStartSpot(f"seed {seed}: no scene in {SCENE_DRAWS} draws; the last: {failure}")
