@@ -14,11 +14,11 @@ set-table run PR2 seed 7. The pictures (start/end.png) are written in every vari
 
 Numbers depend on the machine's load; run it on an otherwise idle machine for the record.
 
-Measured (2-core machine shared with 2-3 other busy processes, load ~4, 2026-11-27, medians of
-3): set-table run +6.1 % (--rrd) / +7.9 % (--view --rrd), whole command +7.4 % / +12.1 %; thesis
-demo run (2.3-3.1 s of wall time) +11 % / +11 %, whole command +11 % / +16 % (other series of 3-5
-runs: +13 to +26 %, inside the baseline's own spread on that machine). docs/view.md ("What it
-costs") has the table.
+Measured (idle 2-core machine, load 0.5-1.2, 2026-11-27, the view's writer in its own process):
+thesis demo run +11.0 % (--rrd) / +7.6 % (--view --rrd), median of 9, whole command +16.6 % /
++16.3 % (the writer process's and Rerun's start-up); set-table run +4.9 % / +7.1 %, whole command
++6.8 % / +9.8 % (median of 2). With the writer in a thread (before) the thesis run paid +10 to
++18 %. docs/view.md ("What it costs") has the table.
 """
 
 from __future__ import annotations
