@@ -230,13 +230,10 @@ class ReachVocabulary(StandingSearch):
             joint = self.geometry.torso_joint
             for torso, height in self._other_torso_heights() if heights is None else heights:
                 assert joint is not None  # there are other torso heights only with a torso joint
-                if (
-                    prosp.in_collision((x, y, natural), {**tucked, joint: height}, self.carried(), objects=True)
-                    or prosp.in_collision((x, y, natural), {**raised, joint: height})
-                    or self.cannot_drive_in(prosp, (x, y, natural), {**tucked, joint: height})
-                ):
+                arrival, ready = {**tucked, joint: height}, {**raised, joint: height}
+                if self._base_refused(prosp, (x, y, natural), arrival, ready) is not None:
                     continue
-                other, why = sequences({**raised, joint: height}, {**tucked, joint: height})
+                other, why = sequences(ready, arrival)
                 if other is not None:
                     return replace(other, torso=torso), None
                 failure = why
