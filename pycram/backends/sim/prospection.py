@@ -172,6 +172,9 @@ class SimProspection(Prospection):
         self._parts: dict[tuple[str, bool], tuple[ArmBodies, np.ndarray, list[SelfGroup]]] = {}
         self._ik_pools: dict[str, queue.SimpleQueue[Any]] = {}
         self._planning_lock = threading.Lock()
+        # navigation's goal check (`drivable`): built on first use; its planner per state
+        self._drive_check: Any = None
+        self._drive_planner: tuple[Any, Any] | None = None
 
     # ------------------------------------------------------------------ plumbing
     @property
@@ -283,11 +286,11 @@ class SimProspection(Prospection):
         snap = self._snapshot()
         configuration = tuple(sorted((str(k), float(v)) for k, v in (joint_configuration or {}).items()))
         key = (snap.qpos.tobytes(), snap.mocap_pos.tobytes(), snap.mocap_quat.tobytes(), configuration, tuple(carried))
-        cached = getattr(self, "_drive_planner", None)
+        cached = self._drive_planner
         if cached is None or cached[0] != key:
             with self._data() as d:
                 self._prepare(d, pose, joint_configuration)
-                check = getattr(self, "_drive_check", None)
+                check = self._drive_check
                 if check is None:
                     check = self._drive_check = DriveCheck(self.scene, d)
                 bodies = self.model.geom_bodyid
