@@ -3,7 +3,8 @@ breakfast types drawn over the whole worktops and inside the containers, kept wh
 pose of the robot reaches them, and one end-to-end run on a development seed.
 
 The scene draws ask the reachability filter (location reasoning in prospection, no simulation):
-about 3 min of CPU for the 10 scenes the draw tests share; the end-to-end run about 1-2 min.
+a draw takes 2-36 s of CPU (seeds 1-10, idle machine); the five the draw tests share about 35 s,
+the end-to-end run about 1-2 min.
 """
 
 from __future__ import annotations
@@ -17,8 +18,11 @@ from pycram.apps.scenarios.reachability import PERCEPTION_MARGIN, perceived_yaw
 from pycram.apps.scenarios.set_table import ANYWHERE_OBJECTS, anywhere_scene, anywhere_sources, run_set_table
 from pycram.environments import load as load_environment
 
-#: Development seeds (0-999, `pycram.apps.experiments.splits`) whose scenes the draw test reads.
-DRAW_SEEDS = range(1, 11)
+#: Development seeds (0-999, `pycram.apps.experiments.splits`) whose scenes the draw tests read:
+#: the five cheapest of seeds 1-10 to draw (seeds 1-10 all took ~160 s, over the suite's 120-s
+#: limit on a loaded CI machine); between them objects on the counter's back half, in drawer 3 and
+#: in the cupboard.
+DRAW_SEEDS = (1, 3, 5, 9, 10)
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +34,7 @@ def scenes():
 def test_anywhere_starts_cover_the_whole_worktops_every_type_and_the_containers(scenes):
     env, drawn = scenes
     assert anywhere_scene(env, 3, "pr2") == drawn[3]  # the same seed, the same scene
-    assert drawn[3] != drawn[4]
+    assert drawn[3] != drawn[5]
     counter = env.surface("counter")
     x0, y0, x1, y1 = counter.bounds
     back = []  # on the counter's back half (towards the wall): out of the narrow starts' strips
