@@ -213,3 +213,28 @@ def test_a_look_that_measures_no_turn_keeps_the_turn_measured_before_while_the_o
     assert carton.yaw == pytest.approx(-math.pi / 4)
     belief.update(PerceptionReport(3.0, (milk(4.4, None),)))  # it moved: the old turn is no proof
     assert carton.properties["axis"] is None and carton.yaw == 0.0
+
+
+def test_a_look_that_sees_less_of_a_standing_objects_height_keeps_the_height_measured_before():
+    def milk(x, height, support="table"):
+        # the table top is at 0.75 m: the carton's bottom there, its top `height` above
+        return Detection("milk", (x, 2.0, 0.75 + height / 2), (0.07, 0.07, height), "white", support=support, pixels=500)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, 0.2),))).added
+    belief.update(PerceptionReport(2.0, (milk(4.31, 0.12),)))  # its top hidden: 8 cm of it unseen
+    assert carton.pose == pytest.approx((4.31, 2.0, 0.85))  # where it is seen, as tall as before
+    assert carton.properties["size"][2] == pytest.approx(0.2)
+    belief.update(PerceptionReport(3.0, (milk(4.31, 0.2),)))
+    assert carton.pose[2] == pytest.approx(0.85)
+    # elsewhere, or on another surface, a shorter measurement is believed: it may have toppled
+    belief.update(PerceptionReport(4.0, (milk(4.36, 0.12),)))
+    assert carton.pose[2] == pytest.approx(0.81) and carton.properties["size"][2] == pytest.approx(0.12)
+    belief.update(PerceptionReport(5.0, (milk(4.36, 0.2),)))
+    belief.update(PerceptionReport(6.0, (milk(4.36, 0.12, support="counter"),)))
+    assert carton.properties["size"][2] == pytest.approx(0.12)
+    # measured wider than it stands: it lies, and its height is what is measured
+    belief.update(PerceptionReport(7.0, (milk(4.36, 0.2),)))
+    lying = Detection("milk", (4.37, 2.0, 0.785), (0.2, 0.07, 0.07), "white", support="table", pixels=500)
+    belief.update(PerceptionReport(8.0, (lying,)))
+    assert carton.properties["size"][2] == pytest.approx(0.07) and carton.lying_axis is not None
