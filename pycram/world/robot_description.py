@@ -8,8 +8,8 @@ validated object as on the module. :meth:`RobotDescription.from_module` checks t
 raises :class:`RobotDescriptionError` naming the robot, the key and the valid keys or choices.
 
 Units are those of the data modules: angles in [rad], lengths in [m], velocities in [m/s] /
-[rad/s], forces in [N]. The values are the module's own objects (not copies; except ``ARMS`` and
-``GRIPPERS`` when something in them is read from the URDF, see
+[rad/s], forces in [N]. The values are the module's own objects (not copies; except ``ARMS``,
+``GRIPPERS`` and ``HEAD`` when something in them is read from the URDF, see
 :mod:`pycram.world.robot_model_file`): the object is frozen (no field can be rebound), its
 mappings are the module's.
 
@@ -187,7 +187,7 @@ class RobotDescription:
         try:
             data = infer_from_model(data, robot)
         except ModelFileError as exc:
-            key = "ARMS" if ": ARMS:" in str(exc) else "GRIPPERS" if ": GRIPPERS:" in str(exc) else "URDF"
+            key = next((k for k in ("ARMS", "GRIPPERS", "HEAD") if f": {k}:" in str(exc)), "URDF")
             problem = str(exc).removeprefix(f"robot description of {robot!r}: ")
             raise RobotDescriptionError(robot, key, problem) from None
         return cls(**data)

@@ -9,11 +9,18 @@ What a description may leave to the model file (`infer_from_model`):
   in order from the root;
 - a gripper's ``joint``, ``coupled_joints`` and ``joint_range``: the one movable, non-mimic joint
   below the last joint of the arm that carries the gripper, the mimic joints that follow it, and
-  its URDF limits (lower: closed, upper: open).
+  its URDF limits (lower: closed, upper: open);
+- the head's ``camera_link`` (`camera_link`): below the head's tilt joint, the camera whose body
+  frame (x: viewing direction, z: up) carries an ``*optical_frame`` (the ROS convention, REP 103),
+  a colour camera (``rgb``/``color`` in its name) where there are several; without optical
+  frames, the one link named ``*camera_link`` or ``*camera_frame``. A head with several cameras
+  and none of them the colour one (the PR2's: a high-definition camera and two stereo pairs) is
+  an error naming them: the description states which.
 
 Joint position and velocity limits are read from the model by the simulator itself
 (`pycram.backends.sim.arm_limits`). What a file cannot say stays in the description: which chain
-is which arm, the tool frames, the camera frame, grasp geometry and named configurations.
+is which arm, the tool frames, which of several cameras to use, grasp geometry and named
+configurations.
 
 The files are found in the installed `example-robot-data` package (`model_dir`; the environment
 variable ``PYCRAM_ROBOT_DATA`` overrides the search). Pure Python: no simulator, no ROS.
@@ -30,7 +37,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["ModelFileError", "UrdfJoint", "KinematicTree", "model_dir", "read_urdf", "infer_from_model"]
+__all__ = [
+    "ModelFileError",
+    "UrdfJoint",
+    "KinematicTree",
+    "model_dir",
+    "read_urdf",
+    "infer_from_model",
+    "camera_link",
+]
 
 #: Joint types that move (the others are fixed or floating).
 MOVABLE = ("revolute", "continuous", "prismatic")
@@ -170,12 +185,34 @@ def _chain_tip(data: Mapping[str, Any], spec: Mapping[str, Any], tree: Kinematic
     return str(tool)
 
 
+def camera_link(tree: KinematicTree, tilt_joint: str) -> str:
+    """The camera link below the joint `tilt_joint` of `tree` (see the module docstring for the
+    rule). Raises `ModelFileError` for an unknown joint, or naming the candidates when the rule
+    finds none or several."""
+    joint = tree.joints.get(tilt_joint)
+    if joint is None:
+        raise ModelFileError(f"{tree.source} has no joint {tilt_joint!r}")
+    links = [j.child for j in tree.below(joint.child)]
+    bodies = list(dict.fromkeys(tree.parent_joint[link].parent for link in links if link.endswith("optical_frame")))
+    colour = [b for b in bodies if any(word in b for word in ("rgb", "color", "colour"))]
+    named = [link for link in links if link.endswith(("camera_link", "camera_frame"))]
+    for candidates in (colour, bodies if len(bodies) == 1 else [], [] if bodies else named):
+        if len(candidates) == 1:
+            return candidates[0]
+    found = ", ".join(bodies or named) or "none"
+    raise ModelFileError(
+        f"cannot tell the camera below {tilt_joint!r} in {tree.source} (cameras: {found}); state 'camera_link' in HEAD"
+    )
+
+
 def infer_from_model(data: Mapping[str, Any], robot: str = "?") -> dict[str, Any]:
     """`data` (a description's keys) with what its ``URDF`` says filled in (see the module
     docstring): arms' ``joints`` from their ``root_link``, grippers' ``joint``,
-    ``coupled_joints`` and ``joint_range``. Keys the description states are kept as they are;
-    a description that needs nothing from the file is returned unchanged (the file is not read).
+    ``coupled_joints`` and ``joint_range``, the head's ``camera_link``. Keys the description
+    states are kept as they are; a description that needs nothing from the file is returned
+    unchanged (the file is not read).
     Raises `ModelFileError` naming the robot, the arm or gripper and what is missing."""
+    data = _with_camera(data, robot)
     arms = data.get("ARMS")
     grippers = data.get("GRIPPERS")
     if not isinstance(arms, Mapping) or not isinstance(grippers, Mapping):
@@ -230,3 +267,18 @@ def infer_from_model(data: Mapping[str, Any], robot: str = "?") -> dict[str, Any
             spec["joint_range"] = (joint.lower, joint.upper)
     out["ARMS"], out["GRIPPERS"] = new_arms, new_grippers
     return out
+
+
+def _with_camera(data: Mapping[str, Any], robot: str) -> Mapping[str, Any]:
+    """`data` with ``HEAD["camera_link"]`` read from the URDF when the head states none (a
+    composed robot's head is no part of its URDF: left to the composition's checks)."""
+    head = data.get("HEAD")
+    if not isinstance(head, Mapping) or "camera_link" in head or data.get("COMPOSITION") is not None:
+        return data
+    if not isinstance(data.get("URDF"), str) or not isinstance(head.get("tilt_joint"), str):
+        return data  # the schema reports what is missing
+    try:
+        link = camera_link(read_urdf(data["URDF"]), head["tilt_joint"])
+    except ModelFileError as exc:
+        raise ModelFileError(f"robot description of {robot!r}: HEAD: {exc}") from None
+    return {**data, "HEAD": {**head, "camera_link": link}}

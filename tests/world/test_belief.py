@@ -218,7 +218,8 @@ def test_a_look_that_measures_no_turn_keeps_the_turn_measured_before_while_the_o
 def test_a_look_that_sees_less_of_a_standing_objects_height_keeps_the_height_measured_before():
     def milk(x, height, support="table"):
         # the table top is at 0.75 m: the carton's bottom there, its top `height` above
-        return Detection("milk", (x, 2.0, 0.75 + height / 2), (0.07, 0.07, height), "white", support=support, pixels=500)
+        size = (0.07, 0.07, height)
+        return Detection("milk", (x, 2.0, 0.75 + height / 2), size, "white", support=support, pixels=500)
 
     belief = BeliefState(APARTMENT)
     (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, 0.2),))).added

@@ -34,6 +34,9 @@ def test_each_registered_description_validates_and_mirrors_its_module(robot):
     assert description is robot_description(robot)  # validated once, cached
     assert description.NAME == robot
     for key, value in _data(robot).items():
+        if key == "HEAD" and "camera_link" not in value:  # read from the URDF: a copy, with it
+            assert description.HEAD == {**value, "camera_link": description.HEAD["camera_link"]}
+            continue
         assert getattr(description, key) is value  # the module's own objects
     with pytest.raises(AttributeError):
         description.NAME = "r2d2"  # type: ignore[misc]

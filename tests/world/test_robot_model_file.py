@@ -68,3 +68,33 @@ def test_a_robot_with_a_gripper_of_its_own_ends_its_chain_at_the_mount():
     data = {k: getattr(tiago, k) for k in RobotDescription.keys()}
     data["ARMS"] = {"right": {"root_link": "torso_lift_link", "tool_link": "gripper_tool_link", "gripper": "right"}}
     assert RobotDescription.from_mapping(data).ARMS["right"]["joints"] == tiago.ARMS["right"]["joints"]
+
+
+def test_the_camera_link_is_read_from_the_urdf_where_it_tells_and_named_where_it_does_not():
+    from pycram.world.robot_model_file import camera_link
+    from pycram.world.robot_registry import robot_description
+
+    tiago = read_urdf("robots/tiago_description/robots/tiago_no_hand.urdf")
+    # three cameras carry optical frames (xtion, its depth and its colour camera): the colour one
+    assert camera_link(tiago, "head_2_joint") == "xtion_rgb_frame"
+    pro = read_urdf("robots/tiago_pro_description/robots/tiago_pro.urdf")
+    assert camera_link(pro, "head_2_joint") == "head_front_camera_link"  # no optical frames: by name
+    # the descriptions that leave it out get the same link the simulator mounts its camera on
+    assert robot_description("tiago").HEAD["camera_link"] == "xtion_rgb_frame"
+    assert robot_description("tiago-pro").HEAD["camera_link"] == "head_front_camera_link"
+    pr2 = read_urdf("robots/pr2_description/urdf/pr2.urdf")
+    with pytest.raises(ModelFileError, match=r"cannot tell the camera.*high_def_frame.*state 'camera_link'"):
+        camera_link(pr2, "head_tilt_joint")
+    with pytest.raises(ModelFileError, match="no joint 'head_3_joint'"):
+        camera_link(tiago, "head_3_joint")
+
+
+def test_a_description_without_a_camera_link_whose_urdf_does_not_tell_names_the_key():
+    from pycram.world.robot_description import RobotDescription, RobotDescriptionError
+    from pycram.world.robot_registry import robot_description
+
+    pr2 = robot_description("pr2")
+    data = {k: getattr(pr2, k) for k in RobotDescription.keys()}
+    data["HEAD"] = {k: v for k, v in pr2.HEAD.items() if k != "camera_link"}
+    with pytest.raises(RobotDescriptionError, match=r"HEAD.*cannot tell the camera.*wide_stereo_link"):
+        RobotDescription.from_mapping(data)

@@ -31,7 +31,8 @@ TORSO = {"joint": "torso_lift_joint", "range": (0.0, 0.31), "default": 0.2}  # [
 HEAD = {
     "pan_joint": "head_pan_joint",
     "tilt_joint": "head_tilt_joint",
-    #: link whose +x axis is the camera's viewing direction and +z its up direction
+    #: link whose +x axis is the camera's viewing direction and +z its up direction: stated, the
+    #: URDF's head has several cameras (high_def_frame, the stereo pairs) and none is the colour one
     "camera_link": "high_def_frame",
     "fovy": 55.0,  # [deg] vertical field of view
     "resolution": (320, 240),  # [px] width, height

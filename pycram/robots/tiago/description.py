@@ -42,7 +42,7 @@ TORSO = {"joint": "torso_lift_joint", "range": (0.0, 0.35), "default": 0.25}  # 
 HEAD = {
     "pan_joint": "head_1_joint",
     "tilt_joint": "head_2_joint",
-    "camera_link": "xtion_rgb_frame",
+    # the camera link (x: viewing direction, z: up) is read from the URDF: xtion_rgb_frame
     "fovy": 50.0,  # [deg]
     "resolution": (320, 240),  # [px]
 }

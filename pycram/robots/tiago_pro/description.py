@@ -42,8 +42,7 @@ TORSO = {"joint": "torso_lift_joint", "range": (0.0, 0.35), "default": 0.25}  # 
 HEAD = {
     "pan_joint": "head_1_joint",
     "tilt_joint": "head_2_joint",
-    #: link whose +x axis is the camera's viewing direction and +z its up direction (URDF)
-    "camera_link": "head_front_camera_link",
+    # the camera link (x: viewing direction, z: up) is read from the URDF: head_front_camera_link
     "fovy": 50.0,  # [deg] vertical field of view
     "resolution": (320, 240),  # [px] width, height
 }
