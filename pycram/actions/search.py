@@ -11,8 +11,11 @@
    where a matching object was last seen before it was believed gone first (moved by a person
    or missed by a look, it is likely still near), places inside containers not known to be
    open last, the kinds of place the object type is most likely found on first
-   (`ObjectType.found_on`: a cup in the drawers before the fridge): it drives to a standing
-   pose in front of each, points the head at it and detects (as in 2.);
+   (`ObjectType.found_on`: a cup in the drawers before the fridge), and of each kind the places
+   an earlier search looked into without seeing a match last (`BeliefState.searched`: a second
+   search, e.g. a transport's next round, does not go through the drawers it has just looked
+   through before the cupboard it never reached): it drives to a standing pose in front of
+   each, points the head at it and detects (as in 2.);
 4. it fails with `pycram.failures.ObjectNotFound`, which names every place it looked at and
    the places it could not look into (closed containers, places it could not reach).
 
@@ -408,17 +411,19 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
 
 def _closed_last(
     environment: Environment, belief: BeliefState, type_name: str | None, last_seen: set[str], lookout: Lookout
-) -> tuple[bool, bool, int]:
+) -> tuple[bool, bool, bool, int]:
     """Sort key of the places to visit: open places first (kept nearest first); places in
     containers not known to be open last -- where a matching object was last seen (`last_seen`)
     first among them, then those whose inside is of a kind the object type is more likely found
     on (`ObjectType.found_on`, most likely first): a person looks for a cup in the drawers
-    before the fridge."""
+    before the fridge. Among either, places an earlier search looked into (`BeliefState.searched`:
+    nothing matching was seen there, or the belief would hold it) come after the others."""
+    searched = lookout.surface in belief.searched
     if lookout.container is None or belief.container_open(lookout.container) is True:
-        return (False, False, 0)
+        return (False, False, searched, 0)
     kinds = OBJECT_TYPES[type_name].found_on if type_name in OBJECT_TYPES else ()
     kind = environment.surface(lookout.surface).kind
-    return (True, lookout.surface not in last_seen, kinds.index(kind) if kind in kinds else len(kinds))
+    return (True, lookout.surface not in last_seen, searched, kinds.index(kind) if kind in kinds else len(kinds))
 
 
 def _visit(
@@ -456,6 +461,7 @@ def _visit(
             return found
         if container is None or belief.container_open(container) is not False:
             looked.append(lookout.name)
+            belief.looked_into(lookout.surface)
             return None
     looked.append(lookout.name)
     return None

@@ -367,6 +367,9 @@ class BeliefState(Belief):
         self.updated = Fluent(None, name="belief updated")
         #: The objects the robot's grippers hold, by gripper (`picked_up`).
         self.in_hand: dict[str, PerceivedObject] = {}
+        #: Surfaces a search looked at from close by (`looked_into`), with when [s, the reports'
+        #: clock]: what was visible there then is believed.
+        self.searched: dict[str, float] = {}
 
     # --- reading ----------------------------------------------------------------------------
     def present(self) -> list[PerceivedObject]:
@@ -483,6 +486,14 @@ class BeliefState(Belief):
                     x, y, z = obj.pose
                     obj.pose = (x + dx, y + dy, z)
                     obj.pose_fluent.set_value(obj.pose)
+
+    def looked_into(self, surface: str) -> None:
+        """A search looked at the surface `surface` from close by (inside an open container, or
+        from in front of an open surface): note it in `searched`, stamped with the last update's
+        time, so that a later search for something it did not see there looks there last."""
+        with self._update_lock:
+            stamp = self.updated.get_value()
+            self.searched[surface] = float(stamp) if isinstance(stamp, (int, float)) else 0.0
 
     def picked_up(self, obj: PerceivedObject, gripper: str) -> None:
         """The robot's `gripper` holds `obj` (its grasp was measured): until it is put down or

@@ -253,3 +253,28 @@ def test_the_search_looks_first_where_a_lost_object_was_last_seen():
     finally:
         robot.shutdown()
         world.close()
+
+
+def test_a_second_search_looks_into_the_places_the_first_looked_into_last():
+    # a transport's next round: the drawers its first search looked through without seeing a
+    # cup come after the cupboard it never reached (cups: drawers before the cupboard)
+    from pycram.actions.search import _closed_last
+    from pycram.environments import load
+    from pycram.world.belief import BeliefState
+
+    environment = load("apartment")
+    belief = BeliefState(environment)
+    places = [p for p in lookouts(environment, "cup", (2.0, 1.5)) if p.container is not None]
+    order = partial(_closed_last, environment, belief, "cup", set())
+
+    def containers() -> list[str]:
+        return list(dict.fromkeys(p.container for p in sorted(places, key=order)))
+
+    assert set(containers()[:3]) == {"drawer 1", "drawer 2", "drawer 3"}  # nearest first
+    assert containers().index("cupboard") < containers().index("fridge")
+    drawers = containers()[:3]
+    for drawer in ("drawer 1", "drawer 2", "drawer 3"):
+        belief.looked_into(f"{drawer} inside")
+    assert containers()[0] == "cupboard"
+    assert containers()[-3:] == drawers  # in the order they had
+    assert set(belief.searched) == {"drawer 1 inside", "drawer 2 inside", "drawer 3 inside"}
