@@ -23,9 +23,9 @@ Likely places come from the environment's description (`Lookout`s): the surfaces
 objects of the type are found on (`ObjectType.found_on`; every surface for an unknown or
 unspecified type), open surfaces seen from their free edge nearest to the robot, surfaces inside
 containers seen from in front of the container. A container measured closed is opened with
-`open_container(name)` when given (a plan, e.g. an opening action); without one it is skipped
-and reported: this package has no opening action yet, so objects in closed containers are found
-only when the scene leaves them open.
+`open_container(name)` when given (a plan, e.g. ``lambda name: perform(Open(name))``; the
+set-table plan passes one that closes the other containers first); without one it is skipped and
+reported, so objects in closed containers are then found only when the scene leaves them open.
 
 The plan uses motion designators only (`subscribing_pose`, `moving`, `pointing_head`,
 `detecting`) and the active robot's belief (`robot.belief`, a
