@@ -216,6 +216,7 @@ def rerun(
                     output=folder if pictures else None,
                     in_containers=scenario != "set-table-open",
                     starts="anywhere" if scenario == "set-table-anywhere" else "narrow",
+                    environment=replay.get("environment") or "apartment",
                     stepping=replay["stepping"],
                     until=until,
                     until_folder=folder,

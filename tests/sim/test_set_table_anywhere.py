@@ -117,3 +117,45 @@ def test_the_table_is_set_end_to_end_with_anywhere_starts():
     assert all(o["placed"] and o["failure"] is None for o in out["objects"].values())
     assert out["started_in"] == {"cup": "drawer 3"}  # brought out of a closed drawer ...
     assert out["failure_causes"] == [] and out["open_containers"] == {}  # ... and every drawer closed again
+
+
+def test_set_table_anywhere_runs_in_other_environments_and_set_table_says_it_does_not():
+    from types import SimpleNamespace
+
+    from pycram.apps.experiments.scenarios import get_scenario
+    from pycram.apps.scenarios.set_table.driver import check_environment
+    from pycram.apps.scenarios.set_table.faults import Faults
+
+    assert check_environment("procedural:7", "anywhere") == "procedural:7"
+    with pytest.raises(ValueError, match=r"apartment only .*, not procedural:7; set-table-anywhere runs in any"):
+        check_environment("procedural:7", "narrow")
+    with pytest.raises(ValueError, match=r"procedural:x"):
+        check_environment("procedural:x", "anywhere")
+    # `pycram experiment --env` asks the scenario's function: set-table is refused up front
+    assert get_scenario("set-table-anywhere").takes_environment()
+    assert not get_scenario("set-table").takes_environment()
+    # a person puts an object down in a strip along the counter's front edge (the edge the
+    # robot works at: nearest the kitchen place), in any environment
+    for name in ("procedural:1", "procedural:2", "procedural:3"):
+        environment = load_environment(name)
+        x0, y0, x1, y1 = Faults._counter_region(
+            SimpleNamespace(world=SimpleNamespace(environment=environment)), "spoon"
+        )
+        counter = environment.surface("counter")
+        assert counter.contains(x0, y0) and counter.contains(x1, y1), (name, (x0, y0, x1, y1), counter.bounds)
+        kx, ky, _ = environment.place("kitchen").pose
+        centre = ((x0 + x1) / 2, (y0 + y1) / 2)
+        cx0, cy0, cx1, cy1 = counter.bounds
+        assert math.dist((kx, ky), centre) < math.dist((kx, ky), ((cx0 + cx1) / 2, (cy0 + cy1) / 2))
+
+
+@pytest.mark.timeout(400)
+def test_the_table_is_set_in_a_generated_apartment():
+    from pycram.apps.scenarios.set_table.driver import run_set_table_anywhere
+
+    # development seed 1 in the development world procedural:1 (`pycram.apps.experiments.splits`)
+    out = run_set_table_anywhere("pr2", 1, environment="procedural:1")
+    assert out["environment"] == "procedural:1"
+    assert out["success"], out["summary"]
+    assert set(out["objects"]) == set(ANYWHERE_OBJECTS)
+    assert out["failure_causes"] == [] and out["open_containers"] == {}

@@ -15,6 +15,7 @@ from typing import Any
 from pycram.apps.run_options import check_stepping, check_until
 from pycram.apps.scenarios.set_table.driver import (
     _check,
+    check_environment,
     check_starts,
     default_objects,
     record_replay_info,
@@ -45,6 +46,7 @@ def main(
     stepping: str | None = None,
     until: float | None = None,
     starts: str = "narrow",
+    environment: str = "apartment",
 ) -> int:
     """`pycram demo --scenario set-table`: run the scenario with live progress, print the task
     tree and what is missing and why; write start/end pictures (and run.gif with `animation`),
@@ -63,7 +65,7 @@ def main(
 
     def checks() -> tuple[frozenset[str], str]:
         kinds = _check(robot, seed, faults)
-        check_starts(starts)
+        check_environment(environment, check_starts(starts))
         checked_stepping = check_stepping(stepping)
         check_until(until)
         return kinds, checked_stepping
@@ -92,6 +94,7 @@ def main(
             stepping=stepping,
             until=until,
             starts=starts,
+            environment=environment,
         )
     finally:
         if live is not None:
@@ -106,6 +109,7 @@ def main(
                 pictures=True,
                 until=until,
                 starts=starts,
+                environment=environment,
             )
             run_id = finish_recording(recorder, result)
     return report_run(
@@ -127,8 +131,8 @@ def main_on_open_surfaces(**options: Any) -> int:
     return main(in_containers=False, **options)
 
 
-def main_anywhere(**options: Any) -> int:
+def main_anywhere(environment: str = "apartment", **options: Any) -> int:
     """`pycram demo --scenario set-table-anywhere`: :func:`main` with the ``anywhere`` starts --
     all six breakfast types anywhere on the worktops and inside the containers, wherever some
-    standing pose of the robot reaches them."""
-    return main(starts="anywhere", **options)
+    standing pose of the robot reaches them -- in `environment` (``--env procedural:SEED``)."""
+    return main(starts="anywhere", environment=environment, **options)

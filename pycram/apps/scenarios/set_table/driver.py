@@ -38,6 +38,7 @@ from pycram.apps.scenarios.set_table.scene import anywhere_scene, place_settings
 from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 
 __all__ = [
+    "check_environment",
     "open_world",
     "record_replay_info",
     "run_scenario",
@@ -95,30 +96,52 @@ def open_world(
     stepping: str = DEFAULT_STEPPING,
     offscreen_size: tuple[int, int] | None = None,
     starts: str = "narrow",
+    environment: str = "apartment",
 ) -> tuple[Any, list[Any]]:
-    """The apartment with the scenario's objects (default: `default_objects`) at random spots
-    from `seed` and `robot` at the start pose (perception misses detections with the ``missed``
-    fault), simulated with `stepping` ("free" or "lockstep", see `pycram.sim.World`;
-    `offscreen_size` [px]: the largest picture it renders, None for the world's default). The
-    spots: with `starts` ``narrow`` those of `start_scene` (some inside closed containers with
-    `in_containers`), with ``anywhere`` those of `anywhere_scene` for `robot`. Returns the world
-    and the placements."""
+    """The environment named `environment` (`pycram.environments.load`: ``apartment``,
+    ``procedural:SEED``, ``file:PATH``) with the scenario's objects (default: `default_objects`)
+    at random spots from `seed` and `robot` at the start pose (perception misses detections with
+    the ``missed`` fault), simulated with `stepping` ("free" or "lockstep", see
+    `pycram.sim.World`; `offscreen_size` [px]: the largest picture it renders, None for the
+    world's default). The spots: with `starts` ``narrow`` those of `start_scene` (some inside
+    closed containers with `in_containers`; the apartment only: its start regions are drawn on
+    its counter), with ``anywhere`` those of `anywhere_scene` for `robot` (any environment).
+    Returns the world and the placements; `ValueError` for narrow starts outside the apartment."""
     from pycram.backends.sim import ItemSpec, World
     from pycram.backends.sim.perception import PerceptionFaults
     from pycram.environments import load as load_environment
     from pycram.world.objects import object_type
 
     objects = default_objects(starts) if objects is None else tuple(objects)
-    environment = load_environment("apartment")
+    check_environment(environment, starts)
+    described = load_environment(environment)
     if starts == "anywhere":
-        placements = anywhere_scene(environment, seed, robot, objects)
+        placements = anywhere_scene(described, seed, robot, objects)
     else:
-        placements = start_scene(environment, seed, objects, in_containers)
+        placements = start_scene(described, seed, objects, in_containers)
     items = [ItemSpec.of(object_type(p.type), p.name, p.position, p.yaw) for p in placements]
     perception = PerceptionFaults(miss_probability=MISS_PROBABILITY, seed=seed) if "missed" in faults else None
     size: dict[str, Any] = {"offscreen_size": offscreen_size} if offscreen_size is not None else {}
-    world = World(robot, items, environment="apartment", perception_faults=perception, stepping=stepping, **size)
+    world = World(robot, items, environment=environment, perception_faults=perception, stepping=stepping, **size)
     return world, placements
+
+
+def check_environment(environment: str, starts: str = "narrow") -> str:
+    """`environment` checked for the start mode `starts`: a name `pycram.environments.load`
+    reads, and the apartment for the ``narrow`` starts (their regions are drawn on the
+    apartment's counter); ValueError naming the problem and what to use otherwise."""
+    from pycram.environments import check_name
+
+    try:
+        name = check_name(environment)
+    except KeyError as error:  # an unknown or malformed name: a bad option like the others
+        raise ValueError(str(error.args[0] if error.args else error)) from None
+    if check_starts(starts) == "narrow" and name != "apartment":
+        raise ValueError(
+            f"set-table is written for the apartment only (its start regions are drawn on the apartment's "
+            f"counter), not {name}; set-table-anywhere runs in any environment"
+        )
+    return name
 
 
 def _check(robot: str, seed: int, faults: Any) -> frozenset[str]:
@@ -146,13 +169,15 @@ def run_scenario(
     until: float | None = None,
     until_folder: Path | None = None,
     starts: str = "narrow",
+    environment: str = "apartment",
 ) -> tuple[SetTableResult, Any]:
     """Run the set-table scenario once; never raises for failures of the plan (they are in the
     result). With `output`, start.png and end.png are written there (and run.gif with
     `animation`); `recorder` (a trace recorder) is told the robot; `progress(world, plan_thread,
     faults)` is called about 4 times a second of wall time while the plan runs; `in_containers`:
     objects may start inside closed containers (`start_scene`); `starts`: the start mode
-    (`STARTS`: ``narrow`` or ``anywhere``, see `open_world`); `objects`: the types to bring
+    (`STARTS`: ``narrow`` or ``anywhere``, see `open_world`); `environment`: where (see
+    `open_world`; other than the apartment with ``anywhere`` starts only); `objects`: the types to bring
     (default: `default_objects`); `stepping`: "lockstep" for a
     run that depends on the seed alone (see `pycram.sim.World`); `until` [s of simulated time]:
     stop the world there, write the scene and belief pictures and the task tree of that moment
@@ -164,14 +189,13 @@ def run_scenario(
 
     kinds = _check(robot, seed, faults)
     check_until(until)
+    check_environment(environment, starts)
     objects = default_objects(starts) if objects is None else tuple(objects)
     scenario = scenario_name(in_containers, starts)
     started_wall = time.monotonic()
     result = SetTableResult(robot, seed, kinds)
     size = STOP_PICTURE_SIZE if until is not None else None
-    world, placements = open_world(
-        robot, seed, kinds, objects, in_containers, stepping, offscreen_size=size, starts=starts
-    )
+    world, placements = open_world(robot, seed, kinds, objects, in_containers, stepping, size, starts, environment)
     result.started_in = {p.name: p.container for p in placements if p.container is not None}
     plan: _PlanThread | None = None
     injector: Faults | None = None
@@ -222,6 +246,7 @@ def record_replay_info(
     pictures: bool,
     until: float | None = None,
     starts: str = "narrow",
+    environment: str = "apartment",
 ) -> None:
     """Store in the recorded run's info what `pycram replay` needs to run it again and -- for a
     run that ended by itself (not stopped by `until`) -- its fingerprint
@@ -237,7 +262,7 @@ def record_replay_info(
     info = recording_info(
         scenario_name(in_containers, starts),
         result.robot,
-        "apartment",
+        environment,
         result.seed,
         stepping,
         options,
@@ -273,7 +298,8 @@ def run_set_table(
     to bring (default: `default_objects`: `OBJECTS`, or with `starts` ``anywhere``
     `ANYWHERE_OBJECTS`; a subset, in that order); `in_containers`: objects may start inside
     closed containers (`start_scene`); `starts`: the start mode (`STARTS`; ``anywhere``: the
-    ``set-table-anywhere`` scenario, `anywhere_scene`). Returns a JSON-serialisable dict: ``success``,
+    ``set-table-anywhere`` scenario, `anywhere_scene`; in another environment than the
+    apartment: `run_set_table_anywhere`). Returns a JSON-serialisable dict: ``success``,
     ``objects`` (per object: ``placed``, ``failure`` (a failure type's name or None),
     ``reason``), ``failure_causes``, ``sim_time`` [s], ``wall_time`` [s], ``robot``, ``seed``,
     ``faults``, ``faults_injected``, ``run_id``, ``started_in`` (object -> the closed container
@@ -282,10 +308,27 @@ def run_set_table(
     ``most_held_at_once`` (the simulator's truth: the object names held at the same time).
     Raises `ValueError` for an unknown robot or fault name.
     """
+    return _run_set_table(robot, seed, faults, db_url, pictures, objects, in_containers, stepping, starts, "apartment")
+
+
+def _run_set_table(
+    robot: str,
+    seed: int,
+    faults: frozenset[str],
+    db_url: str | None,
+    pictures: bool,
+    objects: tuple[str, ...] | None,
+    in_containers: bool,
+    stepping: str,
+    starts: str,
+    environment: str,
+) -> dict[str, Any]:
+    """`run_set_table` in `environment` (the result also says ``environment``)."""
     import os
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     kinds = _check(robot, seed, faults)
+    check_environment(environment, starts)
     objects = default_objects(starts) if objects is None else tuple(objects)
     recorder = None
     if db_url is not None:
@@ -307,6 +350,7 @@ def run_set_table(
             in_containers=in_containers,
             stepping=stepping,
             starts=starts,
+            environment=environment,
         )
     finally:
         run_id = None
@@ -320,6 +364,7 @@ def run_set_table(
                     stepping=stepping,
                     pictures=pictures,
                     starts=starts,
+                    environment=environment,
                 )
             ok = result is not None and result.success
             run_id = recorder.finish(
@@ -329,6 +374,7 @@ def run_set_table(
     out["run_id"] = run_id
     out["stepping"] = stepping
     out["starts"] = starts
+    out["environment"] = environment
     return out
 
 
@@ -352,12 +398,13 @@ def run_set_table_anywhere(
     db_url: str | None = None,
     pictures: bool = False,
     stepping: str = DEFAULT_STEPPING,
+    environment: str = "apartment",
 ) -> dict[str, Any]:
     """The ``set-table-anywhere`` scenario of `pycram experiment`: `run_set_table` with the
     ``anywhere`` starts -- all six breakfast types anywhere on the worktops, in the drawers, on
     the fridge's shelves and in the cupboard, wherever some standing pose of `robot` reaches
-    them (`anywhere_scene`)."""
-    return run_set_table(robot, seed, faults, db_url, pictures, stepping=stepping, starts="anywhere")
+    them (`anywhere_scene`) -- in `environment` (``apartment``, ``procedural:SEED``, ...)."""
+    return _run_set_table(robot, seed, faults, db_url, pictures, None, True, stepping, "anywhere", environment)
 
 
 # the fault names `pycram experiment --faults all` expands to (read by the scenario registry)

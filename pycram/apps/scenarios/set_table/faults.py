@@ -108,15 +108,43 @@ class Faults:
     def _holding(self) -> set[str]:
         return {s.get_value().holding for s in self.world.gripper_states.values()} - {None}
 
+    def _counter_region(self, name: str) -> tuple[float, float, float, float]:
+        """Where [m, map: x0, y0, x1, y1] a person puts `name` down on the counter: its counter
+        start region in the apartment (`START_REGIONS`), else a strip 6-16 cm inside the
+        counter's front edge -- the edge nearest the ``kitchen`` place, where the robot stands
+        to work at the counter -- 10 cm from its ends."""
+        environment = self.world.environment
+        regions = START_REGIONS.get(name, {})
+        if environment.name == "apartment" and "counter" in regions:
+            return regions["counter"]
+        x0, y0, x1, y1 = environment.surface("counter").bounds
+        kx, ky, _ = environment.place("kitchen").pose
+        inside_x, inside_y = min(max(kx, x0), x1), min(max(ky, y0), y1)  # the nearest point of each edge
+        edges = {
+            "south": math.hypot(kx - inside_x, ky - y0),
+            "north": math.hypot(kx - inside_x, ky - y1),
+            "west": math.hypot(kx - x0, ky - inside_y),
+            "east": math.hypot(kx - x1, ky - inside_y),
+        }
+        front = min(edges, key=lambda edge: edges[edge])
+        near, far = 0.06, 0.16
+        if front == "south":
+            return (x0 + 0.1, y0 + near, x1 - 0.1, y0 + far)
+        if front == "north":
+            return (x0 + 0.1, y1 - far, x1 - 0.1, y1 - near)
+        if front == "west":
+            return (x0 + near, y0 + 0.1, x0 + far, y1 - 0.1)
+        return (x1 - far, y0 + 0.1, x1 - near, y1 - 0.1)
+
     def _free_counter_spot(self, name: str, near: tuple[float, float] | None = None) -> tuple[float, float, float]:
-        """A spot [m] for `name` standing upright in its counter start region, clear of every
-        object standing around (objects in a gripper do not count) by 0.4 m if possible, else
-        the clearest spot tried (and at least 0.15 m from `near`, within 0.6 m of it, when
-        given and such spots exist)."""
+        """A spot [m] for `name` standing upright in its counter region (`_counter_region`),
+        clear of every object standing around (objects in a gripper do not count) by 0.4 m if
+        possible, else the clearest spot tried (and at least 0.15 m from `near`, within 0.6 m
+        of it, when given and such spots exist)."""
         from pycram.world.objects import object_type
 
         surface = self.world.environment.surface("counter")
-        x0, y0, x1, y1 = START_REGIONS[name]["counter"]
+        x0, y0, x1, y1 = self._counter_region(name)
         held = self._holding()
         poses = {n: p for n, p in self.world.item_poses.get_value().items() if n != name and n not in held}
         z = surface.height + object_type(name).half_height + 0.002
