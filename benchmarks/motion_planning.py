@@ -7,10 +7,13 @@ the kitchen counter, the drawer cabinet's top and the dining table (where the se
 stands), with breakfast objects on the surface in front. Start and goal are random arm
 configurations, collision-free, with the tool over the surface in front of the robot
 (0.25-0.85 m ahead, 0.02-0.45 m above the surface): reaching between objects, over and around
-them, near the furniture. Each plan uses `OMPLPlanner` (straight line first, else RRT-Connect +
-simplification, 1 s limit) through prospection's configuration checker; every planned path is
-re-checked densely (1/4 of the planning resolution) to count paths that cut an obstacle between
-checks.
+them, near the furniture. Each plan uses `OMPLPlanner` (straight line first, else RRT-Connect,
+OMPL's simplifier and string pulling, a budget of 30000 checks) through prospection's
+configuration checker; every planned path is re-checked densely (1/4 of the planning resolution)
+to count paths that cut an obstacle between checks. The searched paths' quality: vertices (the
+arm stops at each), joint-space length [rad] and duration [s] timed at the arm module's half
+speed. ``--slowest`` lists the slowest 10 % of the plans (where, checks, plan time per check,
+joint-space distance from start to goal).
 
 IK: targets are the tool poses (position and orientation) of random collision-free configurations
 (the same sampler), so each is reachable; mink (`SimProspection.solve_ik`, without and with
@@ -22,7 +25,23 @@ The simulator is not run: prospection answers on a frozen state (the robot stand
 resting), as a plan's questions do between two simulation steps.
 
     MUJOCO_GL=egl .venv/bin/python benchmarks/motion_planning.py [--robots pr2 tiago]
-        [--queries 200] [--ik-targets 100] [--seed 0]
+        [--queries 200] [--ik-targets 100] [--seed 0] [--slowest]
+
+Measured 2026-11-27 18:27-18:29 UTC on this 2-core machine (``--ik-targets 0``, 200 queries per
+robot), the planner before and after that day's changes run alternately, twice each (load average
+3.3-4.3: another engineer's simulations ran; a check took 25 us as when idle; the last idle
+measurement before the changes: PR2 p50 16.1 / p95 249 ms, TIAGo 8.1 / 87 ms):
+
+- PR2: p50 16.9 / 15.9 -> 12.2 / 12.1 ms, p95 271 / 251 -> 134 / 133 ms; checks per plan
+  2115 -> 1194 (p95 of the checks 8187 -> 4492); success 200/200 -> 200/200;
+- TIAGo: p50 8.3 / 8.8 -> 6.6 / 6.6 ms, p95 86 / 90 -> 67 / 67 ms; checks per plan 943 -> 703;
+  success 200/200 -> 200/200;
+- the searched paths: PR2 9.5 -> 4.5 vertices, 6.67 -> 6.37 rad, 11.4 -> 6.7 s at half speed;
+  TIAGo 7.7 -> 4.0 vertices, 5.31 -> 5.51 rad, 8.8 -> 6.2 s;
+- dense re-check failures: PR2 3 -> 2, TIAGo 0 -> 1 (all grazing: at most 0.2 mm deep).
+
+Under heavier contention the same day (17:56-18:16, load 2.6-4.7, a check taking 25-61 us) the
+PR2's p95 was 322-362 ms before and 197-232 ms after, the TIAGo's 111-127 ms and 77-93 ms.
 """
 
 from __future__ import annotations
@@ -132,13 +151,15 @@ def percentile(values, p):
 
 
 def bench_planning(robot, scene, prospection, data, queries, seed) -> dict:
-    from pycram.reasoning.motion import OMPLPlanner
+    from pycram.reasoning.motion import OMPLPlanner, time_parameterize
 
     planner = OMPLPlanner()
     arm = scene.description.DEFAULT_ARM
     stands = STANDS[robot]
     rng = np.random.default_rng(seed)
     times, checks, kinds, reasons, dense_bad = [], [], {}, {}, 0
+    searched = []  # (vertices, length [rad], duration [s]) of the paths RRT-Connect found
+    slow = []  # (ms, stand, checks, us per check, distance [rad])
     per_stand = [queries // len(stands) + (1 if i < queries % len(stands) else 0) for i in range(len(stands))]
     check_time = []
     for (name, base, surface), n in zip(stands, per_stand):
@@ -160,8 +181,20 @@ def bench_planning(robot, scene, prospection, data, queries, seed) -> dict:
                 plan = planner.plan_with(checker, limits, start, goal, seed=seed + i)
                 times.append((time.perf_counter() - t0) * 1e3)
                 checks.append(plan.checks)
+                slow.append(
+                    (
+                        times[-1],
+                        name,
+                        plan.checks,
+                        times[-1] * 1e3 / max(1, plan.checks),
+                        float(np.linalg.norm(np.subtract(goal, start))),
+                    )
+                )
                 if plan:
                     kinds[plan.planner] = kinds.get(plan.planner, 0) + 1
+                    if plan.planner != "straight_line":
+                        timed = time_parameterize(plan.path, limits, period=0.02, velocity_scale=0.5)
+                        searched.append((len(plan.path), plan.length, timed.duration))
                     if not dense_free(checker, plan.path, planner.resolution / 4):
                         dense_bad += 1
                 else:
@@ -178,6 +211,8 @@ def bench_planning(robot, scene, prospection, data, queries, seed) -> dict:
         "reasons": reasons,
         "dense_bad": dense_bad,
         "check_us": statistics.mean(check_time) * 1e6 if check_time else float("nan"),
+        "searched": searched,
+        "slowest": sorted(slow, reverse=True)[: max(1, len(slow) // 10)],
     }
 
 
@@ -260,6 +295,7 @@ def main() -> int:
     parser.add_argument("--queries", type=int, default=200, help="plans per robot")
     parser.add_argument("--ik-targets", type=int, default=100, help="IK targets per robot")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--slowest", action="store_true", help="list the slowest 10 %% of the plans")
     args = parser.parse_args()
     for robot in args.robots:
         scene, prospection, data = build(robot)
@@ -275,6 +311,15 @@ def main() -> int:
             f"{r['checks']:.0f} checks per plan, {r['check_us']:.0f} us per check; "
             f"dense re-check failures {r['dense_bad']} ({spent:.0f} s)"
         )
+        if r["searched"]:
+            vertices, length, duration = (statistics.mean(v) for v in zip(*r["searched"]))
+            print(
+                f"{robot}: searched paths: {vertices:.1f} vertices, {length:.2f} rad long, "
+                f"{duration:.2f} s at half speed (means over {len(r['searched'])})"
+            )
+        if args.slowest:
+            for ms, stand, n, us, distance in r["slowest"]:
+                print(f"  {ms:7.1f} ms  {stand:13s} {n:6d} checks  {us:5.1f} us/check  {distance:.2f} rad apart")
         if args.ik_targets:
             ik = bench_ik(robot, scene, prospection, data, args.ik_targets, args.seed)
             for label, (ok, free, ms) in ik.items():

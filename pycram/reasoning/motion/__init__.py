@@ -4,7 +4,7 @@ joints' limits.
 - :mod:`~pycram.reasoning.motion.planner` -- the :class:`MotionPlanner` interface, its
   :class:`MotionPlan` answer (a path or a typed reason) and :func:`plan_to_pose` (IK, then a plan);
 - :mod:`~pycram.reasoning.motion.ompl_planner` -- :class:`OMPLPlanner`: straight line first, else
-  RRT-Connect with OMPL's path simplification, deterministic per seed;
+  RRT-Connect with OMPL's path simplification and string pulling, deterministic per seed;
 - :mod:`~pycram.reasoning.motion.timing` -- :func:`time_parameterize`: a path as samples (t, q)
   within the joints' velocity and acceleration limits (Ruckig).
 
