@@ -405,6 +405,9 @@ class Prospection(abc.ABC):
         when closer than ``clearance`` [m] (negative: that much penetration is tolerated); the arm
         and an object of the world (not the held one) when closer than ``object_clearance`` [m] if
         that is larger (objects are where they were measured, a few cm off: a plan keeps away).
+        The robot's own parts may overlap each other as deep as the implementation's models of
+        them do in ordinary configurations (the simulator's: 15 mm, link meshes collide as their
+        convex hulls) before that counts.
 
         Raises ``ValueError`` for an unknown arm, joint or object (listing the valid ones),
         ``NotImplementedError`` when this prospection does not support arm motion planning.

@@ -175,6 +175,41 @@ def test_the_threshold_table_takes_the_larger_clearance_and_never_counts_an_igno
     other = ignore.copy()
     other[0, 1] = other[1, 0] = False
     assert threshold_table(other, clearance)[0, 1] == 0.02  # another exclusion matrix: its own table
+    # geoms 0 and 1 the robot's: their contacts (self-collisions) count only deeper than 15 mm
+    robot = np.array([True, True, False])
+    own = threshold_table(ignore, clearance, robot, -0.015)
+    assert own[0, 0] == own[1, 1] == -0.015 and own[0, 1] == -math.inf  # still never if ignored
+    assert own[0, 2] == own[2, 1] == 0.05 and own[2, 2] == 0.05  # with anything else: as before
+    assert threshold_table(ignore, clearance) is table and threshold_table(ignore, clearance, robot, -0.015) is own
+    assert threshold_table(ignore, -0.02 + 0 * clearance, robot, -0.015)[0, 0] == -0.02  # a deeper clearance
+
+
+#: A TIAGo right-arm configuration (measured: the arm leaving drawer 2's handle) in which, with the
+#: torso down, the convex hulls of the shoulder (``arm_1_link``) and the torso column overlap 11 mm.
+TIAGO_BASE = (2.0, 1.5, math.pi / 2)
+SHOULDER_OVER_COLUMN = (2.170, -1.376, 1.271, 2.222, -0.324, -1.412, -0.977)
+
+
+def test_the_robots_own_link_hulls_may_overlap_by_the_tolerance():
+    """Counted, the TIAGo's shoulder-over-column hull overlap (torso down) put the start of every
+    plan from such a configuration "in collision", and the plan was made again tolerating 15 mm
+    with everything -- a carried spoon grazed a drawer's handle that deep and was knocked out of
+    the hand (tests/sim/test_actions_containers.py). Self-contacts count deeper than the
+    prospection's tolerance; contacts with anything else as before (the test above)."""
+    from pycram.backends.sim.prospection import SimProspection
+    from pycram.backends.sim.recording import StateSnapshot
+    from pycram.backends.sim.scene import build_scene, initial_state
+
+    scene = build_scene("tiago", environment="apartment")
+    snapshot = StateSnapshot.of(initial_state(scene, TIAGO_BASE))
+    for torso, tolerance, counted in ((0.0, 0.015, False), (0.0, 0.0, True), (0.25, 0.0, False)):
+        prospection = SimProspection(scene, lambda: snapshot, tolerance=tolerance)
+        with prospection.configuration_checker("right", TIAGO_BASE, {"torso_lift_joint": torso}) as checker:
+            contacts = checker.contacts(SHOULDER_OVER_COLUMN)
+            assert checker.is_free(SHOULDER_OVER_COLUMN) is not counted
+            assert (("arm_1_link", "torso_fixed_column_link") in contacts) is counted, contacts
+            if not counted:
+                assert contacts == []
 
 
 def test_an_open_motion_is_the_straight_line(world):

@@ -19,7 +19,14 @@ of bodies that touch in most random configurations (adjacent links) or in the ro
 configuration are never counted (the "disabled collisions" of MoveIt's setup assistant), measured
 once per arm by :func:`self_collision_exclusions`. The excluded pairs are kept out of the narrow
 phase too (a contype bit per group of robot bodies with the same excluded arm bodies:
-:func:`self_collision_groups`), which halves a check's cost on the PR2.
+:func:`self_collision_groups`), which halves a check's cost on the PR2. The other pairs' hulls
+still overlap a little in ordinary configurations (the TIAGo's shoulder and torso column by 11 mm
+with the torso down, in each of 300 random arm configurations; with 15 mm tolerated, 12 % of them
+self-collide, as with the torso up): a self-contact counts only deeper than the checker's
+``self_tolerance`` (prospection's collision tolerance, 15 mm). Counted, such an overlap put the
+start of a motion "in collision", and arm motion planning fell back to tolerating 15 mm with
+everything (``pycram.robots.common.arm_motion.CLEARANCES``): a carried spoon grazed a drawer's
+handle that deep and was knocked out of the hand.
 """
 
 from __future__ import annotations
@@ -64,22 +71,30 @@ _FIRST_GROUP, _MAX_GROUPS = 2, 28
 #: Threshold tables (see `SimConfigurationChecker._bad`) of the latest checkers, by their
 #: exclusions (the same array for every checker of an arm without an exempt object) and
 #: clearances: making one costs 0.5 ms for 194 geoms, 2 ms for 400, at a plan's first contact.
-_TABLES: OrderedDict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = OrderedDict()
+_TABLES: OrderedDict[tuple[int, bytes, bytes, float], tuple[np.ndarray, np.ndarray]] = OrderedDict()
 _TABLES_KEPT = 6
 _TABLES_LOCK = threading.Lock()
 
 
-def threshold_table(ignore: np.ndarray, clearance: np.ndarray) -> np.ndarray:
+def threshold_table(
+    ignore: np.ndarray, clearance: np.ndarray, robot: np.ndarray | None = None, self_threshold: float = 0.0
+) -> np.ndarray:
     """The (ngeom x ngeom) table of the distances [m] below which a contact between two geoms
-    counts: the larger ``clearance`` of the two, -inf where ``ignore`` (never counted). Cached
-    for the latest few (``ignore``, ``clearance``) pairs: do not change either afterwards."""
-    key = (id(ignore), clearance.tobytes())
+    counts: the larger ``clearance`` of the two; between two geoms of ``robot`` (a mask: a
+    self-collision) at most ``self_threshold``; -inf where ``ignore`` (never counted). Cached
+    for the latest few arguments: do not change the arrays afterwards."""
+    robot_key = b"" if robot is None else np.packbits(robot).tobytes()
+    key = (id(ignore), clearance.tobytes(), robot_key, float(self_threshold))
     with _TABLES_LOCK:
         hit = _TABLES.get(key)
         if hit is not None and hit[0] is ignore:
             _TABLES.move_to_end(key)
             return hit[1]
-    table = np.where(ignore, -np.inf, np.maximum(clearance[:, None], clearance[None, :]))
+    table = np.maximum(clearance[:, None], clearance[None, :])
+    if robot is not None:
+        pairs = np.ix_(robot, robot)
+        table[pairs] = np.minimum(table[pairs], self_threshold)
+    table[ignore] = -np.inf
     with _TABLES_LOCK:
         _TABLES[key] = (ignore, table)
         while len(_TABLES) > _TABLES_KEPT:
@@ -273,7 +288,9 @@ class SimConfigurationChecker(ConfigurationChecker):
 
     Made by `SimProspection.configuration_checker` with ``data`` prepared (the world as it is,
     the base at its pose, the other joints set, kinematics computed); ``release`` gives the
-    planning copy and its data back to their pool on :meth:`close`.
+    planning copy and its data back to their pool on :meth:`close`; ``clearance`` [m, per geom]:
+    a contact counts closer than the larger of its two geoms'; ``self_tolerance`` [m]: a contact
+    between two of the robot's geoms counts only deeper than this (link hulls overlap).
     """
 
     def __init__(
@@ -286,13 +303,18 @@ class SimConfigurationChecker(ConfigurationChecker):
         held: tuple[int, np.ndarray, np.ndarray] | None,
         geom_name: Callable[[int], str],
         release: Callable[[], None],
+        self_tolerance: float = 0.0,
     ) -> None:
+        if not self_tolerance >= 0.0:
+            raise ValueError(f"self_tolerance must be >= 0 [m], got {self_tolerance!r}")
         self.model, self.data = model, data
         self.joints = parts.joints
         self.checks = 0
         self._qadr = parts.qadr
         self._ignore = ignore
         self._clearance = clearance  # per geom [m]: a pair is touching below the larger of its two
+        self._robot = parts.arm | parts.upper | parts.rest
+        self._self_tolerance = float(self_tolerance)
         self._held = held  # (qpos address of the free joint, position in the hand, quaternion in the hand)
         self._hand = parts.hand_body
         self._geom_name = geom_name
@@ -323,12 +345,13 @@ class SimConfigurationChecker(ConfigurationChecker):
 
     def _bad(self, n: int) -> np.ndarray:
         """Which of the first ``n`` contacts count as collisions: closer than the pair's threshold
-        (the larger clearance of its two geoms), the pair not ignored. The thresholds are one
+        (the larger clearance of its two geoms; between two robot geoms at most
+        ``-self_tolerance``), the pair not ignored. The thresholds are one
         table (:func:`threshold_table`), taken at the first contact: one lookup a contact
         (measured: 3 instead of 7 us with 5 contacts, 4 instead of 16 us with 18)."""
         below = self._below
         if below is None:
-            below = self._below = threshold_table(self._ignore, self._clearance)
+            below = self._below = threshold_table(self._ignore, self._clearance, self._robot, -self._self_tolerance)
         contact = self.data.contact
         geoms = contact.geom
         if len(geoms) != n:

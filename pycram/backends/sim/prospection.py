@@ -477,6 +477,11 @@ class SimProspection(Prospection):
             held,
             self._geom_name,
             lambda: self._planning_pool.put((planning, d)),
+            # the robot's own links collide as their convex hulls, which overlap a little in
+            # ordinary configurations (the TIAGo's shoulder and torso column by 11 mm, the torso
+            # up): counted, such an overlap at the start made every plan from there tolerate
+            # shallow contacts with everything, a carried spoon's with a drawer's handle too
+            self_tolerance=self.tolerance,
         )
 
     def tool_pose(self, arm: str, base_pose: Any, joint_configuration: Mapping[str, float] | None = None) -> ToolPose:
