@@ -123,6 +123,8 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
                 break
             reached_q = let_go_at = q
     finally:
+        if let_go_at != start:  # the arm's way off the handle is planned with the drawer where it is
+            belief.moved_container(container.name, let_go_at)
         _release(arm, gripper, list(container.handle_position(let_go_at)), grasp)
     measured = _measure(belief, container)
     _look_at_neighbours(belief, container)

@@ -519,17 +519,43 @@ class BeliefState(Belief):
         """The robot itself put `obj` down at `position` (x, y, z) [m, map], turned by `turn`
         [rad] about the vertical since it was last seen (it turned with the hand that carried
         it: the measured direction of its top's longer axis, property "axis", turns along):
-        believe it so (not gone) until the next look refreshes it; no gripper holds it any more.
-        Its pose fluent pulses."""
+        believe it so (not gone) until the next look refreshes it, standing on (properties "on"
+        and "in") the surface under it there, drawers as last believed open; no gripper holds it
+        any more. Its pose fluent pulses."""
         with self._update_lock:
             self._out_of_hand(obj)
             axis = obj.properties.get("axis")
             if axis is not None and turn:
                 obj.properties["axis"] = (float(axis) + turn + math.pi / 2) % math.pi - math.pi / 2
             obj.pose = tuple(float(v) for v in position)
+            if self.environment is not None and len(obj.pose) == 3:
+                # a look that misses it (the arm in view, the drawer's front) must not leave it
+                # believed where it was picked up from (measured: a spoon put into drawer 2 kept
+                # "on": "table", and a transport judged by it failed)
+                x, y, z = obj.pose
+                size = obj.properties.get("size")
+                bottom = z - float(size[2]) / 2 if size else z
+                surface = support_of(self.environment, x, y, bottom, self.container_states)
+                container = None if surface is None else self.environment.container_of(surface.name)
+                obj.properties["on"] = None if surface is None else surface.name
+                obj.properties["in"] = None if container is None else container.name
             obj.gone = False
             obj.misses = 0
             obj.pose_fluent.set_value(obj.pose)
+
+    def moved_container(self, container: str, q: float) -> None:
+        """The robot itself moved the drawer or door `container` to about `q` [m or rad] (its
+        hand let go of the handle there): believe it so until it is measured (objects believed
+        in a drawer ride along; `container_stamps` keeps the last measurement's time, so the
+        next look still counts as a new measurement). Planning the arm's way off the handle in
+        the world as last measured -- the drawer closed -- swept the arm through the drawer
+        pulled out (measured: the TIAGo's shoved drawer 2 back in from 27 to 18 cm)."""
+        if not math.isfinite(q):
+            raise ValueError(f"a container's position must be finite [m or rad], got {q!r}")
+        with self._update_lock:
+            held = {id(o): o for o in self.in_hand.values()}
+            self._ride_along({container: float(q)}, held)
+            self.container_states[container] = float(q)
 
     def lost(self, obj: PerceivedObject) -> None:
         """The robot has evidence that `obj` is not where it was believed (e.g. its gripper
