@@ -6,7 +6,9 @@ off and looks again.
 
 - A drawer: the fingers close vertically on its horizontal bar, and the handle is moved along
   the slide in `PULL_STEPS` steps (closing: on to `PUSH_BEYOND` [m] past closed, against the
-  stop); afterwards the handles of the containers next to it are looked at too.
+  stop); the drawer is believed where the hand lets go of it (`BeliefState.moved_container`:
+  the arm's way off the handle is planned with it there) until the look measures it; afterwards
+  the handles of the containers next to it are looked at too.
 - A door (`_swing_door`): the fingers close horizontally on its vertical bar, the tool pointing
   into the door, and the handle is carried along its arc around the hinge in `DOOR_STEPS` tool
   poses, the wrist turning with the door (``reaching`` with an ``orientation``). Letting go, the
@@ -123,7 +125,7 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
                 break
             reached_q = let_go_at = q
     finally:
-        if let_go_at != start:  # the arm's way off the handle is planned with the drawer where it is
+        if reached_q != start:  # it moved: the arm's way off the handle is planned with it there
             belief.moved_container(container.name, let_go_at)
         _release(arm, gripper, list(container.handle_position(let_go_at)), grasp)
     measured = _measure(belief, container)
