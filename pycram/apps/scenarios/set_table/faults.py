@@ -117,24 +117,24 @@ class Faults:
         regions = START_REGIONS.get(name, {})
         if environment.name == "apartment" and "counter" in regions:
             return regions["counter"]
-        x0, y0, x1, y1 = environment.surface("counter").bounds
         kx, ky, _ = environment.place("kitchen").pose
-        inside_x, inside_y = min(max(kx, x0), x1), min(max(ky, y0), y1)  # the nearest point of each edge
-        edges = {
-            "south": math.hypot(kx - inside_x, ky - y0),
-            "north": math.hypot(kx - inside_x, ky - y1),
-            "west": math.hypot(kx - x0, ky - inside_y),
-            "east": math.hypot(kx - x1, ky - inside_y),
-        }
-        front = min(edges, key=lambda edge: edges[edge])
-        near, far = 0.06, 0.16
-        if front == "south":
-            return (x0 + 0.1, y0 + near, x1 - 0.1, y0 + far)
-        if front == "north":
-            return (x0 + 0.1, y1 - far, x1 - 0.1, y1 - near)
-        if front == "west":
-            return (x0 + near, y0 + 0.1, x0 + far, y1 - 0.1)
-        return (x1 - far, y0 + 0.1, x1 - near, y1 - 0.1)
+
+        def distance(edge: tuple[Any, Any, Any]) -> float:  # from the kitchen place to the edge
+            (ax, ay), (bx, by), _ = edge
+            length2 = (bx - ax) ** 2 + (by - ay) ** 2 or 1.0
+            f = min(1.0, max(0.0, ((kx - ax) * (bx - ax) + (ky - ay) * (by - ay)) / length2))
+            return math.hypot(kx - ax - f * (bx - ax), ky - ay - f * (by - ay))
+
+        (ax, ay), (bx, by), (nx, ny) = min(environment.surface("counter").edges(), key=distance)
+        length = math.hypot(bx - ax, by - ay)
+        ux, uy = (bx - ax) / length, (by - ay) / length
+        corners = [
+            (ax + ux * along - nx * inward, ay + uy * along - ny * inward)
+            for along in (0.1, length - 0.1)
+            for inward in (0.06, 0.16)
+        ]
+        xs, ys = [c[0] for c in corners], [c[1] for c in corners]
+        return (min(xs), min(ys), max(xs), max(ys))
 
     def _free_counter_spot(self, name: str, near: tuple[float, float] | None = None) -> tuple[float, float, float]:
         """A spot [m] for `name` standing upright in its counter region (`_counter_region`),
