@@ -367,9 +367,9 @@ class BeliefState(Belief):
         self.updated = Fluent(None, name="belief updated")
         #: The objects the robot's grippers hold, by gripper (`picked_up`).
         self.in_hand: dict[str, PerceivedObject] = {}
-        #: Surfaces a search looked at from close by (`looked_into`), with when [s, the reports'
-        #: clock]: what was visible there then is believed.
-        self.searched: dict[str, float] = {}
+        #: Surfaces a search looked at from close by (`looked_into`): what was visible there then
+        #: is believed.
+        self.searched: set[str] = set()
 
     # --- reading ----------------------------------------------------------------------------
     def present(self) -> list[PerceivedObject]:
@@ -489,11 +489,10 @@ class BeliefState(Belief):
 
     def looked_into(self, surface: str) -> None:
         """A search looked at the surface `surface` from close by (inside an open container, or
-        from in front of an open surface): note it in `searched`, stamped with the last update's
-        time, so that a later search for something it did not see there looks there last."""
+        from in front of an open surface): note it in `searched`, so that a later search for
+        something it did not see there looks there last."""
         with self._update_lock:
-            stamp = self.updated.get_value()
-            self.searched[surface] = float(stamp) if isinstance(stamp, (int, float)) else 0.0
+            self.searched.add(surface)
 
     def picked_up(self, obj: PerceivedObject, gripper: str) -> None:
         """The robot's `gripper` holds `obj` (its grasp was measured): until it is put down or
