@@ -342,6 +342,52 @@ def test_mink_reaches_a_reachable_pose_within_a_millimetre(world):
     assert not far and far.reason == "no_solution" and far.positions == ()
 
 
+def _off_the_line(scene, prospection, path, a, b):
+    """The farthest [m] the tool leaves the line a-b along the path's joint segments, sampled 20
+    times each."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    worst = 0.0
+    for q0, q1 in zip(path, path[1:]):
+        for s in np.linspace(0.0, 1.0, 21):
+            p, _ = _tool(scene, prospection, [x + s * (y - x) for x, y in zip(q0, q1)])
+            along = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+            worst = max(worst, float(np.linalg.norm(p - (a + along * (b - a)))))
+    return worst
+
+
+def test_the_tools_straight_line_keeps_the_tool_on_it_where_the_joints_line_bows(world):
+    from pycram.reasoning.motion.cartesian import LINE_TOLERANCE, plan_cartesian_line
+
+    scene, prospection = world
+    a, b = (4.32, 1.62, 1.0), (4.32, 1.78, 1.0)  # 16 cm forward over the table
+    start = _ik(prospection, a)
+    plan = plan_cartesian_line(prospection, ARM, start, (b, FORWARD), BASE)
+    assert plan and plan.planner == "cartesian_line", plan.message
+    assert plan.path[0] == tuple(start) and 2 <= len(plan.path) < 17  # simplified: fewer than its 16 steps
+    assert _off_the_line(scene, prospection, plan.path, a, b) <= LINE_TOLERANCE + 1e-3
+    end, _ = _tool(scene, prospection, plan.path[-1])
+    assert np.linalg.norm(end - np.asarray(b)) <= 1e-3
+    assert prospection.arm_configuration_free(ARM, plan.path[-1], BASE)
+    # the same goal solved from another seed: the joints' straight line to it leaves the line
+    other = _ik(prospection, b, seeds=[[0.0] * len(start)])
+    assert _off_the_line(scene, prospection, [start, other], a, b) > 0.05
+
+
+def test_the_tools_straight_line_says_what_it_touches_or_where_ik_fails(world):
+    from pycram.reasoning.motion.cartesian import plan_cartesian_line
+
+    _, prospection = world
+    through = plan_cartesian_line(
+        prospection, ARM, _ik(prospection, (4.02, 1.78, 0.83)), ((4.24, 1.78, 0.83), FORWARD), BASE
+    )
+    assert not through and through.reason == "no_path" and "touches wall" in through.message
+    start = _ik(prospection, (4.32, 1.62, 1.0))
+    too_far = plan_cartesian_line(prospection, ARM, start, ((4.32, 3.0, 1.0), FORWARD), BASE)
+    assert not too_far and too_far.reason == "no_path" and "no IK solution on the line" in too_far.message
+    with pytest.raises(ValueError, match="start needs 7 positions"):
+        plan_cartesian_line(prospection, ARM, start[:3], ((4.32, 1.7, 1.0), FORWARD), BASE)
+
+
 def test_joint_limits_come_from_the_model_and_the_urdf(world):
     _, prospection = world
     limits = prospection.arm_joint_limits(ARM)

@@ -5,6 +5,8 @@ joints' limits.
   :class:`MotionPlan` answer (a path or a typed reason) and :func:`plan_to_pose` (IK, then a plan);
 - :mod:`~pycram.reasoning.motion.ompl_planner` -- :class:`OMPLPlanner`: straight line first, else
   RRT-Connect with OMPL's path simplification and string pulling, deterministic per seed;
+- :mod:`~pycram.reasoning.motion.cartesian` -- :func:`plan_cartesian_line`: a path whose tool
+  follows the straight line to a pose (a grasp's approach), IK step by step;
 - :mod:`~pycram.reasoning.motion.timing` -- :func:`time_parameterize`: a path as samples (t, q)
   within the joints' velocity and acceleration limits (Ruckig).
 
@@ -26,6 +28,7 @@ Typical use (an action or a process module, the robot standing at ``base``)::
 OMPL and Ruckig (the `sim` extra) are imported when first used.
 """
 
+from .cartesian import plan_cartesian_line
 from .ompl_planner import OMPLPlanner
 from .planner import PLAN_FAILURES, MotionPlan, MotionPlanner, PoseMotionPlan, plan_to_pose
 from .timing import TimedTrajectory, time_parameterize
@@ -37,6 +40,7 @@ __all__ = [
     "PLAN_FAILURES",
     "PoseMotionPlan",
     "TimedTrajectory",
+    "plan_cartesian_line",
     "plan_to_pose",
     "time_parameterize",
 ]
