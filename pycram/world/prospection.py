@@ -239,6 +239,10 @@ class ConfigurationChecker(abc.ABC):
     joints: tuple[str, ...] = ()
     #: Configurations checked so far (by :meth:`is_free`, :meth:`contacts` and :meth:`motion_free`).
     checks: int = 0
+    #: With a held object: how far [rad] the direction that points up through it when the checker
+    #: was made may lean from the vertical in a free configuration (:meth:`held_lean`); the
+    #: default, infinity, lets it turn any way.
+    max_held_lean: float = math.inf
 
     @abc.abstractmethod
     def is_free(self, q: Sequence[float]) -> bool:
@@ -248,6 +252,11 @@ class ConfigurationChecker(abc.ABC):
     @abc.abstractmethod
     def contacts(self, q: Sequence[float]) -> list[tuple[str, str]]:
         """The distinct touching pairs (robot part or held object, obstacle) with the arm at ``q``."""
+
+    def held_lean(self, q: Sequence[float]) -> float:
+        """How far [rad] the direction that pointed up through the held object when the checker
+        was made leans from the vertical with the arm at ``q`` (0 without a held object)."""
+        return 0.0
 
     def motion_free(self, q0: Sequence[float], q1: Sequence[float], resolution: float = 0.02) -> bool:
         """True iff every configuration on the straight joint-space segment from ``q0`` to ``q1``,
@@ -407,7 +416,9 @@ class Prospection(abc.ABC):
         that is larger (objects are where they were measured, a few cm off: a plan keeps away).
         The robot's own parts may overlap each other as deep as the implementation's models of
         them do in ordinary configurations (the simulator's: 15 mm, link meshes collide as their
-        convex hulls) before that counts.
+        convex hulls) before that counts. A configuration that tilts the held object further than
+        the checker's `ConfigurationChecker.max_held_lean` (set it after making the checker) is
+        not free either.
 
         Raises ``ValueError`` for an unknown arm, joint or object (listing the valid ones),
         ``NotImplementedError`` when this prospection does not support arm motion planning.

@@ -388,6 +388,35 @@ def test_the_tools_straight_line_says_what_it_touches_or_where_ik_fails(world):
         plan_cartesian_line(prospection, ARM, start[:3], ((4.32, 1.7, 1.0), FORWARD), BASE)
 
 
+def test_a_held_objects_lean_is_measured_from_how_it_stands_now_and_limits_free_configurations(world):
+    scene, prospection = world
+    joints = scene.description.ARMS[ARM]["joints"]
+    now = [float(prospection._snapshot().qpos[scene.joint_qpos(j)]) for j in joints]
+    rng = np.random.default_rng(3)
+    limits = prospection.arm_joint_limits(ARM)
+    with prospection.configuration_checker(ARM, BASE, held_object=CUP[0], clearance=-1.0) as checker:
+        assert checker.held_lean(now) == pytest.approx(0.0, abs=1e-6)
+        _, rotation_now = _tool(scene, prospection, now)
+        leans = []
+        for _ in range(20):
+            q = [float(rng.uniform(max(lo, -math.pi), min(hi, math.pi))) for lo, hi in zip(limits.lower, limits.upper)]
+            _, rotation = _tool(scene, prospection, q)
+            up = rotation @ rotation_now.T @ np.array([0.0, 0.0, 1.0])  # the direction up now, turned with the hand
+            expected = math.acos(np.clip(up[2], -1.0, 1.0))
+            assert checker.held_lean(q) == pytest.approx(expected, abs=1e-6)
+            leans.append((expected, q))
+        leans.append((0.0, now))
+        assert max(leans)[0] > math.radians(30.0)
+        assert checker.is_free(max(leans)[1])  # any lean, by default (contacts tolerated up to 1 m here)
+        checker.max_held_lean = math.radians(30.0)
+        for lean, q in leans:
+            assert checker.is_free(q) == (lean <= math.radians(30.0))
+            if lean > math.radians(30.0):
+                assert ("the held object", "its tilt limit (30 deg)") in checker.contacts(q)
+    with prospection.configuration_checker(ARM, BASE) as empty:  # no held object: no lean
+        assert empty.held_lean(now) == 0.0
+
+
 def test_joint_limits_come_from_the_model_and_the_urdf(world):
     _, prospection = world
     limits = prospection.arm_joint_limits(ARM)

@@ -231,6 +231,24 @@ def test_an_object_in_hand_is_not_missed_and_its_sighting_in_the_air_is_not_a_ne
     assert belief.in_hand == {} and milk.gone
 
 
+def test_an_object_in_hand_seen_over_a_surface_near_the_hand_is_not_a_new_object():
+    belief = BeliefState(APARTMENT)
+    (held,) = belief.update(PerceptionReport(1.0, (cup(4.3, 2.0),))).added
+    belief.picked_up(held, "left")
+    # carried 20 cm over the table: perception finds the table under it ("on" the table)
+    over_table = Detection("cup", (3.9, 2.1, 1.0), (0.07, 0.07, 0.09), "red", support="table", pixels=200)
+    hands = {"left": (3.92, 2.05, 1.02), "right": (4.5, 1.6, 1.0)}
+    update = belief.update(PerceptionReport(2.0, (over_table,), hands=hands))
+    assert update.added == () and [o.name for o in belief.present()] == ["cup-1"]
+    # the same sighting without the hand's position, or far from the hand that holds a cup: a new cup
+    assert [o.name for o in belief.update(PerceptionReport(3.0, (over_table,))).added] == ["cup-2"]
+    elsewhere = Detection("cup", (3.0, 2.2, 0.8), (0.07, 0.07, 0.09), "red", support="table", pixels=200)
+    assert [o.name for o in belief.update(PerceptionReport(4.0, (elsewhere,), hands=hands)).added] == ["cup-3"]
+    # near a hand that holds no cup: a cup
+    free_hand = Detection("cup", (4.5, 1.7, 0.8), (0.07, 0.07, 0.09), "red", support="table", pixels=200)
+    assert [o.name for o in belief.update(PerceptionReport(5.0, (free_hand,), hands=hands)).added] == ["cup-4"]
+
+
 def test_a_look_that_measures_no_turn_keeps_the_turn_measured_before_while_the_object_stays():
     def milk(x, axis):
         return Detection("milk", (x, 2.0, 0.85), (0.07, 0.07, 0.2), "white", support="table", pixels=500, axis=axis)

@@ -32,6 +32,7 @@ handle that deep and was knocked out of the hand.
 from __future__ import annotations
 
 import copy
+import math
 import queue
 import threading
 from collections import OrderedDict
@@ -321,6 +322,16 @@ class SimConfigurationChecker(ConfigurationChecker):
         self._release: Callable[[], None] | None = release
         self._pos, self._quat = np.zeros(3), np.zeros(4)
         self._below: np.ndarray | None = None  # see _bad
+        self._up = np.zeros(3)
+        self._held_up: np.ndarray | None = None  # the held object's frame: the direction up when made
+        if held is not None:
+            adr = held[0]
+            quat = np.asarray(data.qpos[adr + 3 : adr + 7], float)  # the object as it is (prepared data)
+            inverse = np.zeros(4)
+            mujoco.mju_negQuat(inverse, quat)
+            up = np.zeros(3)
+            mujoco.mju_rotVecQuat(up, np.array([0.0, 0.0, 1.0]), inverse)
+            self._held_up = up
 
     def _collide(self, q: Sequence[float]) -> int:
         """Set the arm to ``q``, run kinematics and collision detection; the contact count."""
@@ -358,15 +369,33 @@ class SimConfigurationChecker(ConfigurationChecker):
             geoms = geoms[:n]
         return contact.dist[:n] < below[geoms[:, 0], geoms[:, 1]]
 
+    def _lean(self) -> float:
+        """How far [rad] the held object's up direction (`held_lean`) leans after `_collide`."""
+        if self._held_up is None:
+            return 0.0
+        mujoco.mju_rotVecQuat(self._up, self._held_up, self._quat)
+        return math.acos(max(-1.0, min(1.0, float(self._up[2]))))
+
+    def held_lean(self, q: Sequence[float]) -> float:
+        self._collide(q)
+        return self._lean()
+
+    def _leans_too_far(self) -> bool:
+        return self.max_held_lean < math.inf and self._lean() > self.max_held_lean
+
     def is_free(self, q: Sequence[float]) -> bool:
         n = self._collide(q)
+        if self._leans_too_far():
+            return False
         return n == 0 or not bool(self._bad(n).any())
 
     def contacts(self, q: Sequence[float]) -> list[tuple[str, str]]:
         n = self._collide(q)
-        if n == 0:
-            return []
         out: dict[tuple[str, str], None] = {}
+        if self._leans_too_far():
+            out[("the held object", f"its tilt limit ({math.degrees(self.max_held_lean):.0f} deg)")] = None
+        if n == 0:
+            return list(out)
         moving = self.model.geom_contype
         for i in np.nonzero(self._bad(n))[0]:
             g1, g2 = (int(g) for g in self.data.contact.geom[i])

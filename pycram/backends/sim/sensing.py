@@ -120,7 +120,7 @@ class Sensing(CommandQueue):
         `pycram.world.belief.PerceptionReport` (detections measured from segmentation, depth and
         colour images of `width` x `height` [px], most visible first; the camera view with its
         depth image; the joint positions of the containers whose handle is in the image or that
-        an object was seen inside),
+        an object was seen inside; where each gripper's tool frame is),
         stamped with the simulated time.
 
         Objects with fewer than `min_pixels` visible pixels or farther than `max_range` [m] are
@@ -163,7 +163,13 @@ class Sensing(CommandQueue):
             if view.in_image(self.environment.container(name).handle_position(q))
             or any(d.container == name for d in detections)
         }
-        return PerceptionReport(eng.time, tuple(detections), view, in_view)
+        tools = eng.deferred_tool_poses()()  # by arm: the robot's own joints, measured as it looks
+        hands = {
+            str(arm["gripper"]): tools[name].position
+            for name, arm in self.scene.description.ARMS.items()
+            if name in tools and arm.get("gripper")
+        }
+        return PerceptionReport(eng.time, tuple(detections), view, in_view, hands)
 
     def request_segmentation(self, camera: str = HEAD_CAMERA, width: int = 320, height: int = 240) -> CommandHandle:
         """Render geom ids per pixel (height x width, -1: background) from `camera`."""

@@ -107,6 +107,7 @@ class MotionPlanner(abc.ABC):
         exempt_object: str | None = None,
         clearance: float = 0.0,
         object_clearance: float = 0.0,
+        held_tilt: float | None = None,
         time_limit: float | None = None,
         seed: int = 0,
     ) -> MotionPlan:
@@ -114,7 +115,10 @@ class MotionPlanner(abc.ABC):
         world; the other joints as they are now or as in ``joint_configuration``. ``held_object``,
         ``exempt_object``, ``clearance`` and ``object_clearance`` [m] are those of
         :meth:`~pycram.world.prospection.Prospection.configuration_checker`; with
-        ``include_torso`` the torso joint is planned too (first in the configurations)."""
+        ``include_torso`` the torso joint is planned too (first in the configurations). With
+        ``held_tilt`` [rad] and a ``held_object``, no configuration of the path tilts the held
+        object further from how it stands now than that, or than the goal tilts it
+        (`ConfigurationChecker.max_held_lean`): carried upright, it stays so on the way."""
         limits = prospection.arm_joint_limits(arm, include_torso)
         with prospection.configuration_checker(
             arm,
@@ -126,6 +130,8 @@ class MotionPlanner(abc.ABC):
             clearance=clearance,
             object_clearance=object_clearance,
         ) as checker:
+            if held_tilt is not None and held_object is not None:
+                checker.max_held_lean = max(held_tilt, checker.held_lean(goal) + 1e-3, checker.held_lean(start) + 1e-3)
             return self.plan_with(checker, limits, start, goal, time_limit=time_limit, seed=seed)
 
 
