@@ -201,3 +201,37 @@ def test_the_path_controller_refuses_malformed_samples_and_follows_a_path():
         assert np.allclose(now, goal, atol=0.01)
     finally:
         world.close()
+
+
+@pytest.mark.parametrize("loaded_tolerance, reason", [(0.05, "succeeded"), (0.02, "blocked")])
+def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkeypatch, loaded_tolerance, reason):
+    """A constant 24 N m pulls the shoulder down while it lifts: its servo (600 N m/rad) holds it
+    0.04 rad short. Within `LOADED_TOLERANCE` after the settle time that is arrival, beyond it
+    'blocked' (naming the joint)."""
+    import mujoco
+
+    from pycram.backends.sim import arm_path
+    from pycram.sim import World
+
+    monkeypatch.setattr(arm_path, "LOADED_TOLERANCE", loaded_tolerance)
+    world = World("pr2", environment="apartment", base_pose=BASE)
+    try:
+        model, data = world._engine.model, world._engine.data
+        joints = world.description.ARMS[ARM]["joints"]
+        lift = joints.index(f"{ARM[0]}_shoulder_lift_joint")
+        here = [world.joint_states.get_value().position[j] for j in joints]
+        goal = list(here)
+        goal[lift] += 0.2
+        samples = [(0.02 * i, [a + (b - a) * i / 50 for a, b in zip(here, goal)]) for i in range(51)]
+        dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joints[lift])]
+        data.qfrc_applied[dof] = -24.0  # the load (applied forces persist until changed)
+        outcome = world.follow_arm_path(ARM, joints, samples).wait(30.0)
+        assert outcome.reason == reason, outcome.message
+        short = goal[lift] - world.joint_states.get_value().position[joints[lift]]
+        assert 0.035 <= short <= 0.045
+        if reason == "succeeded":
+            assert outcome.value == pytest.approx(short, abs=1e-3)
+        else:
+            assert "joints stopped 0.04" in outcome.message and joints[lift] in outcome.message
+    finally:
+        world.close()

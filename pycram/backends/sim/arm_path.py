@@ -28,9 +28,10 @@ arm presses no further against what it hit. The outcome's value is a :class:`Pat
 configuration where it stopped and the index of the last sample it had passed, so the caller can
 back off along the executed part of the path and plan again.
 
-Success: after the last sample every joint is within ``tolerance`` of the path's end; if that is
-not reached within ``settle_time`` [s] the outcome is ``"blocked"`` (naming the joint farthest
-off). Value on success: the largest remaining joint error [rad or m].
+Success: after the last sample every joint is within ``tolerance`` of the path's end, or within
+`LOADED_TOLERANCE` once ``settle_time`` [s] has passed (servos holding a load stop a little short);
+else the outcome is ``"blocked"`` (naming the joint farthest off). Value on success: the largest
+remaining joint error [rad or m].
 
 Every input is checked before anything moves (outcome ``"invalid"``): samples must be finite, of
 the joints' length, at strictly increasing times from 0, within the joints' position limits.
@@ -60,6 +61,7 @@ __all__ = [
     "ITEM_DEPTH",
     "ITEM_DISPLACEMENT",
     "ITEM_TURN",
+    "LOADED_TOLERANCE",
     "MAX_DEVIATION",
     "PATH_TOLERANCE",
     "SETTLE_TIME",
@@ -88,6 +90,11 @@ MAX_DEVIATION = 0.25
 PATH_TOLERANCE = 0.01
 #: Time [s] the joints get after the last sample to come within the tolerance.
 SETTLE_TIME = 2.0
+#: After the settle time, joints this close [rad or m] to the last sample, touching nothing, have
+#: arrived: their servos hold them there under the load (the PR2's forearm roll, a cereal box
+#: held by its side, stops 0.032-0.034 rad short; reported 'blocked', the pick-up let the box go
+#: and it fell: set-table-anywhere, ``procedural:14``, seed 1).
+LOADED_TOLERANCE = 0.05
 
 
 @dataclass(frozen=True)
@@ -263,6 +270,8 @@ class JointPath(Controller):
             if errors[worst] <= self.tol:
                 return ok(float(errors[worst]))
             if elapsed > self.times[-1] + self.settle:
+                if errors[worst] <= max(self.tol, LOADED_TOLERANCE):
+                    return ok(float(errors[worst]))
                 return self._stop(
                     eng, "blocked", f"joints stopped {errors[worst]:.3f} from the goal ({self.joints[worst]})", elapsed
                 )
