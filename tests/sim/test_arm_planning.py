@@ -136,6 +136,38 @@ def test_a_box_put_in_the_way_after_planning_is_hit_softly_detected_and_planned_
         world.close()
 
 
+def test_a_motion_without_a_path_in_the_budget_moves_watched_stops_softly_and_is_planned_again():
+    from pycram.designator import MotionDesignator, perform
+    from pycram.reasoning.motion import MotionPlan
+    from pycram.robots.common.arm_motion import WATCHED_LINE
+
+    world, robot = _world(WALL)
+    try:
+        _to_start(world, robot)
+        planner = _planner(robot)
+        plan_once = planner.planner.plan
+
+        def out_of_budget_until_stopped(*args, **kwargs):  # as RRT-Connect's check budget running out
+            plan = plan_once(*args, **kwargs)
+            if planner.last_stops or not plan:
+                return plan
+            return MotionPlan(plan.joints, (), "no_path", "RRT-Connect found no path in 0 checks")
+
+        planner.planner.plan = out_of_budget_until_stopped
+        with robot:
+            reached = perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
+        assert math.dist(reached.position, GOAL) < 0.01
+        assert any(p.planner == WATCHED_LINE for p in planner.last_plans)  # the joints' line, through the wall
+        (stop,) = planner.last_stops  # watched: the wall stopped it
+        assert stop.reason == "collision" and "wall" in stop.message
+        assert planner.last_plans[-1].planner == "RRTConnect"  # then around it
+        wall = _wall(world)
+        assert math.dist(wall.position[:2], WALL[:2]) < 0.03  # a soft hit
+    finally:
+        robot.shutdown()
+        world.close()
+
+
 def test_a_box_nobody_saw_is_hit_softly_looked_at_and_planned_around_in_the_believed_world():
     """As the robot plans by default: in its believed world, where a cereal box put in the arm's
     way is unknown until the arm hits it; the arm stops, the head looks, the box goes into the

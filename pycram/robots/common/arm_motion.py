@@ -52,14 +52,14 @@ by definition; it is executed as before planning existed: the direct joint inter
 (the drawer at its stop). Such are: a motion whose start touches something even tolerating shallow
 contacts; one whose gripper squeezes something the belief puts no object in (a handle:
 `FIXTURE_EFFORT`); a ``contact`` reach (a hand pushing a door); a `HANDLE_PHASES` reach near a
-container's handle; the `DIRECT_PHASES`. So is, for now, a motion for which the planner finds no
-path within its budget (``'no_path'``: a narrow passage, or a goal walled in): the direct motion is
-watched by nothing but its end (``'blocked'``), as before. The same holds when prospection's IK
-finds no solution for a tool pose (the simulator's own IK is tried, as before), when the robot has
-no prospection that plans (``NotImplementedError``), and while the base or the torso moves
-(`MOVING`: a plan holds for the robot standing where it stands; the thesis demo raises the arm
-while the base drives up). The ROS robot's arm modules use this planner too
-(:mod:`pycram.robots.common.ros_arm_motion`).
+container's handle; the `DIRECT_PHASES`. A motion for which the planner finds no path within its
+budget (``'no_path'``: a narrow passage, or a goal walled in) moves along the joints' straight line
+with the watched path controller (`WATCHED_LINE`): a contact stops it, and it is planned again from
+there, or fails with the stop. Directly, too, when prospection's IK finds no solution for a tool
+pose (the simulator's own IK is tried, as before), when the robot has no prospection that plans
+(``NotImplementedError``), and while the base or the torso moves (`MOVING`: a plan holds for the
+robot standing where it stands; the thesis demo raises the arm while the base drives up). The ROS
+robot's arm modules use this planner too (:mod:`pycram.robots.common.ros_arm_motion`).
 
 **The torso is not planned** (``include_torso=False``): torso motions are the actions' explicit
 ``setting_torso`` motions, and the torso's lift is slow (0.05 m/s on the PR2): planning it with
@@ -94,6 +94,7 @@ __all__ = [
     "TOLERATED_PENETRATION",
     "UNTOUCHED_PHASES",
     "VELOCITY_SCALE",
+    "WATCHED_LINE",
 ]
 
 logger = logging.getLogger(__name__)
@@ -154,6 +155,9 @@ CLEARANCES: tuple[tuple[float, float], ...] = (
     (-TOLERATED_PENETRATION, 0.0),
     (-TOLERATED_PENETRATION, -TOLERATED_PENETRATION),
 )
+#: The planner name of a motion the planner found no path for within its budget, moved along the
+#: joints' straight line by the watched path controller (a contact stops it) instead of directly.
+WATCHED_LINE = "watched_line"
 #: Reaching phases executed directly (not planned): they end with the held object touching down
 #: (``place``: 1 cm above the believed surface; touching down earlier stops the arm with
 #: ``'blocked'``, which the place action takes for "down").
@@ -361,7 +365,7 @@ class ArmMotionPlanner:
         object at the fingers (`_let_go`; None: find out here); ``straight``: the straight line
         or the direct motion, no detour; ``line``: a plan of the tool's straight line to
         ``goal`` (`plan_cartesian_line`), the first attempt's path."""
-        from pycram.reasoning.motion import time_parameterize
+        from pycram.reasoning.motion import MotionPlan, time_parameterize
 
         prospection = self.prospection()
         limits = prospection.arm_joint_limits(self.arm)
@@ -407,7 +411,7 @@ class ArmMotionPlanner:
                 "%s: plan %d: %s", what, seed, f"{plan.planner}, {len(plan.path)} waypoints" if plan else plan.reason
             )
             grasping = straight or (exempt is not None and exempt not in held and not leaving)
-            if plan and plan.planner not in ("straight_line", "cartesian_line") and grasping:
+            if plan and plan.planner not in ("straight_line", "cartesian_line", WATCHED_LINE) and grasping:
                 # the planner lets the fingers through the object being grasped: a detour could
                 # sweep it away with them (measured: the PR2's hand swung round a mug and pushed it
                 # 14 cm) -- a motion towards an object being grasped is the straight line or direct
@@ -426,7 +430,14 @@ class ArmMotionPlanner:
                         f"{stopped.message}; planning again: {plan.reason}: {plan.message}",
                         stopped.outcome,
                     )
-                raise _Direct(f"plan: {plan.reason}: {plan.message}")
+                if plan.reason != "no_path":
+                    raise _Direct(f"plan: {plan.reason}: {plan.message}")
+                # no path within the budget (a narrow passage): the joints' straight line, watched --
+                # moved directly it swept a carried bowl through the plate the other hand held
+                # (PR2, set-table-anywhere, procedural:4, seed 1); watched, a contact stops it
+                logger.info("%s: %s: the joints' straight line, watched", what, plan.message)
+                plan = MotionPlan(plan.joints, (tuple(current), tuple(goal)), None, "", WATCHED_LINE)
+                self.last_plans.append(plan)
             timed = time_parameterize(plan.path, limits, period=PERIOD, velocity_scale=VELOCITY_SCALE)
             samples = timed.samples()
             try:
