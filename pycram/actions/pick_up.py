@@ -363,7 +363,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
         belief.picked_up(obj, gripper)
     try:
         reach(2, "lift")
-        motion(type="setting_arm_configuration", arm=arm, configuration=carry_configuration(arm, grasp))
+        # blocked on its way to carry -- the held box pressed onto the furniture it was taken
+        # from (the PR2's, a cereal box from a cabinet top's back: let go, it fell) -- the base
+        # backs away first and the arm tries once more
+        _arm_to_drive(arm, carry_configuration(arm, grasp))
         back_away(f"picking up {obj.name}")
         # carried with the torso up (`CARRY_TORSO`), once backed away from the furniture: from a
         # drawer, picked with the torso low, the PR2's carried cup hung 4 cm above the table top
