@@ -269,7 +269,19 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
                 f"parking the empty {other} arm",
                 partial(motion, type="setting_arm_configuration", arm=other, configuration="park"),
             )
-    motion(type="moving", pose=location)
+    try:
+        motion(type="moving", pose=location)
+    except RECOVERABLE as error:
+        if deep or not isinstance(unwrap(error), NavigationFailure):
+            raise
+        # location reasoning checks a standing pose with the free arms tucked, as they arrive: the
+        # arm raised to carry did not fit there (measured: PR2, set-table-anywhere,
+        # procedural:14, seed 1, "goal_in_collision" beside a counter) -- tucked, it drives again
+        log.info(
+            "grasping %s: the drive with the %s arm raised failed (%s): tucked, again", obj.name, arm, unwrap(error)
+        )
+        motion(type="setting_arm_configuration", arm=arm, configuration="park")
+        motion(type="moving", pose=location)
     torso = getattr(location, "torso", None)
     if torso is not None:  # e.g. in a low drawer: the sequence was validated at another torso height
         # only once there: a torso lowered where the robot stood would sweep its raised arm over

@@ -313,6 +313,39 @@ def test_an_arm_blocked_on_its_way_up_to_drive_gets_up_all_the_same():
         assert max(abs(a - b) for a, b in zip(up, ARM_CONFIGURATIONS["right"]["carry_top"], strict=True)) < 0.05
 
 
+def test_a_drive_up_to_grasp_refused_with_the_arm_raised_is_driven_again_with_it_tucked():
+    """Location reasoning checks a standing pose with the free arms tucked; a pick-up drives up
+    with its arm raised to carry. Where that raised arm does not fit (the first drive fails, as
+    navigation refuses a goal in collision), the arm is tucked and the base drives again."""
+    from pycram.robots.common.sim_modules import NavigationFailed, NavigationModule
+    from pycram.robots.pr2.description import ARM_CONFIGURATIONS
+
+    with apartment_with("pr2", {"cup": COUNTER}) as (world, robot):
+        ready()
+        module = robot.process_module("navigation")
+        drive = module._execute
+        arms_at_drives = []
+
+        def refuse_the_first_drive_to_the_counter(designator):
+            joints = world.joint_states.get_value().position
+            right = [joints[j] for j in world.description.ARMS["right"]["joints"]]
+            pose = designator.reference()["pose"]
+            if pose.y > 3.5:  # up to the counter, not the start of the search
+                arms_at_drives.append(right)
+                if len(arms_at_drives) == 1:
+                    raise NavigationFailed("drive", "no_path", "goal_in_collision: the robot does not fit at the goal")
+            return drive(designator)
+
+        assert isinstance(module, NavigationModule)
+        module._execute = refuse_the_first_drive_to_the_counter
+        held = perform(PickUp(ObjectDesignator(type="cup"), arm="right"))
+        assert holding(world) == {"cup"} and held.arm == "right"
+        first, again, *_ = arms_at_drives
+        park = ARM_CONFIGURATIONS["right"]["park"]
+        assert max(abs(a - b) for a, b in zip(first, park)) > 0.3  # raised the first time
+        assert max(abs(a - b) for a, b in zip(again, park)) < 0.05  # tucked the second
+
+
 # -- typed failures when recovery is impossible ------------------------------------------------------
 
 
