@@ -77,6 +77,27 @@ def test_starts_are_drawn_where_the_robot_reaches_them():
     assert any(not ok for (_, ok) in scene.checked) or sum(scene.checked.values()) >= len(scene.placements)
 
 
+def test_nothing_starts_inside_a_container_no_standing_pose_opens():
+    """procedural:11's lowest drawer has its handle 0.22 m above the floor: location reasoning
+    finds no standing pose from which the PR2 opens it (the TIAGo's arm reaches that low). A spot
+    inside it is not graspable for the PR2, however reachable it is once the drawer is open."""
+    from pycram.apps.scenarios.common.scene import reachability
+
+    env = load_environment("procedural:11")
+    drawer = env.container("drawer 1")
+    inside = drawer.interior[0]
+    x = sum(p[0] for p in inside.polygon) / len(inside.polygon)
+    y = sum(p[1] for p in inside.polygon) / len(inside.polygon)
+    spot = (x, y, inside.height + OBJECT_TYPES["cup"].half_height)
+    pr2, tiago = reachability("pr2", "procedural:11"), reachability("tiago", "procedural:11")
+    opens, why = pr2.openable("drawer 1")
+    assert not opens and "to_open" in why
+    ok, why = pr2.graspable("cup", spot, support=inside.name)
+    assert not ok and why.startswith("no standing pose opens drawer 1")
+    assert pr2.openable("drawer 2")[0] and tiago.openable("drawer 1")[0]
+    assert all(reachability("pr2", "apartment").openable(c.name)[0] for c in load_environment("apartment").containers)
+
+
 def test_serve_refuses_unknown_repeated_and_too_many_objects_naming_what_to_ask_for():
     with pytest.raises(ValueError, match=r"unknown or unsupported object type\(s\) 'mugg'.*choose from cup"):
         serve.requested(1, ("mugg",))

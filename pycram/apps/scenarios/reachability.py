@@ -12,10 +12,12 @@ sequence without touching the furniture. Asked without `neighbours`, other objec
 do not change the answer.
 
 `graspable` answers for a spot inside a container too (the container opened as `Open` opens
-it), and -- to judge as the robot's reasoning will once it has seen the scene -- with other
-objects counted as believed ones, the object's turn as perception reports it and a margin for
-how far off perception measures it (`draw_spot(..., among_placed=True)`, used by set-table's
-``anywhere`` starts; the other scenes of the task suite do not ask for it yet).
+it; no spot inside a container that no standing pose opens, `openable`: the PR2 opens no drawer
+whose handle is 0.22 m above the floor), and -- to judge as the robot's reasoning will once it
+has seen the scene -- with other objects counted as believed ones, the object's turn as
+perception reports it and a margin for how far off perception measures it (`draw_spot(...,
+among_placed=True)`, used by set-table's ``anywhere`` starts; the other scenes of the task suite
+do not ask for it yet).
 
 This is knowledge of the scene's generator, not of the robot: the robot still starts knowing
 nothing, and no plan may ask this filter. Benchmarks also use it to judge a failure: an
@@ -104,6 +106,7 @@ class ReachabilityFilter:
         finally:
             world.close()
         self._placeable: dict[tuple[str, str], tuple[bool, str]] = {}
+        self._openable: dict[str, tuple[bool, str]] = {}
         self._lock = threading.Lock()
 
     def _first(self, container: str | None, properties: list[tuple[str, Any]]) -> Any:
@@ -142,6 +145,10 @@ class ReachabilityFilter:
         from pycram.reasoning.locations import KnownObject
 
         container = self._container_of(support)
+        if container is not None:
+            opens, why = self.openable(container)
+            if not opens:  # the object inside is out of reach however reachable it is once open
+                return False, f"no standing pose opens {container}: {why}"
         turn = perceived_yaw(type_name, yaw) if as_perceived else float(yaw)
         x, y, z = self._as_opened(container, support, position)
         points = [(x, y, z)]
@@ -157,6 +164,19 @@ class ReachabilityFilter:
                     off = "" if point == points[0] else f" {margin * 100:.0f} cm off"
                     return False, off.strip() + (": " if off else "") + str(error).split(": ", 1)[-1]
         return True, _describe(found[0])
+
+    def openable(self, container: str) -> tuple[bool, str]:
+        """Whether some standing pose opens `container` (closed, nothing else believed) as far
+        as `Open` opens it (`openings`): ``to_open`` of the robot's location reasoning; with the
+        pose found, or why none is (e.g. a drawer whose handle is too low for the arm). Cached."""
+        with self._lock:
+            if container not in self._openable:
+                try:
+                    location = self._first(None, [("to_open", container), ("opening", self.openings[container])])
+                    self._openable[container] = (True, _describe(location))
+                except NoSolutionError as error:
+                    self._openable[container] = (False, str(error).split(": ", 1)[-1])
+            return self._openable[container]
 
     def _container_of(self, support: str | None) -> str | None:
         """The container whose inside `support` is (None for an open surface or None)."""
