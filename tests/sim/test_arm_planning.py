@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 from sim_helpers import ok
 
+from pycram.process_module import ProcessModuleFailure
+
 pytest.importorskip("ompl")
 pytest.importorskip("ruckig")
 pytest.importorskip("mink")
@@ -163,6 +165,39 @@ def test_a_motion_without_a_path_in_the_budget_moves_watched_stops_softly_and_is
         assert planner.last_plans[-1].planner == "RRTConnect"  # then around it
         wall = _wall(world)
         assert math.dist(wall.position[:2], WALL[:2]) < 0.03  # a soft hit
+    finally:
+        robot.shutdown()
+        world.close()
+
+
+def test_after_a_stop_a_plan_no_longer_tolerates_touching_believed_objects():
+    """Before a stop, the last resort of planning tolerates shallow contacts with believed objects;
+    after one (what was hit may be a believed object) it does not: with no path otherwise, the
+    stop is the motion's failure, nothing moves through the object."""
+    from pycram.designator import MotionDesignator, perform
+    from pycram.reasoning.motion import MotionPlan
+    from pycram.robots.common.arm_motion import TOLERATED_PENETRATION
+
+    world, robot = _world(AWAY)
+    try:
+        _to_start(world, robot)
+        planner = _planner(robot)
+        plan_once = planner.planner.plan
+        asked_after_the_stop = []
+
+        def wall_then_no_path(*args, **kwargs):
+            if not planner.last_stops:
+                plan = plan_once(*args, **kwargs)
+                ok(world.move_item("wall", WALL))  # in the way once planned
+                return plan
+            asked_after_the_stop.append(kwargs["object_clearance"])
+            return MotionPlan(planner.joints, (), "no_path", "RRT-Connect found no path in 0 checks")
+
+        planner.planner.plan = wall_then_no_path
+        with robot, pytest.raises(ProcessModuleFailure, match="collision"):
+            perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
+        assert asked_after_the_stop and all(c >= 0.0 for c in asked_after_the_stop)
+        assert -TOLERATED_PENETRATION not in asked_after_the_stop
     finally:
         robot.shutdown()
         world.close()

@@ -387,7 +387,11 @@ class ArmMotionPlanner:
             if planned_line:  # the tool's straight line, planned already
                 plan = line
                 self.last_plans.append(plan)
-            for clearance, object_clearance in () if planned_line else CLEARANCES:
+            # after a stop, contacts with believed objects are no longer tolerated: the object hit
+            # may be one (a plan 15 mm into a believed milk carton stopped on it, and the line
+            # planned again through it, moved directly, knocked it over: procedural:4, seed 1)
+            levels = CLEARANCES if stopped is None else tuple(c for c in CLEARANCES if c[1] >= 0.0)
+            for clearance, object_clearance in () if planned_line else levels:
                 plan = _with_known_objects(
                     partial(
                         self.planner.plan,
