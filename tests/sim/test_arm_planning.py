@@ -302,3 +302,26 @@ def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkey
             assert "joints stopped 0.04" in outcome.message and joints[lift] in outcome.message
     finally:
         world.close()
+
+
+def test_a_direct_arm_move_a_load_holds_a_little_short_has_arrived_too():
+    import mujoco
+
+    from pycram.backends.sim.arm_path import LOADED_TOLERANCE
+    from pycram.sim import World
+
+    world = World("pr2", environment="apartment", base_pose=BASE)
+    try:
+        model, data = world._engine.model, world._engine.data
+        joints = world.description.ARMS[ARM]["joints"]
+        lift = joints.index(f"{ARM[0]}_shoulder_lift_joint")
+        goal = [world.joint_states.get_value().position[j] for j in joints]
+        goal[lift] += 0.2
+        dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joints[lift])]
+        data.qfrc_applied[dof] = -24.0  # 0.04 rad short of the goal under the servo's 600 N m/rad
+        outcome = world.move_arm(ARM, goal).wait(30.0)
+        assert outcome.succeeded, outcome.message
+        short = goal[lift] - world.joint_states.get_value().position[joints[lift]]
+        assert 0.035 <= short <= LOADED_TOLERANCE and outcome.value == pytest.approx(short, abs=1e-3)
+    finally:
+        world.close()

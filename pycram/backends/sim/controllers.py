@@ -215,8 +215,9 @@ class JointTrajectory(Controller):
     """Move joints to goal positions along a smooth (cubic) path, all arriving together.
 
     The duration is chosen from `max_velocity` [rad/s or m/s] unless given. Succeeds when every
-    joint is within `tolerance` of its goal after the path ends; fails with "blocked" if that is
-    not reached within `settle_time` [s].
+    joint is within `tolerance` of its goal after the path ends, or within `loaded_tolerance`
+    (if given) once `settle_time` [s] has passed (servos holding a load stop a little short:
+    `pycram.backends.sim.arm_path.LOADED_TOLERANCE`); else fails with "blocked".
     """
 
     def __init__(
@@ -228,11 +229,13 @@ class JointTrajectory(Controller):
         max_velocity: float = 1.0,
         tolerance: float = 0.01,
         settle_time: float = 2.0,
+        loaded_tolerance: float | None = None,
     ) -> None:
         self.channel = channel
         self.joints, self.goal = list(joints), np.asarray(goal, float)
         self.duration, self.vmax = duration, max_velocity
         self.tol, self.settle = tolerance, settle_time
+        self.loaded_tol = tolerance if loaded_tolerance is None else max(tolerance, loaded_tolerance)
 
     def start(self, eng: Engine) -> Outcome | None:
         refused = invalid_input(
@@ -272,6 +275,8 @@ class JointTrajectory(Controller):
             if err <= self.tol:
                 return ok(err)
             if t - self.t0 > duration + self.settle:
+                if err <= self.loaded_tol:
+                    return ok(err)
                 worst = self.joints[errs.index(err)]
                 return fail("blocked", f"joints stopped {err:.3f} from the goal ({worst})", err)
         return None

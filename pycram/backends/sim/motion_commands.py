@@ -13,7 +13,7 @@ from typing import cast
 
 from pycram.world.types import Pose, Pose2D, Quat, Vec3
 
-from .arm_path import PATH_TOLERANCE, JointPath
+from .arm_path import LOADED_TOLERANCE, PATH_TOLERANCE, JointPath
 from .commands import CommandQueue
 from .controllers import BaseDrive, GripperCommand, HeadPointing, JointTrajectory, Reach
 from .errors import UnknownNameError
@@ -52,7 +52,8 @@ class MotionCommands(CommandQueue):
         joints = self.description.ARMS[self._check_arm(arm)]["joints"]
         if len(positions) != len(joints):
             raise ValueError(f"{arm} arm has {len(joints)} joints, got {len(positions)} positions")
-        return self.submit(JointTrajectory(f"arm:{arm}", joints, positions, duration), f"move_arm:{arm}")
+        trajectory = JointTrajectory(f"arm:{arm}", joints, positions, duration, loaded_tolerance=LOADED_TOLERANCE)
+        return self.submit(trajectory, f"move_arm:{arm}")
 
     def move_arm_to(self, arm: str, configuration: str, duration: float | None = None) -> CommandHandle:
         """Move `arm` to a named configuration of `description.ARM_CONFIGURATIONS[arm]`."""
