@@ -200,14 +200,15 @@ def _let_go_and_retract(
 
 
 def _arm_to_drive(arm: str, configuration: str) -> None:
-    """Move `arm` to `configuration` before driving; blocked where the robot stands (beside the
-    furniture it just worked at: the TIAGo's arm against the cupboard's side after pushing its
-    door shut, 5 of 200 faulted set-table seeds), the base backs away `BACK_AWAY` and it tries
-    once more (raising that failure)."""
+    """Move `arm` to `configuration` before driving; blocked where the robot stands, or stopped
+    by a contact (beside the furniture it just worked at: the TIAGo's arm against the cupboard's
+    side after pushing its door shut, 5 of 200 faulted set-table seeds; a carried bowl on the milk
+    carton beside it), the base backs away `BACK_AWAY` and it tries once more (raising that
+    failure)."""
     try:
         motion(type="setting_arm_configuration", arm=arm, configuration=configuration)
     except RECOVERABLE as error:
-        if getattr(unwrap(error), "reason", None) != "blocked":
+        if getattr(unwrap(error), "reason", None) not in ("blocked", "collision"):
             raise
         log.info("the %s arm is blocked on its way to %s: backing away first (%s)", arm, configuration, unwrap(error))
         back_away(f"the {arm} arm was blocked")

@@ -53,12 +53,13 @@ by definition; it is executed as before planning existed: the direct joint inter
 contacts; one whose gripper squeezes something the belief puts no object in (a handle:
 `FIXTURE_EFFORT`); a ``contact`` reach (a hand pushing a door); a `HANDLE_PHASES` reach near a
 container's handle; the `DIRECT_PHASES`. A motion for which the planner finds no path within its
-budget (``'no_path'``: a narrow passage, or a goal walled in) moves along the joints' straight line
-with the watched path controller (`WATCHED_LINE`): a contact stops it, and it is planned again from
-there, or fails with the stop. Directly, too, when prospection's IK finds no solution for a tool
-pose (the simulator's own IK is tried, as before), when the robot has no prospection that plans
-(``NotImplementedError``), and while the base or the torso moves (`MOVING`: a plan holds for the
-robot standing where it stands; the thesis demo raises the arm while the base drives up). The ROS
+budget (``'no_path'``: a narrow passage, or a goal walled in), or whose goal touches something
+(``'goal_in_collision'``), moves along the joints' straight line with the watched path controller
+(`WATCHED_LINE`): a contact stops it, and it is planned again from there, or fails with the
+stop. Directly, too, when prospection's IK finds no solution for a tool pose (the simulator's own
+IK is tried, as before), when the robot has no prospection that plans (``NotImplementedError``),
+and while the base or the torso moves (`MOVING`: a plan holds for the robot standing where it
+stands; the thesis demo raises the arm while the base drives up). The ROS
 robot's arm modules use this planner too (:mod:`pycram.robots.common.ros_arm_motion`).
 
 **The torso is not planned** (``include_torso=False``): torso motions are the actions' explicit
@@ -434,11 +435,13 @@ class ArmMotionPlanner:
                         f"{stopped.message}; planning again: {plan.reason}: {plan.message}",
                         stopped.outcome,
                     )
-                if plan.reason != "no_path":
+                if plan.reason not in ("no_path", "goal_in_collision"):
                     raise _Direct(f"plan: {plan.reason}: {plan.message}")
-                # no path within the budget (a narrow passage): the joints' straight line, watched --
-                # moved directly it swept a carried bowl through the plate the other hand held
-                # (PR2, set-table-anywhere, procedural:4, seed 1); watched, a contact stops it
+                # no path within the budget (a narrow passage), or a goal that touches something
+                # even tolerating shallow contacts: the joints' straight line, watched -- moved
+                # directly it swept a carried bowl through the plate the other hand held, and a
+                # carried bowl into a milk carton beside it (PR2, set-table-anywhere,
+                # procedural:4 and 8, seed 1); watched, a contact stops it
                 logger.info("%s: %s: the joints' straight line, watched", what, plan.message)
                 plan = MotionPlan(plan.joints, (tuple(current), tuple(goal)), None, "", WATCHED_LINE)
                 self.last_plans.append(plan)
