@@ -13,6 +13,7 @@ hits it and the robot looks.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -77,6 +78,18 @@ def _planner(robot):
     return robot.process_module(f"arm_{ARM}")._motions
 
 
+@contextmanager
+def _at_the_start(wall_at):
+    """The PR2 with its tool at START beside a box standing at `wall_at`, its arm planner."""
+    world, robot = _world(wall_at)
+    try:
+        _to_start(world, robot)
+        yield world, robot, _planner(robot)
+    finally:
+        robot.shutdown()
+        world.close()
+
+
 def test_a_planned_motion_goes_around_a_box_the_straight_line_would_hit():
     from pycram.designator import MotionDesignator, perform
 
@@ -105,10 +118,7 @@ def test_a_planned_motion_goes_around_a_box_the_straight_line_would_hit():
 def test_a_box_put_in_the_way_after_planning_is_hit_softly_detected_and_planned_around():
     from pycram.designator import MotionDesignator, perform
 
-    world, robot = _world(AWAY)
-    try:
-        _to_start(world, robot)
-        planner = _planner(robot)
+    with _at_the_start(AWAY) as (world, robot, planner):
         plan_once = planner.planner.plan
         calls = []
 
@@ -133,9 +143,6 @@ def test_a_box_put_in_the_way_after_planning_is_hit_softly_detected_and_planned_
         assert math.dist(wall.position[:2], WALL[:2]) < 0.03
         w, x, y, z = wall.orientation
         assert math.acos(min(1.0, 1.0 - 2.0 * (x * x + y * y))) < math.radians(10)
-    finally:
-        robot.shutdown()
-        world.close()
 
 
 def test_a_motion_without_a_path_in_the_budget_moves_watched_stops_softly_and_is_planned_again():
@@ -143,10 +150,7 @@ def test_a_motion_without_a_path_in_the_budget_moves_watched_stops_softly_and_is
     from pycram.reasoning.motion import MotionPlan
     from pycram.robots.common.arm_motion import WATCHED_LINE
 
-    world, robot = _world(WALL)
-    try:
-        _to_start(world, robot)
-        planner = _planner(robot)
+    with _at_the_start(WALL) as (world, robot, planner):
         plan_once = planner.planner.plan
 
         def out_of_budget_until_stopped(*args, **kwargs):  # as RRT-Connect's check budget running out
@@ -165,9 +169,6 @@ def test_a_motion_without_a_path_in_the_budget_moves_watched_stops_softly_and_is
         assert planner.last_plans[-1].planner == "RRTConnect"  # then around it
         wall = _wall(world)
         assert math.dist(wall.position[:2], WALL[:2]) < 0.03  # a soft hit
-    finally:
-        robot.shutdown()
-        world.close()
 
 
 def test_after_a_stop_a_plan_no_longer_tolerates_touching_believed_objects():
@@ -178,10 +179,7 @@ def test_after_a_stop_a_plan_no_longer_tolerates_touching_believed_objects():
     from pycram.reasoning.motion import MotionPlan
     from pycram.robots.common.arm_motion import TOLERATED_PENETRATION
 
-    world, robot = _world(AWAY)
-    try:
-        _to_start(world, robot)
-        planner = _planner(robot)
+    with _at_the_start(AWAY) as (world, robot, planner):
         plan_once = planner.planner.plan
         asked_after_the_stop = []
 
@@ -198,9 +196,6 @@ def test_after_a_stop_a_plan_no_longer_tolerates_touching_believed_objects():
             perform(MotionDesignator(type="reaching", arm=ARM, target=list(GOAL), orientation=list(FORWARD)))
         assert asked_after_the_stop and all(c >= 0.0 for c in asked_after_the_stop)
         assert -TOLERATED_PENETRATION not in asked_after_the_stop
-    finally:
-        robot.shutdown()
-        world.close()
 
 
 def test_a_box_nobody_saw_is_hit_softly_looked_at_and_planned_around_in_the_believed_world():
@@ -270,17 +265,15 @@ def test_the_path_controller_refuses_malformed_samples_and_follows_a_path():
         world.close()
 
 
-@pytest.mark.parametrize("loaded_tolerance, reason", [(0.05, "succeeded"), (0.02, "blocked")])
-def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkeypatch, loaded_tolerance, reason):
-    """A constant 24 N m pulls the shoulder down while it lifts: its servo (600 N m/rad) holds it
-    0.04 rad short. Within `LOADED_TOLERANCE` after the settle time that is arrival, beyond it
-    'blocked' (naming the joint)."""
+@contextmanager
+def _a_load_on_the_shoulder():
+    """The PR2 with a constant 24 N m pulling its shoulder down (its servo, 600 N m/rad, holds it
+    0.04 rad short of a goal): (world, arm joints, the shoulder lift's index, the joints now, the
+    joints with the shoulder lifted 0.2 rad)."""
     import mujoco
 
-    from pycram.backends.sim import arm_path
     from pycram.sim import World
 
-    monkeypatch.setattr(arm_path, "LOADED_TOLERANCE", loaded_tolerance)
     world = World("pr2", environment="apartment", base_pose=BASE)
     try:
         model, data = world._engine.model, world._engine.data
@@ -289,9 +282,22 @@ def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkey
         here = [world.joint_states.get_value().position[j] for j in joints]
         goal = list(here)
         goal[lift] += 0.2
-        samples = [(0.02 * i, [a + (b - a) * i / 50 for a, b in zip(here, goal)]) for i in range(51)]
         dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joints[lift])]
         data.qfrc_applied[dof] = -24.0  # the load (applied forces persist until changed)
+        yield world, joints, lift, here, goal
+    finally:
+        world.close()
+
+
+@pytest.mark.parametrize("loaded_tolerance, reason", [(0.05, "succeeded"), (0.02, "blocked")])
+def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkeypatch, loaded_tolerance, reason):
+    """Within `LOADED_TOLERANCE` of the path's end after the settle time is arrival, beyond it
+    'blocked' (naming the joint)."""
+    from pycram.backends.sim import arm_path
+
+    monkeypatch.setattr(arm_path, "LOADED_TOLERANCE", loaded_tolerance)
+    with _a_load_on_the_shoulder() as (world, joints, lift, here, goal):
+        samples = [(0.02 * i, [a + (b - a) * i / 50 for a, b in zip(here, goal)]) for i in range(51)]
         outcome = world.follow_arm_path(ARM, joints, samples).wait(30.0)
         assert outcome.reason == reason, outcome.message
         short = goal[lift] - world.joint_states.get_value().position[joints[lift]]
@@ -300,28 +306,13 @@ def test_joints_a_load_holds_a_little_short_of_the_paths_end_have_arrived(monkey
             assert outcome.value == pytest.approx(short, abs=1e-3)
         else:
             assert "joints stopped 0.04" in outcome.message and joints[lift] in outcome.message
-    finally:
-        world.close()
 
 
 def test_a_direct_arm_move_a_load_holds_a_little_short_has_arrived_too():
-    import mujoco
-
     from pycram.backends.sim.arm_path import LOADED_TOLERANCE
-    from pycram.sim import World
 
-    world = World("pr2", environment="apartment", base_pose=BASE)
-    try:
-        model, data = world._engine.model, world._engine.data
-        joints = world.description.ARMS[ARM]["joints"]
-        lift = joints.index(f"{ARM[0]}_shoulder_lift_joint")
-        goal = [world.joint_states.get_value().position[j] for j in joints]
-        goal[lift] += 0.2
-        dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joints[lift])]
-        data.qfrc_applied[dof] = -24.0  # 0.04 rad short of the goal under the servo's 600 N m/rad
+    with _a_load_on_the_shoulder() as (world, joints, lift, _, goal):
         outcome = world.move_arm(ARM, goal).wait(30.0)
         assert outcome.succeeded, outcome.message
         short = goal[lift] - world.joint_states.get_value().position[joints[lift]]
         assert 0.035 <= short <= LOADED_TOLERANCE and outcome.value == pytest.approx(short, abs=1e-3)
-    finally:
-        world.close()
