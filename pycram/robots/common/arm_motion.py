@@ -59,8 +59,8 @@ budget (``'no_path'``: a narrow passage, or a goal walled in), or whose goal tou
 stop. Directly, too, when prospection's IK finds no solution for a tool pose (the simulator's own
 IK is tried, as before), when the robot has no prospection that plans (``NotImplementedError``),
 and while the base or the torso moves (`MOVING`: a plan holds for the robot standing where it
-stands; the thesis demo raises the arm while the base drives up). The ROS
-robot's arm modules use this planner too (:mod:`pycram.robots.common.ros_arm_motion`).
+stands; the thesis demo raises the arm while the base drives up). The ROS robot's arm modules
+use this planner too (:mod:`pycram.robots.common.ros_arm_motion`).
 
 **The torso is not planned** (``include_torso=False``): torso motions are the actions' explicit
 ``setting_torso`` motions, and the torso's lift is slow (0.05 m/s on the PR2): planning it with
@@ -156,8 +156,9 @@ CLEARANCES: tuple[tuple[float, float], ...] = (
     (-TOLERATED_PENETRATION, 0.0),
     (-TOLERATED_PENETRATION, -TOLERATED_PENETRATION),
 )
-#: The planner name of a motion the planner found no path for within its budget, moved along the
-#: joints' straight line by the watched path controller (a contact stops it) instead of directly.
+#: The planner name of a motion the planner found no path for within its budget, or whose goal
+#: touches something, moved along the joints' straight line by the watched path controller (a
+#: contact stops it) instead of directly.
 WATCHED_LINE = "watched_line"
 #: Reaching phases executed directly (not planned): they end with the held object touching down
 #: (``place``: 1 cm above the believed surface; touching down earlier stops the arm with
