@@ -237,7 +237,8 @@ class ConfigurationChecker(abc.ABC):
 
     #: The joints of a configuration, in order (the torso first when included).
     joints: tuple[str, ...] = ()
-    #: Configurations checked so far (by :meth:`is_free`, :meth:`contacts` and :meth:`motion_free`).
+    #: Configurations checked so far (by :meth:`is_free`, :meth:`contacts`, :meth:`motion_free` and
+    #: :meth:`first_touching`).
     checks: int = 0
     #: With a held object: how far [rad] the direction that points up through it when the checker
     #: was made may lean from the vertical in a free configuration (:meth:`held_lean`); the
@@ -262,12 +263,18 @@ class ConfigurationChecker(abc.ABC):
         """True iff every configuration on the straight joint-space segment from ``q0`` to ``q1``,
         sampled no more than ``resolution`` [rad or m, largest joint step] apart (both ends
         included), is free."""
+        return self.first_touching(q0, q1, resolution) is None
+
+    def first_touching(self, q0: Sequence[float], q1: Sequence[float], resolution: float = 0.02) -> list[float] | None:
+        """The first configuration from ``q0`` on the straight segment to ``q1`` (sampled as
+        :meth:`motion_free` does) that is not free, or None when all are."""
         steps = max(1, math.ceil(max((abs(b - a) for a, b in zip(q0, q1)), default=0.0) / resolution))
         for i in range(steps + 1):
             s = i / steps
-            if not self.is_free([a + s * (b - a) for a, b in zip(q0, q1)]):
-                return False
-        return True
+            q = [a + s * (b - a) for a, b in zip(q0, q1)]
+            if not self.is_free(q):
+                return q
+        return None
 
     def close(self) -> None:  # noqa: B027 - optional hook: implementations release their data here
         """Release the checker's scratch data; it must not be used afterwards."""

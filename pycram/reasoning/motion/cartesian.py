@@ -159,15 +159,10 @@ def _touches(checker: Any, path: list[list[float]]) -> tuple[str, str] | None:
         return "start_in_collision", f"the start touches {_pair(checker.contacts(path[0]))}"
     n = len(path) - 1
     for i, (a, b) in enumerate(zip(path, path[1:]), start=1):
-        if not checker.motion_free(a, b, CARTESIAN_RESOLUTION):
-            bad = next((q for q in _samples(a, b, CARTESIAN_RESOLUTION) if not checker.is_free(q)), b)
+        bad = checker.first_touching(a, b, CARTESIAN_RESOLUTION)
+        if bad is not None:
             return "no_path", f"the line touches {_pair(checker.contacts(bad))} at {i / n * 100:.0f} % of the way"
     return None
-
-
-def _samples(a: Sequence[float], b: Sequence[float], resolution: float) -> list[list[float]]:
-    steps = max(1, math.ceil(max((abs(y - x) for x, y in zip(a, b)), default=0.0) / resolution))
-    return [[x + (i / steps) * (y - x) for x, y in zip(a, b)] for i in range(steps + 1)]
 
 
 def _pair(contacts: list[tuple[str, str]]) -> str:
