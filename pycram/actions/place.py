@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import logging
 import math
+from dataclasses import replace
 from functools import partial
 from typing import Any
 
@@ -35,10 +36,12 @@ from pycram.designators.core import NoSolutionError
 from pycram.designators.location import LocationDesignator
 from pycram.designators.object import ObjectDesignator
 from pycram.execution.failures import GripperEmpty, ObjectOutOfReach, ObjectSlipped, PlacingFailed, PlanFailure
+from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 from pycram.reasoning.locations.targets import KnownObject
 from pycram.world.belief import PerceivedObject
-from pycram.world.objects import FOOTPRINT_SLACK, object_type
+from pycram.world.environment import Surface
+from pycram.world.objects import FOOTPRINT_SLACK, SIDE, Grasp, object_type
 
 from .core import (
     RECOVERABLE,
@@ -57,6 +60,7 @@ from .core import (
 )
 from .handling import _look_again, _pose_text, _reach, _xyz, carry_configuration
 from .held import Held, fingers_yaw, held_objects
+from .pick_up import PickUp, executable_grasps
 
 __all__ = [
     "Place",
@@ -65,6 +69,7 @@ __all__ = [
     "resting_problem",
     "RESTING_SLACK",
     "FOOTPRINT_SLACK",
+    "REGRASP_INSET",
 ]
 
 log = logging.getLogger("pycram.actions")
@@ -81,11 +86,14 @@ PLACE_TOLERANCE = 0.05
 RESTING_SLACK = 0.05
 
 
-def Place(object: Any, target: Any, arm: str | None = None) -> ActionDesignator:
+def Place(object: Any, target: Any, arm: str | None = None, regrasp: bool = True) -> ActionDesignator:
     """Put the held `object` (a `Held`, or the object designator / believed object picked up) at
     `target`: a location designator such as ``('on', 'table')``, a `Spot`, a point (x, y, z)
-    [m, map: the object's centre] or a surface's name. Returns the believed object."""
-    return make_action("placing", object=object, target=target, arm=arm)
+    [m, map: the object's centre] or a surface's name. With `regrasp`, an object that no
+    standing pose puts at the target with the grasp it is held with, but another grasp of its
+    type does, is put down within reach and taken again with that grasp (`regrasping`).
+    Returns the believed object."""
+    return make_action("placing", object=object, target=target, arm=arm, regrasp=None if regrasp else False)
 
 
 def _held_for(designator: ActionDesignator) -> Held:
@@ -322,12 +330,14 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
         raise GripperEmpty(f"the {held.gripper} gripper holds nothing ({held.object.name} was in it)", designator)
     half = object_type(held.object.type).half_height
     attempts: list[str] = []
+    tried: list[tuple[float, float, float]] = []
     last: BaseException | None = None
     try:
         for spot_number, spot in enumerate(_spots(target, held), start=1):
             if spot_number > PLACE_SPOTS:
                 break
             spot = tuple(float(v) for v in spot)
+            tried.append(spot)
             point = [spot[0], spot[1], spot[2] - half + held.grasp.height]
             locations = _place_locations(held, spot, point)
             try:
@@ -365,5 +375,96 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
         ) from error
     message = f"could not place {held.object.name} at {target!r}: " + "; ".join(attempts)
     if last is None or isinstance(last, NoSolutionError):
+        if designator.prop_value("regrasp") is not False:
+            for spot in tried:
+                grasp = _grasp_reaching(held, spot)
+                if grasp is not None:
+                    return regrasping(held, spot, grasp, message)
         raise ObjectOutOfReach(message, designator, attempts=attempts) from last
     raise PlacingFailed(message, designator, getattr(last, "reason", None), attempts) from last
+
+
+# -- regrasping: another grasp for a target the held grasp does not reach ------------------------
+
+#: Put down for a regrasp this far [m] in from the surface's edge (then taken from that side).
+REGRASP_INSET = 0.15
+
+
+def _grasp_reaching(held: Held, spot: tuple[float, float, float]) -> Grasp | None:
+    """Another grasp of the held object's type (one the robot executes) with which some standing
+    pose puts it at `spot` -- asked of location reasoning, nothing moves; None when there is
+    none, and for an object held with a grasp planned for it (lying on its side: it is put down
+    as it hangs in the hand)."""
+    if held.grasp not in object_type(held.object.type).grasps:
+        return None
+    half = object_type(held.object.type).half_height
+    for grasp in executable_grasps(held.object.type):
+        if grasp.approach == held.grasp.approach:
+            continue
+        other = replace(held, grasp=grasp)
+        point = [spot[0], spot[1], spot[2] - half + grasp.height]
+        try:
+            next(iter(solutions(_place_locations(other, spot, point))))
+        except (NoSolutionError, StopIteration):
+            continue
+        return grasp
+    return None
+
+
+def _surface_under(spot: tuple[float, float, float], half: float) -> Surface | None:
+    """The open surface (no furniture over it) an object of half height `half` [m] stands on
+    with its centre at `spot`, None when the environment knows none there."""
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if environment is None:
+        return None
+    under = [
+        s
+        for s in environment.all_surfaces()
+        if s.clearance == math.inf and s.contains(spot[0], spot[1]) and abs(spot[2] - half - s.height) < 0.05
+    ]
+    return min(under, key=lambda s: abs(spot[2] - half - s.height), default=None)
+
+
+def _edge_points(surface: Surface, spot: tuple[float, float, float]) -> list[tuple[float, float, float]]:
+    """Points `REGRASP_INSET` in from each edge of `surface`, across from `spot`, nearest first:
+    where an object is put down to be taken again from that side."""
+    points = []
+    for a, b, n in surface.edges():
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        t = min(max(((spot[0] - a[0]) * dx + (spot[1] - a[1]) * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+        x, y = a[0] + t * dx - REGRASP_INSET * n[0], a[1] + t * dy - REGRASP_INSET * n[1]
+        if surface.contains(x, y):
+            points.append((x, y, surface.height))
+    return sorted(points, key=lambda p: math.dist(p[:2], spot[:2]))
+
+
+def regrasping(held: Held, spot: tuple[float, float, float], grasp: Grasp, why: str) -> PerceivedObject:
+    """Put the held object down within reach on the surface under `spot` (near one of its edges,
+    the nearest to the spot first), take it again with `grasp`'s approach (`PickUp`: a
+    horizontal grasp from any side, or from the top) and place it at `spot`. Measured: a
+    cereal box the PR2 took from the top, as it stood, reaches no spot 0.45 m in on the table
+    that way, from the side it does. Raises `ObjectOutOfReach` (with `why`, the failed
+    placing) when it cannot be put down anywhere within reach -- it is still held then; the
+    failures of the pick-up and of the placing after it as they are."""
+    obj = held.object
+    kind = object_type(obj.type)
+    surface = _surface_under(spot, kind.half_height)
+    if surface is None:
+        raise ObjectOutOfReach(f"{why}; no surface under {_xyz(spot)} to put it down on and take it again", obj)
+    approach = "top" if grasp.approach == "top" else SIDE
+    log.info("placing %s: held %s it reaches no spot; putting it down to take it %s", obj.name, held.grasp.approach, approach)
+    down: PerceivedObject | None = None
+    failures = []
+    for point in _edge_points(surface, spot):
+        near = LocationDesignator([("on", surface.name), ("for", obj.type), ("near", point)])
+        try:
+            down = perform(Place(held, near, arm=held.arm, regrasp=False))
+            break
+        except ObjectOutOfReach as error:
+            failures.append(str(error))
+    if down is None:
+        raise ObjectOutOfReach(f"{why}; regrasping: put down nowhere on {surface.name}: {'; '.join(failures)}", obj)
+    again: Held = perform(PickUp(down, arm=held.arm, grasp=approach))
+    placed: PerceivedObject = perform(Place(again, spot, arm=again.arm, regrasp=False))
+    return placed

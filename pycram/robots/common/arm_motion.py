@@ -30,13 +30,14 @@ arm motion:
    line again: what was hit is not in the believed world even after the look) the motion goes
    on directly, as before planning existed.
 
-A `STRAIGHT_PHASES` motion (the grasp) moves the tool along its straight line to the goal
-(:func:`~pycram.reasoning.motion.cartesian.plan_cartesian_line`) where that line is free and the
-arm follows it without flipping: the joints' straight line between two IK solutions bows (measured:
-6.8 cm sideways over a PR2 side grasp's last 10 cm; the fingers knocked the cup over). A motion
-towards an object being grasped is otherwise executed planned only when the joints' straight line
-is free; otherwise it moves directly: the object being grasped is exempt at the fingers in planning,
-so a detour could sweep it away with them (measured). On the way to the pre-grasp pose
+A `LINE_PHASES` motion (the grasp, the lift, the retreat after letting go) moves the tool along
+its straight line to the goal (:func:`~pycram.reasoning.motion.cartesian.plan_cartesian_line`)
+where that line is free and the arm follows it without flipping: the joints' straight line
+between two IK solutions bows (measured: 6.8 cm sideways over a PR2 side grasp's last 10 cm; the
+fingers knocked the cup over). A `STRAIGHT_PHASES` motion (towards an object being grasped, or away
+from one just let go) is otherwise executed planned only when the joints' straight line is free;
+otherwise it moves directly: the object is exempt at the fingers in planning, so a detour could
+sweep it away with them (measured). On the way to the pre-grasp pose
 (`UNTOUCHED_PHASES`) the object is not exempt but an obstacle like any other. A held object moves
 with the hand where the hand holds it (``pycram.backends.sim.believed_world``). A tool position
 asked for without an orientation keeps the tool's orientation (when IK finds no such solution, the
@@ -92,6 +93,7 @@ __all__ = [
     "PERIOD",
     "REPLANS",
     "STRAIGHT_PHASES",
+    "LINE_PHASES",
     "TOLERATED_PENETRATION",
     "UNTOUCHED_PHASES",
     "VELOCITY_SCALE",
@@ -164,11 +166,18 @@ WATCHED_LINE = "watched_line"
 #: (``place``: 1 cm above the believed surface; touching down earlier stops the arm with
 #: ``'blocked'``, which the place action takes for "down").
 DIRECT_PHASES = ("place",)
-#: Reaching phases that end at an object to grasp, which may not be known to prospection (a plan
-#: that names no ``object``): the tool's straight line, else the joints' straight line or the
-#: direct motion, never a detour (measured: the thesis demo's hand, planned round the counter's
-#: edge, swept the unperceived item away).
-STRAIGHT_PHASES = ("grasp",)
+#: Reaching phases with the fingers round an object that is not held (yet, or any more): the
+#: grasp, which ends at an object that may not be known to prospection (a plan that names no
+#: ``object``), and the retreat from an object just let go, exempt at the fingers. The tool's
+#: straight line, else the joints' straight line or the direct motion, never a detour (measured:
+#: the thesis demo's hand, planned round the counter's edge, swept the unperceived item away; the
+#: PR2's retreat from a cereal box put down from the top, planned through another IK branch,
+#: swung the fingers 15 cm sideways and knocked it over).
+STRAIGHT_PHASES = ("grasp", "retreat")
+#: Reaching phases that try the tool's straight line first (`plan_cartesian_line`), then plan as
+#: any motion: the `STRAIGHT_PHASES`, and the lift of an object just grasped (straight up off its
+#: surface: the joints' line between two IK solutions drags it sideways first).
+LINE_PHASES = (*STRAIGHT_PHASES, "lift")
 #: Reaching phases towards an object that must not touch it (the object a motion names is then an
 #: obstacle like any other, not exempt at the fingers).
 UNTOUCHED_PHASES = ("pre_grasp",)
@@ -326,7 +335,7 @@ class ArmMotionPlanner:
                 raise _Direct(f"IK: {ik.reason}: {ik.message}")
             goal = PathGoal(position=tuple(float(v) for v in position), tolerance=tolerance)
             line = None
-            if phase in STRAIGHT_PHASES:  # the tool along the line, not the joints' bow
+            if phase in LINE_PHASES:  # the tool along the line, not the joints' bow
                 line = self._cartesian_line(prospection, current, pose, base, held, exempt)
             return self._planned(
                 list(line.path[-1]) if line else list(ik.positions),
