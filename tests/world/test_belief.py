@@ -286,3 +286,24 @@ def test_a_look_that_sees_less_of_a_standing_objects_height_keeps_the_height_mea
     lying = Detection("milk", (4.37, 2.0, 0.785), (0.2, 0.07, 0.07), "white", support="table", pixels=500)
     belief.update(PerceptionReport(8.0, (lying,)))
     assert carton.properties["size"][2] == pytest.approx(0.07) and carton.lying_axis is not None
+
+
+def test_a_look_that_sees_an_object_only_in_part_keeps_the_centre_believed_where_it_agrees():
+    def bowl(x, y, slack=0.0, size=(0.14, 0.14, 0.07)):
+        return Detection("bowl", (x, y, 0.785), size, "yellow", support="table", pixels=300, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (seen,) = belief.update(PerceptionReport(1.0, (bowl(4.3, 2.0),))).added
+    # a sliver past an occluder: its centre 6 cm off, but it may be up to 7 cm off: no news
+    belief.update(PerceptionReport(2.0, (bowl(4.27, 1.95, slack=0.07, size=(0.14, 0.14, 0.07)),)))
+    assert seen.pose[:2] == pytest.approx((4.3, 2.0))
+    # a sliver farther off than it may be: the bowl moved
+    belief.update(PerceptionReport(3.0, (bowl(4.2, 1.9, slack=0.05),)))
+    assert seen.pose[:2] == pytest.approx((4.2, 1.9))
+    # seen whole, a look is believed to the millimetre
+    belief.update(PerceptionReport(4.0, (bowl(4.205, 1.9),)))
+    assert seen.pose[:2] == pytest.approx((4.205, 1.9))
+    # on another surface, a part is news too
+    other = Detection("bowl", (4.21, 1.91, 0.985), (0.14, 0.14, 0.07), "yellow", support="counter", slack=0.05)
+    belief.update(PerceptionReport(5.0, (other,)))
+    assert seen.pose[:2] == pytest.approx((4.21, 1.91))
