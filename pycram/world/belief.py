@@ -634,9 +634,11 @@ def _kept_centre(obj: PerceivedObject, detection: Detection) -> Detection:
         or math.dist(detection.position[:2], obj.pose[:2]) > detection.slack + SLACK_MARGIN
     ):
         return detection
+    # the horizontal centre and extent as believed; the height as measured (`_kept_height` then)
     x, y, _ = obj.pose
     kept = (float(x), float(y), float(detection.position[2]))
-    return replace(detection, position=kept, size=cast(Vec3, tuple(before)), axis=obj.properties.get("axis"))
+    size = (float(before[0]), float(before[1]), float(detection.size[2]))
+    return replace(detection, position=kept, size=size, axis=obj.properties.get("axis"))
 
 
 def _kept_height(obj: PerceivedObject, detection: Detection) -> Detection:

@@ -307,3 +307,14 @@ def test_a_look_that_sees_an_object_only_in_part_keeps_the_centre_believed_where
     other = Detection("bowl", (4.21, 1.91, 0.985), (0.14, 0.14, 0.07), "yellow", support="counter", slack=0.05)
     belief.update(PerceptionReport(5.0, (other,)))
     assert seen.pose[:2] == pytest.approx((4.21, 1.91))
+
+
+def test_a_partial_look_that_also_misses_the_top_keeps_the_centre_and_the_height():
+    def milk(x, height, slack=0.0):
+        size = (0.07, 0.07, height)
+        return Detection("milk", (x, 2.0, 0.75 + height / 2), size, "white", support="table", pixels=500, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, 0.2),))).added
+    belief.update(PerceptionReport(2.0, (milk(4.33, 0.1, slack=0.04),)))  # a sliver of its lower half
+    assert carton.pose == pytest.approx((4.3, 2.0, 0.85)) and carton.properties["size"][2] == pytest.approx(0.2)
