@@ -453,7 +453,9 @@ def regrasping(held: Held, spot: tuple[float, float, float], grasp: Grasp, why: 
     if surface is None:
         raise ObjectOutOfReach(f"{why}; no surface under {_xyz(spot)} to put it down on and take it again", obj)
     approach = "top" if grasp.approach == "top" else SIDE
-    log.info("placing %s: held %s it reaches no spot; putting it down to take it %s", obj.name, held.grasp.approach, approach)
+    log.info(
+        "placing %s: held %s it reaches no spot; putting it down to take it %s", obj.name, held.grasp.approach, approach
+    )
     down: PerceivedObject | None = None
     failures = []
     for point in _edge_points(surface, spot):
