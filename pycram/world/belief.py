@@ -638,7 +638,9 @@ def _kept_centre(obj: PerceivedObject, detection: Detection) -> Detection:
     x, y, _ = obj.pose
     kept = (float(x), float(y), float(detection.position[2]))
     size = (float(before[0]), float(before[1]), float(detection.size[2]))
-    return replace(detection, position=kept, size=size, axis=obj.properties.get("axis"))
+    # a turn it measured is news (a box's sides seen in part still show their direction)
+    axis = detection.axis if detection.axis is not None else obj.properties.get("axis")
+    return replace(detection, position=kept, size=size, axis=axis)
 
 
 def _kept_height(obj: PerceivedObject, detection: Detection) -> Detection:

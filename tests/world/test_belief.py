@@ -318,3 +318,14 @@ def test_a_partial_look_that_also_misses_the_top_keeps_the_centre_and_the_height
     (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, 0.2),))).added
     belief.update(PerceptionReport(2.0, (milk(4.33, 0.1, slack=0.04),)))  # a sliver of its lower half
     assert carton.pose == pytest.approx((4.3, 2.0, 0.85)) and carton.properties["size"][2] == pytest.approx(0.2)
+
+
+def test_a_partial_look_that_measures_a_turn_keeps_the_centre_and_takes_the_turn():
+    def milk(x, axis=None, slack=0.0):
+        size = (0.07, 0.07, 0.2)
+        return Detection("milk", (x, 2.0, 0.85), size, "white", support="table", pixels=500, axis=axis, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3),))).added  # seen from afar: no turn
+    belief.update(PerceptionReport(2.0, (milk(4.32, axis=math.pi / 4, slack=0.04),)))  # from close by, in part
+    assert carton.pose[:2] == pytest.approx((4.3, 2.0)) and carton.yaw == pytest.approx(math.pi / 4)

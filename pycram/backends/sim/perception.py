@@ -80,6 +80,9 @@ def _back_project(view: CameraView, rows: np.ndarray, cols: np.ndarray) -> np.nd
     return local @ np.asarray(view.rotation, float).reshape(3, 3).T + np.asarray(view.position, float)
 
 
+#: A round object's rim counts as seen when its highest point seen is at most this far [m] below
+#: its top (standing on the surface under it).
+RIM_SLACK = 0.015
 #: A pixel beside an object's that is this much [m] nearer the camera hides part of the object.
 OCCLUDER_GAP = 0.02
 #: An object's pixels this close [m] to its extent's end on one side make up that side's edge ...
@@ -159,7 +162,7 @@ def _measure(
     `outline`: per pixel, whether it borders something else and whether that hides the object
     (`hidden_outline`). A round object's extent cut short by something nearer the camera (a
     shelf above, a fridge's side wall, another object) is completed from its seen side with its
-    type's diameter (measured: a bowl on a fridge shelf half hidden by the wall was believed
+    type's diameter where its rim is seen (measured: a bowl on a fridge shelf half hidden by the wall was believed
     4.7 cm off its centre, and the gripper closed beside it). Where what is seen cannot say where
     the centre is (both ends hidden, or a box's end), the detection's `slack` says how far off
     its centre may be."""
@@ -168,19 +171,26 @@ def _measure(
     across = rotation[:2, 0] / max(np.linalg.norm(rotation[:2, 0]), 1e-9)
     along = -rotation[:2, 2] / max(np.linalg.norm(rotation[:2, 2]), 1e-9)  # the view's heading
     a, b = points[:, :2] @ across, points[:, :2] @ along
+    top, lowest = float(points[:, 2].max()), float(points[:, 2].min())
     extent, round_ = _footprint_extent(type_name)
+    # the seen end of a round object is its outline only where its rim is seen: below it, the
+    # pixels may be its inside (measured: a cup under the PR2's hand, 2 cm of its inner wall seen)
+    middle = ((a.max() + a.min()) / 2.0 * across + (b.max() + b.min()) / 2.0 * along).tolist()
+    under = support_of(environment, middle[0], middle[1], lowest, container_states)
+    otype = OBJECT_TYPES.get(type_name)
+    rim_seen = otype is not None and top >= (under.height if under else lowest) + otype.height - RIM_SLACK
+    exact = round_ and rim_seen
     diameter = extent if round_ else None
     no_cut = (False, False)
     cut_a = _cut(a, outline[0], outline[1]) if outline is not None else no_cut
     cut_b = _cut(b, outline[0], outline[1]) if outline is not None else no_cut
     width = float(a.max() - a.min())
-    centre_a, slack_a = _uncut_centre(float(a.min()), float(a.max()), cut_a, extent, round_)
+    centre_a, slack_a = _uncut_centre(float(a.min()), float(a.max()), cut_a, extent, exact)
     if diameter is not None and any(cut_a):
         width = max(width, diameter)
-    top, lowest = float(points[:, 2].max()), float(points[:, 2].min())
     slack_b = 0.0
     if view.position[2] > top + 0.05:  # seen from above: the top shows the object's full depth
-        centre_b, slack_b = _uncut_centre(float(b.min()), float(b.max()), cut_b, extent, round_)
+        centre_b, slack_b = _uncut_centre(float(b.min()), float(b.max()), cut_b, extent, exact)
         depth = float(b.max() - b.min())
         if diameter is not None and any(cut_b):
             depth = max(depth, diameter)
