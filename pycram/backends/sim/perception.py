@@ -162,25 +162,25 @@ def _measure(
     `outline`: per pixel, whether it borders something else and whether that hides the object
     (`hidden_outline`). A round object's extent cut short by something nearer the camera (a
     shelf above, a fridge's side wall, another object) is completed from its seen side with its
-    type's diameter where its rim is seen (measured: a bowl on a fridge shelf half hidden by the wall was believed
-    4.7 cm off its centre, and the gripper closed beside it). Where what is seen cannot say where
-    the centre is (both ends hidden, or a box's end), the detection's `slack` says how far off
-    its centre may be."""
+    type's diameter where its rim is seen (measured: a bowl on a fridge shelf half hidden by the
+    wall was believed 4.7 cm off its centre, and the gripper closed beside it). Where what is
+    seen cannot say where the centre is (both ends hidden, a box's end, the rim not seen), the
+    detection's `slack` says how far off its centre may be."""
     # horizontal axes of the view: across it and along it (away from the camera)
     rotation = np.asarray(view.rotation, float).reshape(3, 3)
     across = rotation[:2, 0] / max(np.linalg.norm(rotation[:2, 0]), 1e-9)
     along = -rotation[:2, 2] / max(np.linalg.norm(rotation[:2, 2]), 1e-9)  # the view's heading
     a, b = points[:, :2] @ across, points[:, :2] @ along
     top, lowest = float(points[:, 2].max()), float(points[:, 2].min())
-    extent, round_ = _footprint_extent(type_name)
+    extent, is_round = _footprint_extent(type_name)
     # the seen end of a round object is its outline only where its rim is seen: below it, the
     # pixels may be its inside (measured: a cup under the PR2's hand, 2 cm of its inner wall seen)
     middle = ((a.max() + a.min()) / 2.0 * across + (b.max() + b.min()) / 2.0 * along).tolist()
     under = support_of(environment, middle[0], middle[1], lowest, container_states)
     otype = OBJECT_TYPES.get(type_name)
     rim_seen = otype is not None and top >= (under.height if under else lowest) + otype.height - RIM_SLACK
-    exact = round_ and rim_seen
-    diameter = extent if round_ else None
+    exact = is_round and rim_seen
+    diameter = extent if is_round else None
     no_cut = (False, False)
     cut_a = _cut(a, outline[0], outline[1]) if outline is not None else no_cut
     cut_b = _cut(b, outline[0], outline[1]) if outline is not None else no_cut
