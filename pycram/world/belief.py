@@ -132,9 +132,10 @@ class Detection:
     `pixels` how many pixels of it were visible; `axis` [rad] the direction of the longer
     horizontal axis of its top when seen from above, or of a square top's sides (up to quarter
     turns); None when the top is round or not seen from above. `slack` [m]: how far off the
-    measured centre may be horizontally because the object was seen only in part (hidden at
-    both ends of its extent in view by something nearer the camera); 0 when it was seen whole,
-    or its hidden part could be completed from its known shape.
+    measured centre may be horizontally because the object was seen only in part (hidden by
+    something nearer the camera where its known shape cannot complete it: both ends of its
+    extent in view, a box's end, a round one whose rim is not seen); 0 when it was seen whole, or
+    its hidden part could be completed.
     """
 
     type: str
