@@ -39,7 +39,7 @@ from pycram.execution.failures import GripperEmpty, ObjectOutOfReach, ObjectSlip
 from pycram.execution.perform import perform
 from pycram.execution.robot import current_robot
 from pycram.reasoning.locations.targets import KnownObject
-from pycram.world.belief import PerceivedObject
+from pycram.world.belief import PerceivedObject, support_of
 from pycram.world.environment import Surface
 from pycram.world.objects import FOOTPRINT_SLACK, SIDE, Grasp, object_type
 
@@ -118,11 +118,21 @@ def _held_for(designator: ActionDesignator) -> Held:
     return candidates[0]
 
 
+def _believed_environment() -> Any:
+    """The environment description the active robot's belief holds (None: it knows none)."""
+    return getattr(getattr(current_robot(), "belief", None), "environment", None)
+
+
+def _tool_point(spot: tuple[float, float, float], half: float, grasp: Grasp) -> list[float]:
+    """Where the tool is [m, map] when an object of half height `half` [m] held with `grasp`
+    stands with its centre at `spot`."""
+    return [spot[0], spot[1], spot[2] - half + grasp.height]
+
+
 def _near_side(surface_name: str) -> tuple[float, float, float] | None:
     """A point on the surface 0.15 m in from its edge nearest to the robot (None when the
     environment does not know the surface)."""
-    belief = getattr(current_robot(), "belief", None)
-    environment = getattr(belief, "environment", None)
+    environment = _believed_environment()
     if environment is None:
         return None
     try:
@@ -338,7 +348,7 @@ def placing(designator: ActionDesignator) -> PerceivedObject:
                 break
             spot = tuple(float(v) for v in spot)
             tried.append(spot)
-            point = [spot[0], spot[1], spot[2] - half + held.grasp.height]
+            point = _tool_point(spot, half, held.grasp)
             locations = _place_locations(held, spot, point)
             try:
                 for pose_number, location in enumerate(solutions(locations), start=1):
@@ -402,7 +412,7 @@ def _grasp_reaching(held: Held, spot: tuple[float, float, float]) -> Grasp | Non
         if grasp.approach == held.grasp.approach:
             continue
         other = replace(held, grasp=grasp)
-        point = [spot[0], spot[1], spot[2] - half + grasp.height]
+        point = _tool_point(spot, half, grasp)
         try:
             next(iter(solutions(_place_locations(other, spot, point))))
         except (NoSolutionError, StopIteration):
@@ -413,17 +423,16 @@ def _grasp_reaching(held: Held, spot: tuple[float, float, float]) -> Grasp | Non
 
 def _surface_under(spot: tuple[float, float, float], half: float) -> Surface | None:
     """The open surface (no furniture over it) an object of half height `half` [m] stands on
-    with its centre at `spot`, None when the environment knows none there."""
-    belief = getattr(current_robot(), "belief", None)
-    environment = getattr(belief, "environment", None)
+    with its centre at `spot` (`support_of`, within 5 cm of its bottom), None when the
+    environment knows none there."""
+    environment = _believed_environment()
     if environment is None:
         return None
-    under = [
-        s
-        for s in environment.all_surfaces()
-        if s.clearance == math.inf and s.contains(spot[0], spot[1]) and abs(spot[2] - half - s.height) < 0.05
-    ]
-    return min(under, key=lambda s: abs(spot[2] - half - s.height), default=None)
+    bottom = spot[2] - half
+    surface = support_of(environment, spot[0], spot[1], bottom)
+    if surface is None or surface.clearance != math.inf or abs(bottom - surface.height) >= 0.05:
+        return None
+    return surface
 
 
 def _edge_points(surface: Surface, spot: tuple[float, float, float]) -> list[tuple[float, float, float]]:
