@@ -37,7 +37,9 @@ def test_a_report_survives_the_message_round_trip():
     ) @ np.array([[1, 0, 0], [0, math.cos(angle), -math.sin(angle)], [0, math.sin(angle), math.cos(angle)]])
     depth = np.linspace(0.5, 3.0, 12 * 16, dtype=float).reshape(12, 16)
     view = CameraView((0.1, 0.2, 1.3), rotation, 49.5, depth, 3.5)
-    detection = Detection("mug", (1.0, 0.2, 0.95), (0.06, 0.06, 0.1), "red", (0.8, 0.1, 0.1), "counter", "drawer", 57)
+    detection = Detection(
+        "mug", (1.0, 0.2, 0.95), (0.06, 0.06, 0.1), "red", (0.8, 0.1, 0.1), "counter", "drawer", 57, 0.4, 0.03
+    )
     plain = Detection("bowl", (1.2, -0.1, 0.93), (0.1, 0.1, 0.05), "white", (0.9, 0.9, 0.9), None, None, 30)
     report = PerceptionReport(12.5, (detection, plain), view, {"drawer": 0.21})
     msg = detections_message(report, message, "map")
@@ -60,6 +62,8 @@ def test_a_report_survives_the_message_round_trip():
         57,
     )
     assert (back.detections[1].support, back.detections[1].container) == (None, None)
+    assert (back.detections[0].axis, back.detections[0].slack) == pytest.approx((0.4, 0.03))
+    assert (back.detections[1].axis, back.detections[1].slack) == (None, 0.0)  # not measured, seen whole
     assert back.view is not None
     assert back.view.position == pytest.approx(view.position)
     assert np.asarray(back.view.rotation) == pytest.approx(rotation, abs=1e-9)

@@ -286,3 +286,50 @@ def test_a_look_that_sees_less_of_a_standing_objects_height_keeps_the_height_mea
     lying = Detection("milk", (4.37, 2.0, 0.785), (0.2, 0.07, 0.07), "white", support="table", pixels=500)
     belief.update(PerceptionReport(8.0, (lying,)))
     assert carton.properties["size"][2] == pytest.approx(0.07) and carton.lying_axis is not None
+
+
+def test_a_look_that_sees_an_object_only_in_part_keeps_the_centre_believed_where_it_agrees():
+    def bowl(x, y, slack=0.0, size=(0.14, 0.14, 0.07)):
+        return Detection("bowl", (x, y, 0.785), size, "yellow", support="table", pixels=300, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (seen,) = belief.update(PerceptionReport(1.0, (bowl(4.3, 2.0),))).added
+    # a sliver past an occluder: its centre 6 cm off, but it may be up to 7 cm off: no news
+    belief.update(PerceptionReport(2.0, (bowl(4.27, 1.95, slack=0.07, size=(0.14, 0.14, 0.07)),)))
+    assert seen.pose[:2] == pytest.approx((4.3, 2.0))
+    # a sliver farther off than it may be: the bowl moved
+    belief.update(PerceptionReport(3.0, (bowl(4.2, 1.9, slack=0.05),)))
+    assert seen.pose[:2] == pytest.approx((4.2, 1.9))
+    # most of it seen (a centre at most 1.5 cm off): the look is news, not the older centre
+    belief.update(PerceptionReport(3.5, (bowl(4.19, 1.89, slack=0.015),)))
+    assert seen.pose[:2] == pytest.approx((4.19, 1.89))
+    # seen whole, a look is believed to the millimetre
+    belief.update(PerceptionReport(4.0, (bowl(4.205, 1.9),)))
+    assert seen.pose[:2] == pytest.approx((4.205, 1.9))
+    # on another surface, a part is news too
+    other = Detection("bowl", (4.21, 1.91, 0.985), (0.14, 0.14, 0.07), "yellow", support="counter", slack=0.05)
+    belief.update(PerceptionReport(5.0, (other,)))
+    assert seen.pose[:2] == pytest.approx((4.21, 1.91))
+
+
+def test_a_partial_look_that_also_misses_the_top_keeps_the_centre_and_the_height():
+    def milk(x, height, slack=0.0):
+        size = (0.07, 0.07, height)
+        return Detection("milk", (x, 2.0, 0.75 + height / 2), size, "white", support="table", pixels=500, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3, 0.2),))).added
+    belief.update(PerceptionReport(2.0, (milk(4.33, 0.1, slack=0.04),)))  # a sliver of its lower half
+    assert carton.pose == pytest.approx((4.3, 2.0, 0.85)) and carton.properties["size"][2] == pytest.approx(0.2)
+
+
+def test_a_partial_look_that_measures_a_turn_keeps_the_centre_and_takes_the_turn():
+    def milk(x, axis=None, slack=0.0):
+        size = (0.07, 0.07, 0.2)
+        return Detection("milk", (x, 2.0, 0.85), size, "white", support="table", pixels=500, axis=axis, slack=slack)
+
+    belief = BeliefState(APARTMENT)
+    (carton,) = belief.update(PerceptionReport(1.0, (milk(4.3),))).added  # seen from afar: no turn
+    belief.update(PerceptionReport(2.0, (milk(4.32, axis=math.pi / 4, slack=0.04),)))  # from close by, in part
+    assert carton.pose[:2] == pytest.approx((4.3, 2.0))
+    assert abs(carton.yaw) == pytest.approx(math.pi / 4)  # a square top: up to quarter turns

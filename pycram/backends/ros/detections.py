@@ -9,7 +9,8 @@ the in-process perception module does. A real robot's perception publishes the s
 
 Conventions: every pose is in the message's ``header.frame_id`` (the map); the camera pose is
 OpenGL's (x right, y up, looking along -z); the depth image is ``32FC1`` [m along the optical
-axis]; ``''`` stands for "none" in ``support`` / ``container``. A message without a depth image
+axis]; ``''`` stands for "none" in ``support`` / ``container``, NaN for a top's ``axis`` not
+measured; ``slack`` [m] how far off a centre seen in part may be. A message without a depth image
 carries no view: then no believed object is marked gone.
 """
 
@@ -69,6 +70,8 @@ def detections_message(report: PerceptionReport, message: Callable[..., Any], fr
                 pixels=int(d.pixels),
                 u=float(projected[0]) if projected else 0.0,
                 v=float(projected[1]) if projected else 0.0,
+                axis=math.nan if d.axis is None else float(d.axis),
+                slack=float(d.slack),
             )
         )
     out.items = items
@@ -106,6 +109,8 @@ def report_of(msg: Any, stamp: float) -> PerceptionReport:
             support=i.support or None,
             container=i.container or None,
             pixels=int(i.pixels),
+            axis=None if math.isnan(i.axis) else float(i.axis),
+            slack=float(i.slack),
         )
         for i in msg.items
     )

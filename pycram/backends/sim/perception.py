@@ -80,6 +80,75 @@ def _back_project(view: CameraView, rows: np.ndarray, cols: np.ndarray) -> np.nd
     return local @ np.asarray(view.rotation, float).reshape(3, 3).T + np.asarray(view.position, float)
 
 
+#: A round object's rim counts as seen when its highest point seen is at most this far [m] below
+#: its top (standing on the surface under it).
+RIM_SLACK = 0.015
+#: A pixel beside an object's that is this much [m] nearer the camera hides part of the object.
+OCCLUDER_GAP = 0.02
+#: An object's pixels this close [m] to its extent's end on one side make up that side's edge ...
+EDGE_BAND = 0.015
+#: ... which is hidden when at least this share of its outline pixels there border something
+#: nearer the camera (or the image's border).
+HIDDEN_SHARE = 0.5
+
+
+def hidden_outline(labels: np.ndarray, depth: np.ndarray, index: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Per pixel (`rows`, `cols`) of object `index` in the per-pixel object `labels`: (outline,
+    hidden) -- whether it borders a pixel that is not the object's, and whether that neighbour
+    is something nearer the camera by more than `OCCLUDER_GAP` (`depth` [m]) or lies beyond the
+    image's border: the object may go on behind it."""
+    height, width = labels.shape
+    near = depth[rows, cols] - OCCLUDER_GAP
+    outline = np.zeros(len(rows), bool)
+    hidden = np.zeros(len(rows), bool)
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        r, c = rows + dr, cols + dc
+        off_image = (r < 0) | (r >= height) | (c < 0) | (c >= width)
+        r, c = np.clip(r, 0, height - 1), np.clip(c, 0, width - 1)
+        other = off_image | (labels[r, c] != index)
+        outline |= other
+        hidden |= off_image | (other & (depth[r, c] < near))
+    return np.stack([outline, hidden])
+
+
+def _cut(values: np.ndarray, outline: np.ndarray, hidden: np.ndarray) -> tuple[bool, bool]:
+    """Whether the object's extent along `values` [m] (one value per pixel) is cut short at its
+    low end and at its high end: most outline pixels at that end border an occluder."""
+    ends = []
+    for band in (values <= values.min() + EDGE_BAND, values >= values.max() - EDGE_BAND):
+        edge = band & outline
+        ends.append(bool(edge.any()) and float(hidden[edge].mean()) >= HIDDEN_SHARE)
+    return ends[0], ends[1]
+
+
+def _uncut_centre(
+    low: float, high: float, cut: tuple[bool, bool], extent: float | None, exact: bool
+) -> tuple[float, float]:
+    """The centre [m] of an extent seen from `low` to `high` and how far off it may be [m],
+    knowing the object is at most `extent` long there (None: not known), `exact`ly so for a
+    round one: where one end of a round object is hidden, it reaches on behind it from the seen
+    end; where both ends are hidden, or a box's (its extent in view depends on its turn), the
+    middle of what is seen, off by up to half of what is missing."""
+    middle = (low + high) / 2.0
+    if extent is None or high - low >= extent or not any(cut):
+        return middle, 0.0
+    if exact and cut[0] != cut[1]:
+        return (high - extent / 2.0 if cut[0] else low + extent / 2.0), 0.0
+    return middle, (extent - (high - low)) / 2.0
+
+
+def _footprint_extent(type_name: str) -> tuple[float | None, bool]:
+    """The longest a type's footprint can be in any horizontal direction [m] and whether that is
+    its extent in every direction (a round object's diameter: a cup, a bowl, a plate) -- a box's
+    is its footprint's diagonal; (None, False) for an unknown type."""
+    otype = OBJECT_TYPES.get(type_name)
+    if otype is None:
+        return None, False
+    if otype.shape != "box":
+        return 2.0 * otype.size[0], True
+    return 2.0 * math.hypot(otype.size[0], otype.size[1]), False
+
+
 def _measure(
     view: CameraView,
     type_name: str,
@@ -87,22 +156,47 @@ def _measure(
     colours: np.ndarray,
     environment: Environment,
     container_states: dict[str, float],
+    outline: np.ndarray | None = None,
 ) -> Detection:
-    """A detection from an object's visible pixels: their map `points` [m] and `colours`."""
+    """A detection from an object's visible pixels: their map `points` [m] and `colours`;
+    `outline`: per pixel, whether it borders something else and whether that hides the object
+    (`hidden_outline`). A round object's extent cut short by something nearer the camera (a
+    shelf above, a fridge's side wall, another object) is completed from its seen side with its
+    type's diameter where its rim is seen (measured: a bowl on a fridge shelf half hidden by the
+    wall was believed 4.7 cm off its centre, and the gripper closed beside it). Where what is
+    seen cannot say where the centre is (both ends hidden, a box's end, the rim not seen), the
+    detection's `slack` says how far off its centre may be."""
     # horizontal axes of the view: across it and along it (away from the camera)
     rotation = np.asarray(view.rotation, float).reshape(3, 3)
     across = rotation[:2, 0] / max(np.linalg.norm(rotation[:2, 0]), 1e-9)
     along = -rotation[:2, 2] / max(np.linalg.norm(rotation[:2, 2]), 1e-9)  # the view's heading
     a, b = points[:, :2] @ across, points[:, :2] @ along
-    width = float(a.max() - a.min())
-    centre_a = float(a.max() + a.min()) / 2.0
     top, lowest = float(points[:, 2].max()), float(points[:, 2].min())
+    extent, is_round = _footprint_extent(type_name)
+    # the seen end of a round object is its outline only where its rim is seen: below it, the
+    # pixels may be its inside (measured: a cup under the PR2's hand, 2 cm of its inner wall seen)
+    middle = ((a.max() + a.min()) / 2.0 * across + (b.max() + b.min()) / 2.0 * along).tolist()
+    under = support_of(environment, middle[0], middle[1], lowest, container_states)
+    otype = OBJECT_TYPES.get(type_name)
+    rim_seen = otype is not None and top >= (under.height if under else lowest) + otype.height - RIM_SLACK
+    exact = is_round and rim_seen
+    diameter = extent if is_round else None
+    no_cut = (False, False)
+    cut_a = _cut(a, outline[0], outline[1]) if outline is not None else no_cut
+    cut_b = _cut(b, outline[0], outline[1]) if outline is not None else no_cut
+    width = float(a.max() - a.min())
+    centre_a, slack_a = _uncut_centre(float(a.min()), float(a.max()), cut_a, extent, exact)
+    if diameter is not None and any(cut_a):
+        width = max(width, diameter)
+    slack_b = 0.0
     if view.position[2] > top + 0.05:  # seen from above: the top shows the object's full depth
-        centre_b = float(b.max() + b.min()) / 2.0
+        centre_b, slack_b = _uncut_centre(float(b.min()), float(b.max()), cut_b, extent, exact)
         depth = float(b.max() - b.min())
+        if diameter is not None and any(cut_b):
+            depth = max(depth, diameter)
     else:  # only the near side is seen: assume the object is as deep as it is wide
-        centre_b = float(b.min()) + width / 2.0
-        depth = width
+        centre_b = float(b.min()) + (diameter or width) / 2.0
+        depth = diameter or width
     x, y = (centre_a * across + centre_b * along).tolist()
     surface = support_of(environment, x, y, lowest, container_states)
     bottom = surface.height if surface is not None else max(0.0, lowest)
@@ -130,6 +224,7 @@ def _measure(
         None if container is None else container.name,
         int(len(points)),
         axis,
+        math.hypot(slack_a, slack_b),
     )
 
 
@@ -225,7 +320,8 @@ def measure_detections(
             continue
         if callable(rgb):
             rgb = rgb()
-        detection = _measure(view, types[index], points, rgb[rows, cols], environment, container_states)
+        outline = hidden_outline(labels, depth, int(index), rows, cols)
+        detection = _measure(view, types[index], points, rgb[rows, cols], environment, container_states, outline)
         if faults.pose_noise:
             noisy = tuple(float(v) for v in np.asarray(detection.position) + rng.normal(0.0, faults.pose_noise, 3))
             detection = _replace(detection, position=noisy)
