@@ -48,7 +48,7 @@ from pycram.execution.robot import current_robot
 from pycram.world.belief import PerceivedObject
 from pycram.world.objects import OBJECT_TYPES, Grasp, approach_matches, object_type
 
-from .container_state import DOOR_USEFUL
+from .container_state import DOOR_TOLERANCE, DOOR_USEFUL
 from .containers import DOOR_OPENING, Open, opening_one_at_a_time
 from .core import (
     RECOVERABLE,
@@ -103,6 +103,12 @@ WIDE_MARGIN = 0.03
 #: under the furniture (the hand is wider than the object, and the handles of the drawers above
 #: stick out 4 cm).
 OUT_FROM_UNDER = 0.12
+#: Picking from behind a door (a fridge's, a cupboard's) that no standing pose reaches into with
+#: the door open as `Open` opens it: it is opened this far [rad] (92 deg; or to its limit) and
+#: the grasp is planned again. The door's leaf swung further back frees the floor in front of
+#: the shelves (measured: a bowl on a generated fridge's middle shelf is reached by the PR2 from
+#: 1 standing pose with the door at 67 deg, from 3 at 92 deg; `procedural:46`, seed 1).
+DOOR_WIDE = 1.6
 #: The named torso position objects are carried at (a robot without a torso keeps its own).
 CARRY_TORSO = "up"
 
@@ -427,9 +433,10 @@ def _wider_opening(obj: PerceivedObject, as_far_as_needed: bool = False) -> floa
     """How far [m] to pull out the drawer `obj` lies in: near the slide's end, or -- with
     `as_far_as_needed` -- just so far that the object is `OUT_FROM_UNDER` out from under the
     furniture (its footprint past the closed drawer's front). Behind a door (a cupboard's, the
-    fridge's) believed open less than `DOOR_USEFUL`: `DOOR_OPENING` [rad] (the object was seen
-    inside, and the door was closed since or stuck part way). None when it is in no container or
-    the container is (about) that far open already."""
+    fridge's): with `as_far_as_needed`, `DOOR_OPENING` [rad] when it is believed open less than
+    `DOOR_USEFUL` (the object was seen inside, and the door was closed since or stuck part way);
+    else `DOOR_WIDE` (or the door's limit). None when it is in no container or the container is
+    (about) that far open already."""
     name = obj.properties.get("in")
     belief = getattr(current_robot(), "belief", None)
     environment = getattr(belief, "environment", None)
@@ -437,7 +444,11 @@ def _wider_opening(obj: PerceivedObject, as_far_as_needed: bool = False) -> floa
         return None
     container = environment.container(name)
     if container.kind == "door":
-        return DOOR_OPENING if abs(float(belief.container_states.get(name, 0.0))) < DOOR_USEFUL else None
+        now = abs(float(belief.container_states.get(name, 0.0)))
+        if as_far_as_needed:
+            return DOOR_OPENING if now < DOOR_USEFUL else None
+        wide = min(container.limits[1], DOOR_WIDE)
+        return wide if now < wide - DOOR_TOLERANCE else None
     if container.kind != "drawer":
         return None
     wide = container.limits[1] - WIDE_MARGIN
