@@ -254,6 +254,31 @@ def test_eight_threads_give_the_same_answers_as_one(world):
         assert r == alone
 
 
+def test_drivable_counts_an_arms_touch_as_the_drive_does(world):
+    """Approaching the back counter with the right arm held out at counter height: the first
+    pose where the fingers touch the counter by less than prospection's `COLLISION_TOLERANCE` (a
+    touch arm motions may make) is one the drive refuses -- it fails on any contact -- and
+    `drivable` refuses it too, with the drive's tolerance (measured: reasoning offered standing
+    poses where a carried box touched the counter by 0.1 mm, every one refused by the drive as
+    "goal_in_collision")."""
+    p = world.prospection()
+    start = world.base_pose.get_value()
+    ok(world.move_arm_to("right", "pre_grasp"))
+    try:
+        poses = [(0.2, -0.3 - 0.01 * k, -math.pi / 2) for k in range(80)]
+        brushing = next(i for i, pose in enumerate(poses) if p.in_collision(pose, objects=True, tolerance=0.0))
+        assert not p.in_collision(poses[brushing], objects=True)  # within prospection's tolerance
+        assert not p.drivable(poses[brushing])
+        out = world.drive_to(*poses[brushing]).wait(T)
+        assert out is not None and not out.succeeded and "goal_in_collision" in out.message
+        outside = poses[brushing - 1]
+        assert p.drivable(outside)
+        ok(world.drive_to(*outside))
+        ok(world.drive_to(start.x, start.y, start.yaw))
+    finally:
+        ok(world.move_arm_to("right", "park"))
+
+
 def test_drivable_is_the_drives_own_verdict_on_a_goal(world):
     """Approaching the back counter head-on: where the robot still touches nothing, the drive
     keeps its clearance and refuses a goal; `drivable` says so before the drive does (location

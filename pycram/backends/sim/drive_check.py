@@ -25,10 +25,17 @@ from .occupancy import FloorMap, base_footprint, body_outlines, build_floor_map,
 from .occupancy import _add as rasterize
 from .scene import Scene
 
-__all__ = ["layered_planner", "band_outlines", "DriveCheck", "OUTLINE_ABOVE"]
+__all__ = ["layered_planner", "band_outlines", "DriveCheck", "OUTLINE_ABOVE", "DRIVE_TOLERANCE"]
 
 #: A band's obstacles are kept off by the robot's outline below its top plus this [m].
 OUTLINE_ABOVE = 0.02
+#: The drive's exact check (the whole robot and what it holds, where only an arm's outline is in
+#: the way) counts every contact penetrating more than this [m] -- none: a drive fails on any
+#: contact. Location reasoning's `SimProspection.drivable` checks with the same tolerance, not
+#: prospection's `COLLISION_TOLERANCE` (measured: a carried cereal box 0.1 mm into the counter's
+#: edge at a standing pose reasoning offered, refused by the drive as "goal_in_collision" at every
+#: candidate; set-table-anywhere, PR2, `procedural:46`, seed 1).
+DRIVE_TOLERANCE = 0.0
 
 
 def layered_planner(

@@ -25,7 +25,7 @@ from pycram.world.prospection import BasePose
 from pycram.world.types import Outcome, Pose2D
 
 from .controllers import BaseDrive, Controller, fail, invalid_input
-from .drive_check import band_outlines, layered_planner
+from .drive_check import DRIVE_TOLERANCE, band_outlines, layered_planner
 from .engine import Engine
 from .occupancy import FloorMap, base_footprint, build_floor_map, local_vertices, robot_parts
 from .occupancy import _add as rasterize
@@ -67,8 +67,8 @@ class Navigation:
         self._item_qpos = np.array([[a, a + 1, a + 2] for a in eng.item_qpos.values()], dtype=np.int64).reshape(-1, 3)
         self._planner: PathPlanner | None = None
         self._robot_state = StateSnapshot.of(eng.data)
-        # no tolerance: a drive fails on any contact
-        self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=0.0)
+        # a drive fails on any contact (`DRIVE_TOLERANCE`)
+        self._prospection = SimProspection(eng.scene, lambda: self._robot_state, tolerance=DRIVE_TOLERANCE)
 
     def exact_check(self, eng: Engine) -> Callable[[float, float, float], bool]:
         """Whether the whole robot, in its configuration now and with the items its grippers

@@ -212,12 +212,17 @@ class SimProspection(Prospection):
         mujoco.mj_kinematics(self.model, d)
 
     def _touching(
-        self, d: mujoco.MjData, robot: np.ndarray | None = None, obstacles: np.ndarray | None = None
+        self,
+        d: mujoco.MjData,
+        robot: np.ndarray | None = None,
+        obstacles: np.ndarray | None = None,
+        tolerance: float | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Collision detection on `d` (kinematics computed): contact geoms (g1, g2), whether g1
         is the robot's one, and which contacts are robot-obstacle collisions (`robot`: the mask
         of the robot's geoms, with those of objects it carries; default: the robot's own;
-        `obstacles`: the mask of the obstacles' geoms, default: the environment's)."""
+        `obstacles`: the mask of the obstacles' geoms, default: the environment's), penetrating
+        more than `tolerance` [m] (default: this prospection's)."""
         mujoco.mj_collision(self.model, d)
         n = d.ncon
         geoms = d.contact.geom[:n]
@@ -226,7 +231,8 @@ class SimProspection(Prospection):
         is_obstacle = self._is_env if obstacles is None else obstacles
         hit1 = is_robot[g1] & is_obstacle[g2]
         hit2 = is_robot[g2] & is_obstacle[g1]
-        return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -self.tolerance)
+        allowed = self.tolerance if tolerance is None else tolerance
+        return g1, g2, hit1, (hit1 | hit2) & (d.contact.dist[:n] < -allowed)
 
     def _contacts(self, d: mujoco.MjData) -> list[tuple[str, str]]:
         """Distinct (robot part, environment part) pairs that touch in `d` (kinematics computed)."""
@@ -262,6 +268,7 @@ class SimProspection(Prospection):
         joint_configuration: Mapping[str, float] | None = None,
         carried: Sequence[str] = (),
         objects: bool = False,
+        tolerance: float | None = None,
     ) -> bool:
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
@@ -269,7 +276,7 @@ class SimProspection(Prospection):
             obstacles = self._is_env
             if objects:  # every object but the carried ones is an obstacle too
                 obstacles = (self._is_env | self._object_geoms()) & ~robot
-            return bool(self._touching(d, robot, obstacles)[3].any())
+            return bool(self._touching(d, robot, obstacles, tolerance)[3].any())
 
     def drivable(
         self, base_pose: Any, joint_configuration: Mapping[str, float] | None = None, carried: Sequence[str] = ()
@@ -278,9 +285,10 @@ class SimProspection(Prospection):
         floor map's bands, the footprint grown by the drive's clearance, the robot's outline in
         `joint_configuration`) in this prospection's world, the objects not `carried` in the
         bands of their tops; where only an arm's outline is in the way, `in_collision` with the
-        objects decides, as the drive's exact check does. The planner is kept per state and
+        objects decides, as the drive's exact check does, with the drive's tolerance
+        (`drive_check.DRIVE_TOLERANCE`: none). The planner is kept per state and
         configuration (one designator resolution asks many poses of one state)."""
-        from .drive_check import DriveCheck
+        from .drive_check import DRIVE_TOLERANCE, DriveCheck
 
         pose = as_base_pose(base_pose)
         snap = self._snapshot()
@@ -300,7 +308,9 @@ class SimProspection(Prospection):
         planner = cached[1]
 
         def exact(x: float, y: float, yaw: float) -> bool:
-            return not self.in_collision((x, y, yaw), joint_configuration, carried, objects=True)
+            return not self.in_collision(
+                (x, y, yaw), joint_configuration, carried, objects=True, tolerance=DRIVE_TOLERANCE
+            )
 
         return planner.pose_free(pose.x, pose.y, pose.yaw, exact)
 
