@@ -20,9 +20,10 @@ For each place setting, in order:
   up with the free arm (``PickUp(next, arm=free)``, abandoned by ``pursue`` as soon as the
   next one is believed gone: no searching with full hands) and puts it at its setting, then
   puts this one down: two objects carried at once, one trip to the table fewer;
-* each round runs under `with_timeout` (a budget of simulated time), with one more round for
-  the failures that a second look may fix (the object was moved, missed by perception, a
-  drawer was stuck and is free now);
+* each round's fetching runs under `with_timeout` (a budget of simulated time, from the moment
+  the object is found: the search is bounded by the places it visits, and a kitchen with more
+  drawers and doors takes longer to search), with one more round for the failures that a second
+  look may fix (the object was moved, missed by perception, a drawer was stuck and is free now);
 * afterwards, with empty hands, every drawer and door the robot believes open is closed again
   (`Close`), so no drawer is left sticking out into the room.
 
@@ -67,7 +68,7 @@ from pycram.actions import (
 )
 from pycram.actions.core import arms, base_pose_fluent, motion, while_driving
 from pycram.actions.search import LOOK_RANGE
-from pycram.core.expressions import State, pursue, with_timeout
+from pycram.core.expressions import State, pursue, seq, with_timeout
 from pycram.core.fluent import Fluent
 from pycram.designators.core import DesignatorError
 from pycram.designators.object import ObjectDesignator
@@ -107,8 +108,11 @@ log = logging.getLogger("pycram.demo")
 #: could not execute or designators without a solution that escaped an action's recovery.
 WORLD_FAILURES = (PlanFailure, ProcessModuleError, DesignatorError)
 
-#: Simulated time [s] one transport round may take (search, fetch, place, the recoveries inside;
-#: a search through the three drawers alone takes about 150 s).
+#: Simulated time [s] one transport round may take once its object is found (fetch, place, the
+#: recoveries inside). The search before is not counted: it ends when it has looked at every
+#: likely place, and a kitchen's size decides how long that takes (measured: a bowl on a
+#: generated fridge's shelf was found after 184 s of opening and closing the cupboard and the
+#: fridge, and the round ran out while the robot picked it up; `procedural:35`, seed 1).
 ROUND_TIME_BUDGET = 300.0
 #: Looking from elsewhere: a named place at least this far [m] from where the robot stands.
 ELSEWHERE = 0.5
@@ -497,16 +501,24 @@ def _bring(
         def transport(round_number: int = round_number) -> Any:
             held = _held(setting.type)
             if held is not None:  # still in a gripper after an interrupted round: put it down
-                try:
+
+                def put_down(held: Held = held) -> Any:
                     return perform(Place(held, setting.point, arm=held.arm))
+
+                try:
+                    return _within_budget(put_down, f"put the {setting.type} down")
                 except GripperEmpty as empty:  # lost meanwhile (taken, dropped): fetch it again
                     log.info("set table: the %s is no longer held (%s); fetching it again", setting.type, empty)
-            found = find(setting.type, record)
-            if round_number == 1 and partner is not None and not partner.placed and _arms_to_spare() >= 2:
-                return _carry_two(found, outcome, partner, record)
-            return perform(Transport(found, setting.point))
+            found = find(setting.type, record)  # bounded by the places it looks at, not by the budget
 
-        state = with_timeout(ROUND_TIME_BUDGET, transport, errors, name=f"bring the {setting.type}")
+            def fetch() -> Any:
+                if round_number == 1 and partner is not None and not partner.placed and _arms_to_spare() >= 2:
+                    return _carry_two(found, outcome, partner, record)
+                return perform(Transport(found, setting.point))
+
+            return _within_budget(fetch, f"fetch the {setting.type}")
+
+        state = seq(transport, errors=errors, name=f"bring the {setting.type}")
         if state.get_value() is State.SUCCEEDED:
             outcome.placed, outcome.failure = True, None
             return
@@ -519,6 +531,14 @@ def _bring(
         close_opened_containers()  # the next round starts with the room as it should be
         if isinstance(error, (ObjectOutOfReach, GraspFailed)):
             look_from_elsewhere(setting.type)  # perceived from one view only: measure it again
+
+
+def _within_budget(fetch: Callable[[], Any], name: str, budget: float = ROUND_TIME_BUDGET) -> None:
+    """Run `fetch` as a task bounded by `budget` [s of simulated time] (`with_timeout`); raise
+    what it raised, or the `TimeoutError` when it ran out of time."""
+    errors: list[BaseException] = []
+    if with_timeout(budget, fetch, errors, name=name).get_value() is not State.SUCCEEDED:
+        raise errors[0] if errors else PlanFailure(f"{name} did not succeed")
 
 
 def set_table(settings: list[PlaceSetting], record: PlanRecord | None = None) -> list[SettingOutcome]:
