@@ -533,11 +533,11 @@ def _bring(
             look_from_elsewhere(setting.type)  # perceived from one view only: measure it again
 
 
-def _within_budget(fetch: Callable[[], Any], name: str, budget: float = ROUND_TIME_BUDGET) -> None:
-    """Run `fetch` as a task bounded by `budget` [s of simulated time] (`with_timeout`); raise
-    what it raised, or the `TimeoutError` when it ran out of time."""
+def _within_budget(fetch: Callable[[], Any], name: str) -> None:
+    """Run `fetch` as a task bounded by `ROUND_TIME_BUDGET` [s of the active clock: simulated
+    time] (`with_timeout`); raise what it raised, or the `TimeoutError` when it ran out of time."""
     errors: list[BaseException] = []
-    if with_timeout(budget, fetch, errors, name=name).get_value() is not State.SUCCEEDED:
+    if with_timeout(ROUND_TIME_BUDGET, fetch, errors, name=name).get_value() is not State.SUCCEEDED:
         raise errors[0] if errors else PlanFailure(f"{name} did not succeed")
 
 
