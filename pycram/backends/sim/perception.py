@@ -202,7 +202,6 @@ def _measure(
     bottom = surface.height if surface is not None else max(0.0, lowest)
     axis = None
     if view.position[2] > top + 0.05:  # the top is seen: its longer axis, or how a square one is turned
-        otype = OBJECT_TYPES.get(type_name)
         # a box standing on its square base has no longer axis on top (seen in part it looks
         # oblong): its sides' direction; lying on its side, it has one
         standing_square = (
