@@ -270,6 +270,8 @@ class SimProspection(Prospection):
         objects: bool = False,
         tolerance: float | None = None,
     ) -> bool:
+        """`Prospection.in_collision`; contacts penetrating less than `tolerance` [m] (default:
+        this prospection's, `COLLISION_TOLERANCE` unless built with another) do not count."""
         with self._data() as d:
             self._prepare(d, base_pose, joint_configuration)
             robot = self._carry(d, base_pose, carried) if carried else self._is_robot
