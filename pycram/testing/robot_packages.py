@@ -10,8 +10,8 @@ PyCRAM registers one (`pycram.world.robot_registry`).
   imported from it, so that a later package of the same name, elsewhere, is imported afresh.
 - :func:`installed_robot_package` does both::
 
-    with installed_robot_package(tmp_path, "tiago_differential", overrides={"BASE": {"kind": "differential"}}):
-        world = World("tiago_differential")  # the TIAGo's description on a differential drive
+    with installed_robot_package(tmp_path, "tiago_omni", overrides={"BASE": {"kind": "omnidirectional"}}):
+        world = World("tiago_omni")  # the TIAGo's description on an omnidirectional base
 
 A written package has no ``robot.py``; the simulator then makes the robot from the description
 alone (`pycram.robots.common.sim_robot.make_sim_robot`).

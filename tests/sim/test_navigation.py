@@ -100,30 +100,6 @@ def test_a_door_left_open_across_the_route_is_driven_around():
         world.close()
 
 
-DIFFERENTIAL_TWIN = "tiago_differential"
-
-
-@pytest.fixture(scope="module")
-def differential_tiago(tmp_path_factory):
-    """A world with the TIAGo on the differential drive its real base is (its description with
-    ``BASE["kind"] = "differential"``, registered through an entry point as another package
-    would; the TIAGo itself stays omnidirectional by default, see its description)."""
-    from pycram.sim import World
-    from pycram.testing.robot_packages import installed_robot_package
-    from pycram.world import robot_registry
-
-    with installed_robot_package(
-        tmp_path_factory.mktemp("twin"),
-        DIFFERENTIAL_TWIN,
-        like="tiago",
-        package="differential_tiago",
-        overrides={"BASE": {"kind": "differential"}},
-    ):
-        assert robot_registry.robot_description(DIFFERENTIAL_TWIN).base_kinematics.kind == "differential"
-        with World(DIFFERENTIAL_TWIN) as w:
-            yield w
-
-
 def _moves_left(world) -> tuple[float, float]:
     """Drive 0.4 m to the robot's left (same heading) and back; (metres travelled along the base's
     own y axis, largest heading change [rad]) on the way there."""
@@ -143,23 +119,22 @@ def _moves_left(world) -> tuple[float, float]:
     return sideways, turned
 
 
-def test_an_omnidirectional_base_steps_sideways(world):
-    assert world.description.BASE.get("kind", "omnidirectional") == "omnidirectional"
-    sideways, turned = _moves_left(world)
-    assert sideways > 0.35, sideways
-    assert turned < 0.05
-
-
-def test_a_differential_drive_never_steps_sideways(differential_tiago):
-    """Asked to move 0.4 m to its left, the differential TIAGo turns, drives along its heading and
+def test_a_base_moves_sideways_as_its_kinematics_allow(world):
+    """Asked to move 0.4 m to its left, the omnidirectional PR2 steps sideways without turning;
+    the TIAGo, a differential drive as its real base is, turns, drives along its heading and
     turns back: it faces the way it goes (about 90 deg) and travels less than 2 cm sideways."""
-    sideways, turned = _moves_left(differential_tiago)
-    assert sideways < 0.02, sideways
-    assert turned > 1.2
+    kind = world.description.base_kinematics.kind
+    assert kind == {"pr2": "omnidirectional", "tiago": "differential"}[world.robot]
+    sideways, turned = _moves_left(world)
+    if kind == "omnidirectional":
+        assert sideways > 0.35, sideways
+        assert turned < 0.05
+    else:
+        assert sideways < 0.02, sideways
+        assert turned > 1.2
 
 
-def test_a_differential_drive_drives_around_an_obstacle(differential_tiago):
-    world = differential_tiago
+def test_a_base_drives_around_an_obstacle_on_its_way(world):
     start = world.base_pose.get_value()
     c, s = math.cos(start.yaw), math.sin(start.yaw)
     obstacle = ok(world.place_obstacle(start.x + 0.9 * c, start.y + 0.9 * s))

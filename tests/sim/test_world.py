@@ -89,7 +89,9 @@ def test_blocked_straight_drive_fails_and_stops(world):
 
 def test_drive_can_be_cancelled(world):
     start = world.base_pose.get_value()
-    handle = world.drive_to(start.x + 2.0, start.y + 1.0, start.yaw)
+    # 2 m ahead along its heading: every base (a differential drive too) sets off at once
+    c, s = math.cos(start.yaw), math.sin(start.yaw)
+    handle = world.drive_to(start.x + 2.0 * c, start.y + 2.0 * s, start.yaw)
     assert (world.sim_time > world.sim_time.get_value() + 0.8).wait_for(T)
     handle.cancel()
     out = handle.wait(T)

@@ -59,10 +59,10 @@ def test_leaving_the_block_unregisters_the_robot_and_forgets_its_modules(tmp_pat
 
 def test_overrides_update_a_dict_key_or_replace_a_value(tmp_path):
     tiago = robot_registry.robot_description("tiago")
-    overrides = {"BASE": {"kind": "differential"}, "ROS": None}
-    with installed_robot_package(tmp_path, "tiago-differential", like="tiago", overrides=overrides):
-        twin = robot_registry.robot_description("tiago-differential")
-    assert twin.base_kinematics.kind == "differential" and tiago.base_kinematics.kind == "omnidirectional"
+    overrides = {"BASE": {"kind": "omnidirectional"}, "ROS": None}
+    with installed_robot_package(tmp_path, "tiago-omni", like="tiago", overrides=overrides):
+        twin = robot_registry.robot_description("tiago-omni")
+    assert twin.base_kinematics.kind == "omnidirectional" and tiago.base_kinematics.kind == "differential"
     assert {k: v for k, v in twin.BASE.items() if k != "kind"} == {k: v for k, v in tiago.BASE.items() if k != "kind"}
     assert twin.ROS is None and tiago.ROS is not None
     assert twin.ARMS == tiago.ARMS

@@ -14,18 +14,14 @@ NAME = "tiago"
 URDF = "robots/tiago_description/robots/tiago_no_hand.urdf"
 ROOT_LINK = "base_footprint"
 
-#: TIAGo's real base is a differential drive (two driven wheels and casters). The simulated one
-#: is still omnidirectional by default: `"differential"` (`pycram.world.base_kinematics`; it
-#: would back up at most `max_reverse` -- no laser behind it -- and arrive at / leave a pose
-#: straight along its heading over `approach`) is built and measured -- set-table development
-#: seeds 11-40 30/30, as omnidirectional; the robot check passes 31/31 and set-table seed 205
-#: is set since a drive that stops millimetres off its goal turns on the spot instead of turning
-#: towards that offset and back (that swing knocked a held cup against the fridge) -- but one
-#: end-to-end test still fails with it: the run with the stuck drawer overruns its 300-s
-#: transport round (turning on the spot costs ~1.5x the simulated time) and its second round's
-#: reach into the drawer is blocked. See issue 34's notes.
+#: TIAGo's real base is a differential drive (two driven wheels and casters), and so is the
+#: simulated one (`pycram.world.base_kinematics`): it turns on the spot, drives along its heading
+#: or on arcs, never sideways; it backs up at most `max_reverse` (no laser behind it) and arrives
+#: at / leaves a pose straight along its heading over `approach` where turning there would sweep
+#: an arm or a carried object over the furniture. Turning on the spot costs it ~1.5x the
+#: simulated time of the omnidirectional base it had until stop 41 (see docs/set-table.md).
 BASE = {
-    "kind": "omnidirectional",
+    "kind": "differential",
     "max_reverse": 0.5,  # [m]
     "approach": 0.3,  # [m]
     "max_linear_velocity": 0.6,  # [m/s]
