@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import pytest
 from sim_helpers import Recorder, T, ok, wait_wall
 
 OBSTACLE_HALF = 0.15  # [m] half width of `place_obstacle`'s box
