@@ -41,12 +41,13 @@ def carry_configuration(arm: str, grasp: Grasp) -> str:
     return "carry_top" if grasp.approach == "top" and not body and "carry_top" in named else "carry"
 
 
-def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None, grasping: Any = None) -> None:
+def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None, grasping: Any = None) -> Any:
     """Reach phase `phase` of a sequence: the `index`-th validated tool pose of `location` when
     it has them (top grasps: the tool's orientation matters), else `point` with the phase's
     offset along the base's heading. `grasping`: the believed object being grasped (it may touch
     the fingers on the way: the motion's ``object``), None for none. The arm's joints validated
-    for that pose (`location.joints`) go along as IK's first guess (the motion's ``joints``)."""
+    for that pose (`location.joints`) go along as IK's first guess (the motion's ``joints``).
+    Returns what the motion returns (the reached tool pose)."""
     poses = getattr(location, "tool_poses", ())
     extra = {} if grasping is None else {"object": grasping}
     validated = getattr(location, "joints", ())
@@ -54,9 +55,10 @@ def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] |
         extra["joints"] = list(validated[index])
     if location.grasp == "top" and len(poses) > index:
         position, orientation = poses[index]
-        motion(type="reaching", arm=arm, target=list(position), orientation=list(orientation), phase=phase, **extra)
-    else:
-        motion(type="reaching", arm=arm, target=point, phase=phase, **extra)
+        return motion(
+            type="reaching", arm=arm, target=list(position), orientation=list(orientation), phase=phase, **extra
+        )
+    return motion(type="reaching", arm=arm, target=point, phase=phase, **extra)
 
 
 def _pose_text(location: Any) -> str:

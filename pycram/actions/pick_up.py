@@ -111,6 +111,10 @@ OUT_FROM_UNDER = 0.12
 DOOR_WIDE = 1.6
 #: The named torso position objects are carried at (a robot without a torso keeps its own).
 CARRY_TORSO = "up"
+#: Picking from a shelf behind a door: once lifted, the object is taken straight out along the
+#: door's opening direction until its footprint is this far [m] past the furniture's front, and
+#: only then to the carry configuration (`_withdraw`).
+WITHDRAW_MARGIN = 0.05
 
 
 def PickUp(object: Any, arm: str | None = None, grasp: str | None = None) -> ActionDesignator:
@@ -237,9 +241,43 @@ def _planned_reach(arm: str, location: Any, obj: PerceivedObject) -> Any:
         dx, dy, dz = (a - b for a, b in zip(obj.pose, candidate.centre, strict=True))
         extra = {} if grasping is None else {"object": grasping}
         target = [x + dx, y + dy, z + dz]
-        motion(type="reaching", arm=arm, target=target, orientation=list(orientation), phase=phase, **extra)
+        return motion(type="reaching", arm=arm, target=target, orientation=list(orientation), phase=phase, **extra)
 
     return reach
+
+
+def _withdraw(arm: str, obj: PerceivedObject, lifted: Any) -> bool:
+    """Take `obj`, held by `arm` and lifted (the tool at `lifted`, the pose the lift reached: a
+    position [m, map] and orientation), out of the cupboard or fridge it stands in, straight
+    along the door's opening direction until its footprint is `WITHDRAW_MARGIN` past the
+    furniture's front (a ``lift`` reach: the tool's line, else planned); True when it did.
+    Going to the carry configuration from inside, the held bowl met the fridge's side wall, and
+    backing the base away dragged it along the wall (PR2, set-table-anywhere, ``procedural:80``
+    and ``procedural:130``, seed 1). Best effort: a failure is logged and the pick-up goes on as
+    before. Nothing to do (False) for an object not behind a door or out already, or for a lift
+    that reports no tool pose."""
+    environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
+    name = obj.properties.get("in")
+    position, orientation = getattr(lifted, "position", None), getattr(lifted, "orientation", None)
+    if environment is None or name is None or position is None or orientation is None:
+        return False
+    container = environment.container(name)
+    if container.kind != "door":  # a drawer is open above: the lift takes the object out
+        return False
+    dx, dy = container.opening_direction
+    out = container.front + WITHDRAW_MARGIN + object_type(obj.type).footprint_radius
+    distance = out - container.along_slide(obj.pose[0], obj.pose[1])
+    if distance <= 0.0:
+        return False
+    x, y, z = (float(v) for v in position)
+    target = [x + distance * dx, y + distance * dy, z]
+    try:
+        # a lift's line (the tool's straight line, else planned); with the orientation given, no offset
+        motion(type="reaching", arm=arm, target=target, orientation=[float(v) for v in orientation], phase="lift")
+    except RECOVERABLE as error:
+        log.info("taking %s out of %s: %s; on to carrying it from where it is", obj.name, name, unwrap(error))
+        return False
+    return True
 
 
 def _turn_between(obj: PerceivedObject, before: float, after: float) -> float:
@@ -326,11 +364,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     point = _grasp_point(obj, grasp, location.yaw)
     planned_reach = _planned_reach(arm, location, obj)
 
-    def reach(index: int, phase: str, grasping: Any = None) -> None:
+    def reach(index: int, phase: str, grasping: Any = None) -> Any:
         if planned_reach is not None:
-            planned_reach(index, phase, grasping)
-        else:
-            _reach(arm, location, index, phase, point, grasping)
+            return planned_reach(index, phase, grasping)
+        return _reach(arm, location, index, phase, point, grasping)
 
     try:
         if candidate is not None and grasp.approach != "top" and grasp.radius:
@@ -381,7 +418,10 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     if belief is not None:
         belief.picked_up(obj, gripper)
     try:
-        reach(2, "lift")
+        lifted = reach(2, "lift")
+        if _withdraw(arm, obj, lifted):  # out of the doorway: the base backs away before the arm
+            # moves to carry (the carry pose, fixed to the base, lay in the fridge's side wall)
+            back_away(f"taking {obj.name} out of {obj.properties.get('in')}")
         # blocked on its way to carry -- the held box pressed onto the furniture it was taken
         # from (the PR2's, a cereal box from a cabinet top's back: let go, it fell) -- the base
         # backs away first and the arm tries once more

@@ -176,7 +176,8 @@ DIRECT_PHASES = ("place",)
 STRAIGHT_PHASES = ("grasp", "retreat")
 #: Reaching phases that try the tool's straight line first (`plan_cartesian_line`), then plan as
 #: any motion: the `STRAIGHT_PHASES`, and the lift of an object just grasped (straight up off its
-#: surface: the joints' line between two IK solutions drags it sideways first).
+#: surface: the joints' line between two IK solutions drags it sideways first; and straight out
+#: of a doorway, `pycram.actions.pick_up._withdraw`).
 LINE_PHASES = (*STRAIGHT_PHASES, "lift")
 #: Reaching phases towards an object that must not touch it (the object a motion names is then an
 #: obstacle like any other, not exempt at the fingers).
