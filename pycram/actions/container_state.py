@@ -12,7 +12,6 @@ now, `_look_at_neighbours` at the handles within `NEIGHBOUR_RADIUS` [m] of one.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from functools import partial
 from typing import Any
 
@@ -44,39 +43,26 @@ def _environment() -> Any:
     return belief, environment
 
 
-def _measure(belief: Any, container: Any, expected: float | None = None, then: Sequence[float] = ()) -> float | None:
+def _measure(belief: Any, container: Any, expected: float | None = None) -> float | None:
     """Look at the handle; the opening [m or rad] perception measured (None when these looks did
     not measure it: an older value of the belief is no measurement).
 
     With `expected` (where the container should be now, far from where it is believed to be) the
     head looks there first and then where it was believed to be: perception measures the
-    container whenever its handle is in view, so the belief ends with what was seen. The
-    openings in `then` are looked at afterwards, in turn, until one look measures it (where the
-    container may be instead: a door the hand slipped off stops short of where it let go)."""
+    container whenever its handle is in view, so the belief ends with what was seen."""
     believed = belief.container_states.get(container.name, 0.0)
     before = belief.container_stamps.get(container.name)
     looks = [believed]
     if expected is not None and abs(expected - believed) > DOOR_TOLERANCE:
         looks.insert(0, expected)
-
-    def measured() -> bool:
-        return belief.container_stamps.get(container.name) != before
-
-    def look(q: float) -> None:
+    for q in looks:
         # standing close, the head may not turn all the way: it looks as near as it can
         best_effort(
             "looking at a handle",
             partial(motion, type="pointing_head", coordinates=list(container.handle_position(q))),
         )
         motion(type="detecting")
-
-    for q in looks:
-        look(q)
-    for q in then:
-        if measured():
-            break
-        look(q)
-    if not measured():  # not measured by these looks
+    if belief.container_stamps.get(container.name) == before:  # not measured by these looks
         return None
     return float(belief.container_states[container.name])
 

@@ -13,8 +13,7 @@ off and looks again.
   into the door, and the handle is carried along its arc around the hinge in `DOOR_STEPS` tool
   poses, the wrist turning with the door (``reaching`` with an ``orientation``). Letting go, the
   hand backs off the door and out round its free edge, the base backs off and the arm is parked
-  (an arm coming back round an open door pushes it shut); like a drawer, the door is believed
-  where the hand let go of it until the look measures it.
+  (an arm coming back round an open door pushes it shut).
 
 Raises `HandleMissed` (the gripper closed beside the handle -- below `HANDLE_OPENING` [m] -- or,
 for a door, on something wider than its bar), `ContainerStuck` (the container did not follow) or
@@ -129,7 +128,7 @@ def _move_handle(location: Any, *, belief: Any, container: Any, goal: float) -> 
         if reached_q != start:  # it moved: the arm's way off the handle is planned with it there
             belief.moved_container(container.name, let_go_at)
         _release(arm, gripper, list(container.handle_position(let_go_at)), grasp)
-    measured = _measure(belief, container, then=[start] if reached_q != start else [])
+    measured = _measure(belief, container)
     _look_at_neighbours(belief, container)
     if measured is None:
         raise ContainerFailure(f"could not see the handle of {container.name!r} after moving it", container.name)
@@ -207,14 +206,8 @@ def _swing_door(location: Any, belief: Any, container: Any, start: float, goal: 
                 break
             reached = q
     finally:
-        if reached != start:  # as a drawer's: the arm's way off is planned with the door there,
-            # and the look after it goes to where the handle is now -- not where the door was
-            # closed, maybe out of view from close by (the PR2 at a generated fridge did not see
-            # its handle after opening it: set-table-anywhere, procedural:130, seed 1)
-            belief.moved_container(container.name, max(reached, 0.0))
         _let_go_of_door(arm, gripper, container, reached, back)
-    # then where it was: a door the hand slipped off stops short of where the hand let go
-    measured = _measure(belief, container, then=[start] if reached != start else [])
+    measured = _measure(belief, container)
     if measured is None:
         raise ContainerFailure(f"could not see the handle of {container.name!r} after moving it", container.name)
     done = measured < DOOR_CLOSED if closing else measured >= min(goal - DOOR_TOLERANCE, DOOR_USEFUL)

@@ -64,33 +64,6 @@ def test_the_pr2_opens_and_closes_the_fridge_door_by_its_handle_along_its_arc():
         assert robot.belief.container_states["fridge"] < math.radians(4)
 
 
-def test_a_door_swung_open_is_believed_where_the_hand_let_go_until_the_look_measures_it():
-    """As a drawer: the arm's way off the handle is planned with the door there, and the look
-    afterwards goes where its handle is now (looking where it was closed, a PR2 close to a
-    generated fridge saw no handle)."""
-    from pycram.actions.containers import DOOR_OPENING
-
-    with apartment_with("pr2", {"cup": TABLE}) as (world, robot):
-        perform(ParkArms())
-        perform(MoveTorso("up"))
-        belief = robot.belief
-        told: list[tuple[str, float, float | None]] = []
-        moved = belief.moved_container
-
-        def moved_and_noted(name, q):
-            told.append((name, q, belief.container_stamps.get(name)))
-            moved(name, q)
-
-        belief.moved_container = moved_and_noted
-        measured = perform(Open("fridge"))
-        (name, q, stamp), *_ = told
-        assert name == "fridge" and q == pytest.approx(DOOR_OPENING)  # the hand's last step
-        assert belief.container_stamps["fridge"] != stamp  # measured after it
-        assert abs(measured - opening_of(world, "fridge")) < math.radians(1)
-        perform(Close("fridge"))
-        assert opening_of(world, "fridge") < math.radians(4)
-
-
 @pytest.mark.parametrize("robot_name", ROBOTS)
 def test_a_stuck_fridge_door_raises_container_stuck(robot_name):
     with apartment_with(robot_name, {"cup": TABLE}) as (world, robot):
