@@ -253,9 +253,9 @@ def _withdraw(arm: str, obj: PerceivedObject, lifted: Any) -> bool:
     furniture's front (a ``lift`` reach: the tool's line, else planned); True when it did.
     Going to the carry configuration from inside, the held bowl met the fridge's side wall, and
     backing the base away dragged it along the wall (PR2, set-table-anywhere, ``procedural:80``
-    and ``procedural:130``, seed 1; ``procedural:80`` sets the table with this). Best effort: a failure is logged and the pick-up goes on as
-    before. Nothing to do (False) for an object not behind a door or out already, or for a lift
-    that reports no tool pose."""
+    and ``procedural:130``, seed 1; ``procedural:80`` sets the table with this). Best effort: a
+    failure is logged and the pick-up goes on as before. Nothing to do (False) for an object not
+    behind a door or out already, or for a lift that reports no tool pose."""
     environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
     name = obj.properties.get("in")
     position, orientation = getattr(lifted, "position", None), getattr(lifted, "orientation", None)
