@@ -246,6 +246,18 @@ def _planned_reach(arm: str, location: Any, obj: PerceivedObject) -> Any:
     return reach
 
 
+def _believed_container(obj: PerceivedObject) -> tuple[Any, Any] | None:
+    """The active robot's belief and the container (`pycram.world.environment.Container`) `obj`
+    is believed in (its ``"in"`` property); None when it is in none, or when the robot has no
+    belief of the environment."""
+    name = obj.properties.get("in")
+    belief = getattr(current_robot(), "belief", None)
+    environment = getattr(belief, "environment", None)
+    if not name or environment is None:
+        return None
+    return belief, environment.container(name)
+
+
 def _withdraw(arm: str, obj: PerceivedObject, lifted: Any) -> bool:
     """Take `obj`, held by `arm` and lifted (the tool at `lifted`, the pose the lift reached: a
     position [m, map] and orientation), out of the cupboard or fridge it stands in, straight
@@ -256,12 +268,11 @@ def _withdraw(arm: str, obj: PerceivedObject, lifted: Any) -> bool:
     and ``procedural:130``, seed 1; ``procedural:80`` sets the table with this). Best effort: a
     failure is logged and the pick-up goes on as before. Nothing to do (False) for an object not
     behind a door or out already, or for a lift that reports no tool pose."""
-    environment = getattr(getattr(current_robot(), "belief", None), "environment", None)
-    name = obj.properties.get("in")
+    believed = _believed_container(obj)
     position, orientation = getattr(lifted, "position", None), getattr(lifted, "orientation", None)
-    if environment is None or name is None or position is None or orientation is None:
+    if believed is None or position is None or orientation is None:
         return False
-    container = environment.container(name)
+    container = believed[1]
     if container.kind != "door":  # a drawer is open above: the lift takes the object out
         return False
     dx, dy = container.opening_direction
@@ -275,7 +286,7 @@ def _withdraw(arm: str, obj: PerceivedObject, lifted: Any) -> bool:
         # a lift's line (the tool's straight line, else planned); with the orientation given, no offset
         motion(type="reaching", arm=arm, target=target, orientation=[float(v) for v in orientation], phase="lift")
     except RECOVERABLE as error:
-        log.info("taking %s out of %s: %s; on to carrying it from where it is", obj.name, name, unwrap(error))
+        log.info("taking %s out of %s: %s; on to carrying it from where it is", obj.name, container.name, unwrap(error))
         return False
     return True
 
@@ -477,12 +488,11 @@ def _wider_opening(obj: PerceivedObject, as_far_as_needed: bool = False) -> floa
     `DOOR_USEFUL` (the object was seen inside, and the door was closed since or stuck part way);
     else `DOOR_WIDE` (or the door's limit). None when it is in no container or the container is
     (about) that far open already."""
-    name = obj.properties.get("in")
-    belief = getattr(current_robot(), "belief", None)
-    environment = getattr(belief, "environment", None)
-    if not name or belief is None or environment is None or obj.pose is None:
+    believed = _believed_container(obj)
+    if believed is None or obj.pose is None:
         return None
-    container = environment.container(name)
+    belief, container = believed
+    name = container.name
     if container.kind == "door":
         now = abs(float(belief.container_states.get(name, 0.0)))
         if as_far_as_needed:
