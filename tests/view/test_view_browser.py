@@ -10,7 +10,6 @@ from __future__ import annotations
 import io
 import os
 import re
-import signal
 import subprocess
 import sys
 import threading
@@ -24,7 +23,7 @@ pytest.importorskip("rerun")
 pytest.importorskip("mujoco")
 
 from chromium import Chromium, chromium_path  # noqa: E402
-from view_helpers import ROOT, pycram_env  # noqa: E402
+from view_helpers import ROOT, interrupt, pycram_env  # noqa: E402
 
 #: Wall time [s] the viewer may take to load and show the run (software rendering, 2 cores).
 LOAD_TIMEOUT = 200.0
@@ -104,13 +103,6 @@ def _start(args: list[str], folder: Path) -> tuple[subprocess.Popen[str], _Lines
     return child, _Lines(child.stderr)
 
 
-def _stop(child: subprocess.Popen[str]) -> int:
-    """Ctrl-C for a command that keeps serving its view; returns its exit code."""
-    if child.poll() is None:
-        child.send_signal(signal.SIGINT)
-    return child.wait(60)
-
-
 def _look(browser: Chromium, url: str, ended: _Lines, ended_pattern: str) -> bytes:
     """Open `url`, wait until the command says the run ended (`ended_pattern` on its standard
     error) and the viewer shows the run: its state names a PyCRAM recording and the view's
@@ -151,7 +143,7 @@ def test_the_live_view_loads_in_a_browser_and_shows_the_run(tmp_path):
         if os.environ.get("PYCRAM_DOCS_SCREENSHOTS") == "1":
             (ROOT / "docs" / "view.png").write_bytes(png)
     finally:
-        code = _stop(demo)
+        code = interrupt(demo)
     assert code == 0, "".join(stderr.lines)[-2000:]
     assert (tmp_path / "out" / "end.png").is_file()
 
@@ -171,7 +163,7 @@ def test_an_experiment_streams_the_run_it_is_asked_to_show(tmp_path):
         shown = set(re.findall(r"recording_id=(pycram-[0-9a-f-]+)", state))
         assert len(shown) == 1, f"only seed 2's run is shown, not {shown}"
     finally:
-        code = _stop(experiment)
+        code = interrupt(experiment)
     assert code == 0, "".join(stderr.lines)[-2000:]
 
 

@@ -152,13 +152,12 @@ def test_pycram_run_saves_the_view_of_a_plan_script(tmp_path):
 def test_pycram_view_serves_a_run_from_the_database_until_ctrl_c(set_table_run):
     """`pycram view RUN --no-rrd`: the viewer serves the rebuilt run on 127.0.0.1; Ctrl-C stops it
     (exit code 0) and its temporary recording is gone."""
-    import signal
     import subprocess
     import sys
     import tempfile
     import urllib.request
 
-    from view_helpers import pycram_env
+    from view_helpers import interrupt, pycram_env
 
     folder, db_file, _ = set_table_run
     before = set(Path(tempfile.gettempdir()).glob("pycram-view-*/run-1-db.rrd"))
@@ -184,8 +183,7 @@ def test_pycram_view_serves_a_run_from_the_database_until_ctrl_c(set_table_run):
         page = urllib.request.urlopen(f"http://127.0.0.1:{found.group(2)}/", timeout=30).read()
         assert b"re_viewer.js" in page
     finally:
-        child.send_signal(signal.SIGINT)
-        code = child.wait(60)
+        code = interrupt(child)
     assert code == 0
     assert set(Path(tempfile.gettempdir()).glob("pycram-view-*/run-1-db.rrd")) <= before
 

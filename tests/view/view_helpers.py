@@ -4,6 +4,7 @@ view's hooks, logging handler and threads start and end with it)."""
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -30,3 +31,17 @@ def run_pycram(args: list[str], cwd: Path, timeout: float = 280.0) -> subprocess
         text=True,
         timeout=timeout,
     )
+
+
+def interrupt(child: subprocess.Popen[str], timeout: float = 60.0) -> int:
+    """Ctrl-C for a `pycram` child that keeps serving its view; its exit code. A child still
+    running after `timeout` [s] is killed (its view server and workers end with it) and the test
+    fails: it never outlives the test, holding a core."""
+    if child.poll() is None:
+        child.send_signal(signal.SIGINT)
+    try:
+        return child.wait(timeout)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.wait()
+        raise AssertionError(f"`pycram` did not stop within {timeout} s of Ctrl-C; killed") from None

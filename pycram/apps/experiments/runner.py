@@ -50,6 +50,7 @@ from pycram.apps.experiments.scenarios import (
     get_scenario,
 )
 from pycram.apps.run_options import check_stepping
+from pycram.core.process_lifetime import end_with_parent
 from pycram.core.runtime.lockstep import DEFAULT_STEPPING
 from pycram.world.robot_registry import DEFAULT_ROBOT
 
@@ -451,9 +452,12 @@ def _takes_stepping(function: Any) -> bool:
     return any(p.name == "stepping" or p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters)
 
 
-def _worker_init() -> None:
-    """Local workers: Ctrl-C goes to the driver only (it stops the experiment in order)."""
+def _worker_init(driver: int | None = None) -> None:
+    """Local workers: Ctrl-C goes to the driver only (it stops the experiment in order); a worker
+    ends when its driver dies however it dies (a killed driver leaves no run going on alone).
+    `driver`: the driver's pid."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    end_with_parent(signal.SIGTERM, parent=driver)
     os.environ.setdefault("MUJOCO_GL", "egl")
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("pycram.demo").setLevel(logging.ERROR)  # a demo's story, once per run: noise here
@@ -524,7 +528,9 @@ def _run_local(prepared: PreparedExperiment, workers: int, stop: Any, finished: 
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_worker_init)
+    pool = ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_worker_init, initargs=(os.getpid(),)
+    )
     futures: dict[Any, RunKey] = {}
     try:
         for key in prepared.todo:

@@ -29,6 +29,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from urllib.parse import quote
 
+from pycram.core.process_lifetime import end_with_parent
+
 __all__ = ["ViewerServer", "ViewError", "rerun_program", "DEFAULT_PORT", "LOOPBACK"]
 
 log = logging.getLogger(__name__)
@@ -59,19 +61,6 @@ def rerun_program() -> Path:
     if not program.exists():
         raise ViewError(f"rerun-sdk is installed without its viewer program ({program} is missing); reinstall it")
     return program
-
-
-def _end_with_parent() -> None:
-    """(In the viewer's process, before it starts; Linux.) Have the kernel end it when the process
-    that started it dies, however that dies (a killed run leaves no server behind)."""
-    try:
-        import ctypes
-        import signal
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, int(signal.SIGTERM))  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):  # not Linux: `stop` (and the atexit of the caller) end it
-        pass
 
 
 class ViewerServer:
@@ -143,7 +132,7 @@ class ViewerServer:
             text=True,
             env=env,
             start_new_session=True,  # Ctrl-C in the terminal goes to pycram, which stops it
-            preexec_fn=_end_with_parent,
+            preexec_fn=end_with_parent,  # a killed run leaves no server behind
         )
         self._reader = threading.Thread(target=self._read, name="pycram-view-server", daemon=True)
         self._reader.start()
