@@ -5,8 +5,9 @@ A run recorded by `pycram demo` (thesis, set-table, set-table-open, set-table-an
 
 * ``replay``: what defines the run -- ``scenario``, ``robot``, ``environment``, ``seed``,
   ``stepping``, ``backend``, the scenario's ``options`` (e.g. ``item_at``, ``steal``,
-  ``faults``, ``pictures``: a picture taken costs one control tick of simulated time, so it
-  is part of the run) -- and the ``pycram`` and ``python`` versions that ran it;
+  ``faults``, ``pictures``: whether start and end pictures were written; they cost no
+  simulated time since stop 42 -- one control tick before, so runs recorded then replay with
+  it) -- and the ``pycram`` and ``python`` versions that ran it;
 * ``fingerprint``: the run's record (`pycram.trace.fingerprint.run_record`, packed): its task
   lines, final poses and the world's state every simulated second -- only for a run that ended
   by itself (not stopped by a signal or `--until`).

@@ -160,4 +160,6 @@ def test_clean_shutdown_leaves_no_thread(tmp_path):
     assert current_clock() is not world_clock
     with pytest.raises(WorldClosedError):
         w.drive_to(0, 0, 0)
+    with pytest.raises(WorldClosedError, match="closed"):
+        w.snapshot(tmp_path / "b.png")
     w.close()  # idempotent

@@ -175,6 +175,20 @@ def test_images_are_not_blank_and_show_the_robot(world, tmp_path):
     assert iio.imread(path).std() > 5
 
 
+def test_a_snapshot_costs_the_run_no_simulated_time(world, tmp_path):
+    """Pictures for people draw the published state in the caller's thread: in a lock-step world
+    the simulation takes no step for them, so a run with pictures is the run without (a start
+    picture had moved a TIAGo Pro set-table run by one tick and changed its outcome)."""
+    import imageio.v3 as iio
+
+    assert world.stepping == "lockstep"
+    before, trajectory = world.sim_time.get_value(), len(world.trajectory())
+    first = iio.imread(world.snapshot(tmp_path / "a.png"))
+    second = iio.imread(world.snapshot(tmp_path / "b.png"))
+    assert world.sim_time.get_value() == before and len(world.trajectory()) == trajectory
+    assert (first == second).all()  # the same state drawn twice: the same picture
+
+
 def test_animation_is_recorded(world, tmp_path):
     ok(world.start_recording(fps=20))
     base = world.base_pose.get_value()

@@ -85,6 +85,24 @@ class StateSnapshot:
         mujoco.mj_kinematics(model, data)
         mujoco.mj_camlight(model, data)
 
+    def picture(self, model: mujoco.MjModel, camera: str | FollowView, width: int, height: int) -> np.ndarray:
+        """This state drawn from `camera` (a camera name or a `FollowView`): an RGB image (height
+        x width x 3, uint8), rendered in the calling thread on a copy of `model` with a renderer
+        of its own (made and closed here: ~0.1 s), so no simulation thread is asked or waited
+        for. Thread-safe as copying `model` is while a simulation steps (it writes only weld
+        parameters and force ranges, which drawing never reads)."""
+        model = copy.copy(model)  # mj_copyModel: nothing shared with the simulation afterwards
+        model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
+        model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+        data = mujoco.MjData(model)
+        self.apply(model, data)
+        renderer = mujoco.Renderer(model, height=height, width=width)
+        try:
+            renderer.update_scene(data, camera=camera.view(model, data) if isinstance(camera, FollowView) else camera)
+            return renderer.render().copy()
+        finally:
+            renderer.close()
+
 
 class RecordedFrames(list):
     """RGB frames (height x width x 3, uint8), oldest first, as recorded by a `FrameRecorder`.

@@ -3,7 +3,8 @@ snapshots to PNG, and the head camera's object perception (`perceive`: what the 
 `detect`: measured detections for the belief, with perception faults).
 
 Rendering happens in the simulation thread (its own renderers, created on first use); each
-command returns a `CommandHandle` at once. Images are height x width arrays [px].
+command returns a `CommandHandle` at once. `snapshot` (pictures for people) draws the published
+state in the caller's thread instead and costs the simulation nothing. Images are height x width arrays [px].
 """
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ from .camera import FollowView
 from .commands import CommandQueue
 from .engine import Engine
 from .errors import WorldClosedError
-from .handle import CommandHandle, _wait_wall
+from .handle import CommandHandle
 from .perception import MAX_RANGE, MIN_PIXELS, PerceptionFaults, measure_detections, view_of
+from .recording import StateSnapshot
 from .render import Renderers, write_png
 from .robot_model import HEAD_CAMERA
 
@@ -35,6 +37,8 @@ class Sensing(CommandQueue):
     _fault_rng: np.random.Generator
     _renderers: Renderers | None
     _perception_renderers: Renderers | None
+    _state: StateSnapshot  #: what the sensors last published (`World._publish`)
+    _closed: bool
 
     def _get_renderers(self) -> Renderers:
         if self._renderers is None:
@@ -79,16 +83,18 @@ class Sensing(CommandQueue):
         camera: str | FollowView = "overview",
         width: int = 640,
         height: int = 480,
-        timeout: float = 30.0,
     ) -> Path:
-        """Render `camera` (a camera name or a `FollowView`) and write a PNG to `path` (blocks up
-        to `timeout` [s of wall time])."""
-        handle = self.request_image(camera, width, height)
-        _wait_wall(handle, timeout)
-        out = handle.outcome
-        if out is None or not out.succeeded:
-            raise WorldClosedError(f"snapshot failed: {out}")
-        return write_png(path, out.value)
+        """Draw `camera` (a camera name or a `FollowView`) and write a PNG to `path`.
+
+        The picture shows the state the sensors last published -- in a lock-step world, while
+        plan code (the caller) runs, exactly the present; in a free-running one at most one
+        sensor period old -- and is drawn in the calling thread (`StateSnapshot.picture`): it
+        sends the simulation no command, so it costs no simulated time and writing pictures
+        never changes a run. Raises `WorldClosedError` once the world is closed."""
+        self._check_camera(camera)
+        if self._closed:
+            raise WorldClosedError("snapshot of a closed world")
+        return write_png(path, self._state.picture(self.scene.model, camera, width, height))
 
     def perceive(self, min_pixels: int = 20, width: int = 320, height: int = 240) -> CommandHandle:
         """Items visible to the head camera (segmentation render): value `list[VisibleItem]`,
