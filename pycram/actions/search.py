@@ -55,7 +55,8 @@ from pycram.world.belief import BeliefState, PerceivedObject
 from pycram.world.environment import Environment, Surface
 from pycram.world.objects import OBJECT_TYPES
 
-from .core import motion
+from .core import arms, motion
+from .held import held_objects
 
 __all__ = [
     "Lookout",
@@ -398,15 +399,40 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
     driven to); False, with the reason in `skipped`, when none can. Each drive runs with the
     plan's `while_driving` job, if any."""
     first: BaseException | None = None
+    parked = False
     for stand in _stands(lookout, environment):
-        try:
-            motion(type="moving", pose=stand)
-            return True
-        except _FAILURES as failure:
-            first = first or failure
-            logger.info("cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure)
+        for _ in range(2):
+            try:
+                motion(type="moving", pose=stand)
+                return True
+            except _FAILURES as failure:
+                first = first or failure
+                logger.info(
+                    "cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure
+                )
+            if parked or not _park_empty_arms():
+                break
+            # an empty arm left out (raised to carry, or where a handle was let go) widens the
+            # robot: the place's own standing pose, refused beside a door swung open with it,
+            # is tried again with them parked (measured: the TIAGo Pro at the cupboard)
+            parked = True
     skipped[lookout.name] = f"could not get there: {first}"
     return False
+
+
+def _park_empty_arms() -> bool:
+    """Park each arm that holds nothing (best effort; an arm parked already is there at once);
+    whether any could be parked."""
+    parked = False
+    for arm in arms():
+        if arm in held_objects():
+            continue
+        try:
+            motion(type="setting_arm_configuration", arm=arm, configuration="park")
+            parked = True
+        except _FAILURES as failure:
+            logger.info("could not park the empty %s arm: %s", arm, failure)
+    return parked
 
 
 def _closed_last(
@@ -451,6 +477,10 @@ def _visit(
             except _FAILURES as failure:
                 skipped[lookout.name] = f"could not open {container}: {failure}"
                 return None
+            # opening leaves the robot where it held the handle, often beside the door it swung
+            # open, which then hides the inside (measured: the TIAGo Pro at the cupboard): the
+            # look is made from the place's own standing pose again (else from where it is)
+            _drive_to_look(lookout, environment, {})
         try:
             found = _look(description, _target(lookout, environment, belief))
         except _FAILURES as failure:

@@ -236,6 +236,34 @@ def test_an_object_seen_in_the_cupboard_that_was_closed_since_is_picked_up_after
         assert tasks_named(task, "perform opening")
 
 
+def test_a_look_into_a_door_container_it_opened_is_made_from_the_places_standing_pose():
+    """Opening the cupboard leaves the TIAGo Pro where it held the handle, beside the door it
+    swung open, which hides the shelf from there; with its empty left arm still raised to carry,
+    the place's own standing pose does not fit beside the open door. The search parks the empty
+    arm, stands there again and sees the cup (set-table, TIAGo Pro, dev seeds 11 and 12: the cup
+    in the cupboard was never seen)."""
+    from pycram.actions.containers import opening_one_at_a_time
+    from pycram.actions.search import _visit, lookouts
+
+    with apartment_with(
+        "tiago-pro", {"cup": ("cupboard shelf", (4.15, 4.65))}, base_pose=(4.35, 3.4, math.pi / 2)
+    ) as (world, robot):
+        perform(ParkArms())
+        perform(MoveTorso("up"))
+        perform(MotionDesignator(type="setting_arm_configuration", arm="left", configuration="carry"))
+        environment = robot.belief.environment
+        (shelf,) = [place for place in lookouts(environment, "cup", (4.35, 3.4)) if place.container == "cupboard"]
+        looked, skipped = [], {}
+        description = ObjectDesignator(type="cup")
+        found, task = run_as_task(
+            lambda: _visit(description, shelf, environment, robot.belief, opening_one_at_a_time(), looked, skipped)
+        )
+        assert found is not None and found.type == "cup", (looked, skipped)
+        assert opening_of(world, "cupboard") >= math.radians(45)
+        base = world.base_pose.get_value()
+        assert math.dist((base.x, base.y), shelf.stand[:2]) < 0.05  # looked from the place's own pose
+
+
 def test_a_drawer_pulled_out_beside_the_one_closed_is_seen_and_closed_too():
     """Closing a drawer looks at its neighbours' handles: one pulled out meanwhile (by a person
     here; by the TIAGo's arm going up from drawer 1 in the faulted set-table runs) is believed
