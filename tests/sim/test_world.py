@@ -87,6 +87,26 @@ def test_blocked_straight_drive_fails_and_stops(world):
     ok(world.drive_to(start.x, start.y, start.yaw))
 
 
+def test_a_base_that_stopped_touching_something_drives_off_but_not_into_it(world):
+    """A drive stopped by a contact leaves the base touching the obstacle: a drive away from it
+    succeeds (every drive failed at once before: the TIAGo Pro stood against a drawer handle for
+    the rest of a set-table run), a drive on into it still fails and does not get past it."""
+    start = world.base_pose.get_value()
+    c, s = math.cos(start.yaw), math.sin(start.yaw)
+    obstacle = ok(world.place_obstacle(start.x + 1.2 * c, start.y + 1.2 * s))
+    try:
+        out = world.drive_to(start.x + 2.0 * c, start.y + 2.0 * s, start.yaw, plan_path=False).wait(T)
+        assert out is not None and out.reason == "collision", out
+        stopped = world.base_pose.get_value()
+        out = world.drive_to(start.x + 2.0 * c, start.y + 2.0 * s, start.yaw, plan_path=False).wait(T)
+        assert out is not None and out.reason in ("collision", "blocked"), out
+        assert world.base_pose.get_value().distance_to(stopped) < 0.05
+        ok(world.drive_to(start.x, start.y, start.yaw, plan_path=False))
+    finally:
+        ok(world.remove_obstacle(obstacle))
+    assert world.base_pose.get_value().distance_to(start) < 0.02
+
+
 def test_drive_can_be_cancelled(world):
     start = world.base_pose.get_value()
     # 2 m ahead along its heading: every base (a differential drive too) sets off at once

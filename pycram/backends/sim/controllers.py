@@ -103,9 +103,17 @@ class BaseDrive(Controller):
     Fails with "collision" when a base link touches the environment, with "blocked" when the base
     lags its reference by more than `max_lag` [m] (or 0.15 rad), and with "timeout" when it does
     not settle within 2 cm / 2 deg. Succeeds within `tolerance` [m] and `yaw_tolerance` [rad].
+    What a base link touches as the drive starts does not fail it until the base is
+    `LEAVING_CONTACT` away from where it started: a base that came to rest touching something
+    may drive off (else every drive failed at once and the robot stood there for good; measured:
+    the TIAGo Pro against a drawer handle, set-table seed 29); driving into it, the base lags its
+    reference and the drive fails "blocked".
     """
 
     channel = "base"
+
+    #: How far [m] the base may drive before what it touched at the start counts as a collision.
+    LEAVING_CONTACT = 0.15
 
     #: Tolerances [m], [rad] of the intermediate stops of a differential drive's turn-drive-turn.
     STOP_TOLERANCE = (0.01, 0.02)
@@ -117,6 +125,8 @@ class BaseDrive(Controller):
         self._stops: list[Pose2D] = []
         self._last = goal  # the last move's target: `goal`, or the turn on the spot that reaches it
         self.kinematics = BaseKinematics()
+        self._origin = (0.0, 0.0)  # where the base started [m]
+        self._touching: set[str] = set()  # what a base link touched then (environment geom names)
 
     def start(self, eng: Engine) -> Outcome | None:
         refused = invalid_input(
@@ -128,6 +138,8 @@ class BaseDrive(Controller):
         if refused is not None:
             return refused
         p = eng.base_pose()
+        self._origin = (p.x, p.y)
+        self._touching = {other for _, other in eng.base_contacts()}  # what it may drive off
         self.kinematics = BaseKinematics.of(eng.desc.BASE)
         here, goal = BasePose(p.x, p.y, p.yaw), BasePose(self.goal.x, self.goal.y, self.goal.yaw)
         self._last = self.goal
@@ -175,11 +187,16 @@ class BaseDrive(Controller):
 
     def update(self, eng: Engine, t: float) -> Outcome | None:
         rx, ry, ryaw = self._reference(t)
-        contacts = eng.base_contacts()
-        if contacts:
-            return fail("collision", f"base touches {contacts[0][1]}", eng.base_pose())
         qpos = eng.data.qpos
         x, y, yaw = (float(qpos[i]) for i in eng.base_qpos)  # BASE_JOINTS: x, y, yaw
+        contacts = eng.base_contacts()
+        if contacts and self._touching:
+            if math.hypot(x - self._origin[0], y - self._origin[1]) < self.LEAVING_CONTACT:
+                contacts = [c for c in contacts if c[1] not in self._touching]
+            else:
+                self._touching = set()  # it has driven off: every contact counts again
+        if contacts:
+            return fail("collision", f"base touches {contacts[0][1]}", eng.base_pose())
         lag = math.hypot(rx - x, ry - y)
         if lag > self.max_lag or abs(ryaw - yaw) > 0.15:
             return fail("blocked", f"base is {lag:.3f} m behind its reference", eng.base_pose())
