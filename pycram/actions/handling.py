@@ -32,13 +32,11 @@ BACK_AWAY = 0.3
 
 def carry_configuration(arm: str, grasp: Grasp) -> str:
     """The named arm configuration to carry an object held with `grasp` in: ``carry_top`` (the
-    tool pointing down, the object level) for top grasps of rims and across an axis (bowls,
-    plates, spoons) when the robot's description has it, else ``carry`` -- also for the top grasp
-    of a cup's or mug's body (out of a drawer): carried in ``carry_top`` and put down on the
-    table, the PR2's cup ended tilted 75 deg (measured), in ``carry`` upright."""
+    tool pointing down, the object level) for a grasp `Grasp.held_from_above` when the robot's
+    description has it, else ``carry``. The arm comes to the grasp in it too (location reasoning
+    checks the grasp from there)."""
     named = _description().ARM_CONFIGURATIONS.get(arm, {})
-    body = grasp.across == "radial" and grasp.radius == 0.0
-    return "carry_top" if grasp.approach == "top" and not body and "carry_top" in named else "carry"
+    return "carry_top" if grasp.held_from_above and "carry_top" in named else "carry"
 
 
 def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None, grasping: Any = None) -> Any:

@@ -71,6 +71,15 @@ class Grasp:
         if self.approach not in APPROACHES:
             raise ValueError(f"grasp approach {self.approach!r} is not one of {', '.join(APPROACHES)}")
 
+    @property
+    def held_from_above(self) -> bool:
+        """Whether an object held with this grasp is carried with the tool pointing down (the
+        arm's ``carry_top`` configuration, where it has one): top grasps of rims and across an
+        axis (bowls, plates, spoons, boxes from above) -- not the top grasp of a cup's or mug's
+        body (out of a drawer): carried so and put down on the table, the PR2's cup ended tilted
+        75 deg (measured), in ``carry`` (the tool level) upright."""
+        return self.approach == "top" and not (self.across == "radial" and self.radius == 0.0)
+
     def side_point(
         self, centre: tuple[float, float, float] | list[float], half_height: float, heading: float
     ) -> tuple[float, float, float]:

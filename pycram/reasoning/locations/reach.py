@@ -186,7 +186,16 @@ class ReachVocabulary(StandingSearch):
                     if margin:  # room to spare below the grasp
                         (gx, gy, gz), q = poses[1]
                         poses.insert(2, ((gx, gy, gz - margin), q))
-                    answer = prosp.reachable(arm, poses, (x, y, yaw), configuration)
+                    answer = None
+                    coming = (self.geometry.carry_top or {}).get(arm)
+                    if coming and grasp.held_from_above:
+                        # IK from where the arm comes (it carries the object in `carry_top` too):
+                        # from `ready`, the TIAGo Pro's grasps came out with the wrist turned the
+                        # other way round, and the way to `carry_top` swung a plate held from
+                        # above 0.55 m sideways into a milk carton it had not seen (dev seed 28)
+                        answer = prosp.reachable(arm, poses, (x, y, yaw), {**configuration, **coming})
+                    if not answer:
+                        answer = prosp.reachable(arm, poses, (x, y, yaw), configuration)
                     if answer:
                         joints = tuple(j for i, j in enumerate(answer.solutions) if not (margin and i == 2))
                         tool = tuple(p for i, p in enumerate(poses) if not (margin and i == 2))

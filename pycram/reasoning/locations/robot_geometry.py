@@ -34,7 +34,9 @@ class RobotGeometry:
     frame where a point to reach lies comfortably. `approach_offsets`: phase -> (back along the
     approach [m], up [m]). `tucked`: joint name -> position of every arm's park configuration.
     `ready` per arm: the configuration the arm is raised to before it approaches (``carry``: over
-    the furniture), joint name -> position. `contact_margin` [m]: how far below a grasp pose the
+    the furniture), joint name -> position; `carry_top` per arm: the one it comes in instead for a
+    grasp `Grasp.held_from_above` (``carry_top``: the tool pointing down), joint name -> position.
+    `contact_margin` [m]: how far below a grasp pose the
     arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
     pass through configurations IK did not check). `torso_joint` and `torso_positions` (name ->
     height [m]): the torso lift, for solutions that need another torso height. `door_push`: how
@@ -60,6 +62,7 @@ class RobotGeometry:
     tucked: Mapping[str, float]
     arm_joints: Mapping[str, tuple[str, ...]]
     ready: Mapping[str, Mapping[str, float]] = None  # type: ignore[assignment]
+    carry_top: Mapping[str, Mapping[str, float]] = None  # type: ignore[assignment]
     contact_margin: float = 0.0
     torso_joint: str | None = None
     torso_positions: Mapping[str, float] = None  # type: ignore[assignment]
@@ -93,6 +96,11 @@ class RobotGeometry:
                 a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry"]))
                 for a, s in d.ARMS.items()
                 if "carry" in d.ARM_CONFIGURATIONS[a]
+            },
+            carry_top={
+                a: dict(zip(s["joints"], d.ARM_CONFIGURATIONS[a]["carry_top"]))
+                for a, s in d.ARMS.items()
+                if "carry_top" in d.ARM_CONFIGURATIONS[a]
             },
             contact_margin=float(d.GRASP_CONTACT_MARGIN),
             torso_joint=d.TORSO.get("joint"),
