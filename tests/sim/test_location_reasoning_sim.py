@@ -115,6 +115,26 @@ def test_to_reach_solutions_let_the_robot_grasp_the_object(robot_name, seed, nam
         world.close()
 
 
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_grasp_held_from_above_is_solved_near_the_configuration_it_is_carried_in(seed):
+    """The TIAGo Pro comes to a plate with its arm in ``carry_top`` and carries it there:
+    location reasoning solves the grasp from there, so the lift's joints lie near it (from the
+    side ``carry`` they came out with the wrist turned the other way round, 2.9 rad from it,
+    and the way to ``carry_top`` swung a plate 0.55 m sideways into a milk carton)."""
+    world, robot = make("tiago-pro", seed, objects=("plate",))
+    try:
+        with robot:
+            motion(type="setting_torso", position="up")
+            location = LocationDesignator([("to_reach", believed(world, "plate"))]).reference()
+            assert location.grasp == "top"
+            carry_top = robot.description.ARM_CONFIGURATIONS[location.arm]["carry_top"]
+            lift = location.joints[-1]
+            assert max(abs(a - b) for a, b in zip(lift, carry_top)) < 2.0
+    finally:
+        robot.shutdown()
+        world.close()
+
+
 def test_an_object_out_of_reach_says_so():
     world, robot = make("tiago", 1)  # the cup stands 0.46 m deep on the counter
     try:

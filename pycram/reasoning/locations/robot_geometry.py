@@ -36,12 +36,12 @@ class RobotGeometry:
     `ready` per arm: the configuration the arm is raised to before it approaches (``carry``: over
     the furniture), joint name -> position; `carry_top` per arm: the one it comes in instead for a
     grasp `Grasp.held_from_above` (``carry_top``: the tool pointing down), joint name -> position.
-    `contact_margin` [m]: how far below a grasp pose the
-    arm must reach as well without touching anything (``GRASP_CONTACT_MARGIN``; executed motions
-    pass through configurations IK did not check). `torso_joint` and `torso_positions` (name ->
-    height [m]): the torso lift, for solutions that need another torso height. `door_push`: how
-    the hand meets a door's face when it pushes one (``DOOR_PUSH``, see `pycram.reasoning.locations.doors`;
-    None: the robot does not push doors).
+    `contact_margin` [m]: how far below a grasp pose the arm must reach as well without touching
+    anything (``GRASP_CONTACT_MARGIN``; executed motions pass through configurations IK did not
+    check). `torso_joint` and `torso_positions` (name -> height [m]): the torso lift, for
+    solutions that need another torso height. `door_push`: how the hand meets a door's face when
+    it pushes one (``DOOR_PUSH``, see `pycram.reasoning.locations.doors`; None: the robot does not
+    push doors).
     `fingertip_reach` [m]: how far the finger tips reach beyond the tool frame along the approach
     (``FINGERTIP_REACH``); a top grasp keeps them `top_grasp_clearance` [m]
     (``TOP_GRASP_CLEARANCE``) above the surface the object rests on (`top_grasp_height`).
