@@ -407,9 +407,7 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
                 return True
             except _FAILURES as failure:
                 first = first or failure
-                logger.info(
-                    "cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure
-                )
+                logger.info("cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure)
             if parked or not _park_empty_arms():
                 break
             # an empty arm left out (raised to carry, or where a handle was let go) widens the

@@ -245,9 +245,10 @@ def test_a_look_into_a_door_container_it_opened_is_made_from_the_places_standing
     from pycram.actions.containers import opening_one_at_a_time
     from pycram.actions.search import _visit, lookouts
 
-    with apartment_with(
-        "tiago-pro", {"cup": ("cupboard shelf", (4.15, 4.65))}, base_pose=(4.35, 3.4, math.pi / 2)
-    ) as (world, robot):
+    with apartment_with("tiago-pro", {"cup": ("cupboard shelf", (4.15, 4.65))}, base_pose=(4.35, 3.4, math.pi / 2)) as (
+        world,
+        robot,
+    ):
         perform(ParkArms())
         perform(MoveTorso("up"))
         perform(MotionDesignator(type="setting_arm_configuration", arm="left", configuration="carry"))
