@@ -25,6 +25,8 @@ pytest.importorskip("mujoco")
 from chromium import Chromium, chromium_path  # noqa: E402
 from view_helpers import ROOT, interrupt, pycram_env  # noqa: E402
 
+from pycram.core.process_lifetime import end_with_parent  # noqa: E402
+
 #: Wall time [s] the viewer may take to load and show the run (software rendering, 2 cores).
 LOAD_TIMEOUT = 200.0
 
@@ -99,6 +101,7 @@ def _start(args: list[str], folder: Path) -> tuple[subprocess.Popen[str], _Lines
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=end_with_parent,  # ended with the test run even when a time-out kills it
     )
     return child, _Lines(child.stderr)
 

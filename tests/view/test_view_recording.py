@@ -159,6 +159,8 @@ def test_pycram_view_serves_a_run_from_the_database_until_ctrl_c(set_table_run):
 
     from view_helpers import interrupt, pycram_env
 
+    from pycram.core.process_lifetime import end_with_parent
+
     folder, db_file, _ = set_table_run
     before = set(Path(tempfile.gettempdir()).glob("pycram-view-*/run-1-db.rrd"))
     child = subprocess.Popen(
@@ -170,6 +172,7 @@ def test_pycram_view_serves_a_run_from_the_database_until_ctrl_c(set_table_run):
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=end_with_parent,  # ended with the test run even when a time-out kills it
     )
     try:
         lines = []
