@@ -465,6 +465,7 @@ def _visit(
         return None
     if not _drive_to_look(lookout, environment, skipped):
         return None
+    opened = False  # the last look is the first since this visit opened the container
     for _ in range(2):  # a look that finds the container closed opens it and looks again
         if container is not None and belief.container_open(container) is False:
             if open_container is None:
@@ -475,12 +476,18 @@ def _visit(
             except _FAILURES as failure:
                 skipped[lookout.name] = f"could not open {container}: {failure}"
                 return None
-            # opening leaves the robot where it held the handle, often beside the door it swung
-            # open, which then hides the inside (measured: the TIAGo Pro at the cupboard): the
-            # look is made from the place's own standing pose again (else from where it is)
-            _drive_to_look(lookout, environment, {})
+            opened = True
         try:
             found = _look(description, _target(lookout, environment, belief))
+            if found is None and opened and container and environment.container(container).kind == "door":
+                # opening leaves the robot where it held the handle, often beside the door it
+                # swung open, which then hides the shelf (measured: the TIAGo Pro at the
+                # cupboard): it looks again from the place's own standing pose. (A drawer is
+                # looked into from where it was pulled out: from the standing pose, farther
+                # back, its walls hide what lies inside.)
+                opened = False
+                if _drive_to_look(lookout, environment, {}):
+                    found = _look(description, _target(lookout, environment, belief))
         except _FAILURES as failure:
             skipped[lookout.name] = f"could not look at it: {failure}"
             return None
