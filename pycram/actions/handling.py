@@ -1,7 +1,8 @@
 """What picking up and placing share: the arm configuration an object is carried in
 (`carry_configuration`), reaching one phase of a grasp or place sequence (`_reach`), backing
-the base away from the furniture (`back_away`, `BACK_AWAY` [m]), and looking at an object again
-before believing what a look tells (`_look_again`, at most `LOOKS_TO_CONFIRM` looks).
+the base away from the furniture (`back_away`, `BACK_AWAY` [m]), parking the arms that hold
+nothing (`park_empty_arms`), and looking at an object again before believing what a look tells
+(`_look_again`, at most `LOOKS_TO_CONFIRM` looks).
 
 Everything here moves the robot through motion designators (`pycram.actions.core.motion`);
 `back_away` is best effort (a failure is logged, not raised).
@@ -9,15 +10,19 @@ Everything here moves the robot through motion designators (`pycram.actions.core
 
 from __future__ import annotations
 
+import logging
 from typing import Any
 
 from pycram.execution.robot import current_robot
 from pycram.world.belief import PerceivedObject
 from pycram.world.objects import Grasp
 
-from .core import _description, best_effort, motion
+from .core import RECOVERABLE, _description, arms, best_effort, motion, unwrap
+from .held import held_objects
 
-__all__ = ["carry_configuration", "back_away", "BACK_AWAY", "LOOKS_TO_CONFIRM"]
+__all__ = ["carry_configuration", "back_away", "park_empty_arms", "BACK_AWAY", "LOOKS_TO_CONFIRM"]
+
+log = logging.getLogger("pycram.actions")
 
 #: Looks at an object that should be in view before the action believes what they tell: it is
 #: looked at again while it is missed but not believed gone yet (`BeliefState.misses_to_gone`).
@@ -37,6 +42,21 @@ def carry_configuration(arm: str, grasp: Grasp) -> str:
     checks the grasp from there)."""
     named = _description().ARM_CONFIGURATIONS.get(arm, {})
     return "carry_top" if grasp.held_from_above and "carry_top" in named else "carry"
+
+
+def park_empty_arms(keep: str | None = None) -> bool:
+    """Park each arm but `keep` that holds nothing (best effort: a failure is logged; an arm
+    parked already is there at once); whether any was parked."""
+    parked = False
+    for arm in arms():
+        if arm == keep or arm in held_objects():
+            continue
+        try:
+            motion(type="setting_arm_configuration", arm=arm, configuration="park")
+            parked = True
+        except RECOVERABLE as error:
+            log.info("parking the empty %s arm: %s", arm, unwrap(error))
+    return parked
 
 
 def _reach(arm: str, location: Any, index: int, phase: str, point: list[float] | None, grasping: Any = None) -> Any:

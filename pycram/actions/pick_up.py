@@ -55,7 +55,6 @@ from .core import (
     ActionParameterError,
     action_plan,
     arm_name,
-    arms,
     attempt,
     best_effort,
     check_grasp,
@@ -67,7 +66,7 @@ from .core import (
     solutions,
     unwrap,
 )
-from .handling import _look_again, _pose_text, _reach, _xyz, back_away, carry_configuration
+from .handling import _look_again, _pose_text, _reach, _xyz, back_away, carry_configuration, park_empty_arms
 from .held import Held, fingers_yaw, held_objects
 from .search import search_for
 
@@ -319,12 +318,7 @@ def _grasp_from(location: Any, obj: PerceivedObject, grasp: Grasp) -> Held:
     _arm_to_drive(arm, "park" if deep else carry_configuration(arm, grasp))
     # another arm that holds nothing is parked: raised to carry, it stands over the counter beside
     # the object and swept a milk carton over as the base drove up (measured: the PR2's)
-    for other in arms():
-        if other != arm and other not in held_objects():
-            best_effort(
-                f"parking the empty {other} arm",
-                partial(motion, type="setting_arm_configuration", arm=other, configuration="park"),
-            )
+    park_empty_arms(keep=arm)
     try:
         motion(type="moving", pose=location)
     except RECOVERABLE as error:

@@ -55,8 +55,8 @@ from pycram.world.belief import BeliefState, PerceivedObject
 from pycram.world.environment import Environment, Surface
 from pycram.world.objects import OBJECT_TYPES
 
-from .core import arms, motion
-from .held import held_objects
+from .core import motion
+from .handling import park_empty_arms
 
 __all__ = [
     "Lookout",
@@ -408,7 +408,7 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
             except _FAILURES as failure:
                 first = first or failure
                 logger.info("cannot stand at (%.2f, %.2f) to look at %s: %s", stand[0], stand[1], lookout.name, failure)
-            if parked or not _park_empty_arms():
+            if parked or not park_empty_arms():
                 break
             # an empty arm left out (raised to carry, or where a handle was let go) widens the
             # robot: the place's own standing pose, refused beside a door swung open with it,
@@ -416,21 +416,6 @@ def _drive_to_look(lookout: Lookout, environment: Environment, skipped: dict[str
             parked = True
     skipped[lookout.name] = f"could not get there: {first}"
     return False
-
-
-def _park_empty_arms() -> bool:
-    """Park each arm that holds nothing (best effort; an arm parked already is there at once);
-    whether any could be parked."""
-    parked = False
-    for arm in arms():
-        if arm in held_objects():
-            continue
-        try:
-            motion(type="setting_arm_configuration", arm=arm, configuration="park")
-            parked = True
-        except _FAILURES as failure:
-            logger.info("could not park the empty %s arm: %s", arm, failure)
-    return parked
 
 
 def _closed_last(
